@@ -1,0 +1,3 @@
+"""pymoo-rail: energy-efficient train driving as pymoo problems and algorithms."""
+
+__version__ = "0.1.0"
