@@ -1,0 +1,133 @@
+"""The line on a distance grid: what the simulator and the exact solver read per step.
+
+Line resistances are per unit weight (N/kN): gradient ``i`` permille gives ``i`` N/kN (seed 000
+eq. 2-10), a curve of radius R gives ``600 / R`` (eq. 2-11), a tunnel of length Ls gives
+``0.00013 Ls`` (eq. 2-12). With ``gradient_model = "train_length"`` they act on the train as the
+average over its length (eq. 4-14); the stations beyond both ends count as flat. Each grid cell
+stores the exact mean of that (piecewise linear) average over the cell, so the work done against
+gradients over a run equals ``m g`` times the rise of the train's centre of mass exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pymoo_rail.model.case import Case
+from pymoo_rail.model.curves import KMH_PER_MS
+from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.train import GRAVITY_MS2
+
+CURVE_RESISTANCE_A = 600.0  # seed 000 eq. 2-11, the usual value in [450, 800]
+TUNNEL_RESISTANCE_PER_M = 0.00013  # seed 000 eq. 2-12, N/kN per metre of tunnel
+
+
+@dataclass(frozen=True, eq=False)
+class TrackGrid:
+    """Per-node and per-cell arrays of one line for one train.
+
+    Attributes
+    ----------
+    position_m : (n,) node positions, from 0 to the line length
+    limit_ms : (n,) the speed limit at each node for the head of the train, the lowest limit that
+        applies anywhere under the train or within the next cell (so it holds over the whole length)
+    grade_force_n : (n-1,) gradient force per cell, + resists motion
+    other_force_n : (n-1,) curve and tunnel resistance per cell (always >= 0)
+    neutral : (n-1,) 1 where the cell touches a neutral section (no traction), else 0
+    """
+
+    dx_m: float
+    position_m: np.ndarray
+    limit_ms: np.ndarray
+    grade_force_n: np.ndarray
+    other_force_n: np.ndarray
+    neutral: np.ndarray
+
+    @property
+    def n_nodes(self) -> int:
+        return self.position_m.shape[0]
+
+    @property
+    def line_force_n(self) -> np.ndarray:
+        """All line resistance per cell (gradient + curves + tunnels)."""
+        return self.grade_force_n + self.other_force_n
+
+
+def _integrals(rows: list[tuple[float, float, float]], x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """W(x) = int_0^x w and WW(x) = int_0^x W for a piecewise-constant w (0 outside the rows).
+
+    W and WW are 0 for x <= 0 and continue (linearly resp. quadratically) beyond the last row.
+    """
+    knots = sorted({0.0} | {r[0] for r in rows} | {r[1] for r in rows})
+    knots = np.asarray(knots)
+    slope = np.zeros(knots.shape[0])  # w on [knot_k, knot_{k+1})
+    for start, end, value in rows:
+        slope[(knots >= start) & (knots < end)] += value
+    w_cum = np.zeros(knots.shape[0])
+    ww_cum = np.zeros(knots.shape[0])
+    for k in range(1, knots.shape[0]):
+        h = knots[k] - knots[k - 1]
+        w_cum[k] = w_cum[k - 1] + slope[k - 1] * h
+        ww_cum[k] = ww_cum[k - 1] + w_cum[k - 1] * h + 0.5 * slope[k - 1] * h * h
+    xc = np.maximum(x, 0.0)
+    k = np.clip(np.searchsorted(knots, xc, side="right") - 1, 0, knots.shape[0] - 1)
+    h = xc - knots[k]
+    return w_cum[k] + slope[k] * h, ww_cum[k] + w_cum[k] * h + 0.5 * slope[k] * h * h
+
+
+def cell_means(rows: list[tuple[float, float, float]], position_m: np.ndarray, train_length_m: float | None) -> np.ndarray:
+    """Exact mean over each cell of w (point mass) or of its average over the train length."""
+    a, b = position_m[:-1], position_m[1:]
+    if train_length_m is None:
+        w_b, _ = _integrals(rows, b)
+        w_a, _ = _integrals(rows, a)
+        return (w_b - w_a) / (b - a)
+    length = train_length_m
+    _, ww_b = _integrals(rows, b)
+    _, ww_a = _integrals(rows, a)
+    _, ww_bl = _integrals(rows, b - length)
+    _, ww_al = _integrals(rows, a - length)
+    return (ww_b - ww_a - ww_bl + ww_al) / (length * (b - a))
+
+
+def default_dx_m(case: Case) -> float:
+    """Grid step used when none is given: 1 m for metro sections, 5 m for long main-line runs."""
+    return 1.0 if case.line.length_m <= 10_000 else 5.0
+
+
+def build_grid(case: Case, dx_m: float | None = None) -> TrackGrid:
+    """Discretise the case's line for its train.
+
+    Parameters
+    ----------
+    case : Case
+    dx_m : float, optional
+        Requested step; the actual step divides the line into equal cells no longer than this.
+    """
+    if dx_m is None:
+        dx_m = default_dx_m(case)
+    if not (np.isfinite(dx_m) and dx_m > 0):
+        raise CaseError("dx_m", dx_m, "the grid step must be a positive number")
+    line, train = case.line, case.train
+    n_cells = max(int(np.ceil(line.length_m / dx_m - 1e-9)), 2)
+    position = np.linspace(0.0, line.length_m, n_cells + 1)
+    dx = line.length_m / n_cells
+
+    averaging = train.length_m if line.gradient_model == "train_length" else None
+    weight_kn = train.mass_kg * GRAVITY_MS2 / 1000.0
+    grade = cell_means(list(line.gradients), position, averaging) * weight_kn
+    other_rows = [(s, e, CURVE_RESISTANCE_A / r) for s, e, r in line.curves]
+    other_rows += [(s, e, TUNNEL_RESISTANCE_PER_M * (e - s)) for s, e in line.tunnels]
+    other = cell_means(other_rows, position, averaging) * weight_kn if other_rows else np.zeros(n_cells)
+
+    # The head at x must respect every limit on [x - L, x + dx): the whole train, plus the cell ahead.
+    limit_kmh = np.full(position.shape[0], train.max_speed_kmh)
+    for start, end, value in line.speed_limits:
+        covered = (start < position + dx) & (end > position - train.length_m)
+        limit_kmh[covered] = np.minimum(limit_kmh[covered], value)
+    neutral = np.zeros(n_cells, dtype=np.uint8)
+    for start, end in line.neutral_sections:
+        neutral[(position[:-1] < end) & (position[1:] > start)] = 1
+    return TrackGrid(dx_m=dx, position_m=position, limit_ms=limit_kmh / KMH_PER_MS,
+                     grade_force_n=grade, other_force_n=other, neutral=neutral)

@@ -1,0 +1,119 @@
+"""The line between two stops: gradients, curves, tunnels, speed limits, neutral sections."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from pymoo_rail.model.errors import CaseError
+
+Interval = tuple[float, float]
+Valued = tuple[float, float, float]
+
+GRADIENT_MODELS = ("train_length", "point_mass")
+
+
+def _check_intervals(field: str, rows: tuple, length_m: float, *, tile: bool, width: int) -> None:
+    """Rows ``[start_m, end_m, ...]`` inside [0, length]; ``tile`` demands they cover it exactly."""
+    previous_end = 0.0
+    for k, row in enumerate(rows):
+        if len(row) != width:
+            raise CaseError(f"{field}[{k}]", list(row), f"needs {width} numbers")
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in row):
+            raise CaseError(f"{field}[{k}]", list(row), "needs finite numbers")
+        start, end = row[0], row[1]
+        if end <= start:
+            raise CaseError(f"{field}[{k}]", list(row), "end_m must be greater than start_m (negative or zero length)")
+        if start < 0 or end > length_m + 1e-9:
+            raise CaseError(f"{field}[{k}]", list(row), f"lies outside the line [0, {length_m}] m")
+        if tile and abs(start - previous_end) > 1e-9:
+            kind = "gap" if start > previous_end else "overlap"
+            raise CaseError(f"{field}[{k}]", list(row), f"{kind} at {previous_end} m: segments must tile the line")
+        if not tile and start < previous_end - 1e-9:
+            raise CaseError(f"{field}[{k}]", list(row), f"overlaps the previous entry ending at {previous_end} m")
+        previous_end = end
+    if tile and abs(previous_end - length_m) > 1e-9:
+        raise CaseError(field, f"ends at {previous_end} m", f"must cover the line up to length_m = {length_m}")
+
+
+@dataclass(frozen=True)
+class Line:
+    """A section of track from one stop (x = 0) to the next (x = ``length_m``).
+
+    ``gradients`` rows are ``(start_m, end_m, permille)`` with + uphill; ``speed_limits`` rows are
+    ``(start_m, end_m, kmh)``; both must tile [0, length]. ``curves`` rows are
+    ``(start_m, end_m, radius_m)``; ``tunnels`` and ``neutral_sections`` rows ``(start_m, end_m)``.
+    ``gradient_model`` is ``"train_length"`` (line resistance averaged over the train, seed 000
+    eq. 4-14) or ``"point_mass"``.
+    """
+
+    length_m: float
+    gradients: tuple[Valued, ...]
+    speed_limits: tuple[Valued, ...]
+    curves: tuple[Valued, ...] = ()
+    tunnels: tuple[Interval, ...] = ()
+    neutral_sections: tuple[Interval, ...] = ()
+    gradient_model: str = "train_length"
+
+    def __post_init__(self) -> None:
+        if isinstance(self.length_m, bool) or not isinstance(self.length_m, (int, float)) \
+                or not math.isfinite(self.length_m) or self.length_m <= 0:
+            raise CaseError("line.length_m", self.length_m, "must be a positive number")
+        for name in ("gradients", "speed_limits", "curves", "tunnels", "neutral_sections"):
+            object.__setattr__(self, name, tuple(tuple(float(v) for v in row) for row in getattr(self, name)))
+        _check_intervals("line.gradients", self.gradients, self.length_m, tile=True, width=3)
+        _check_intervals("line.speed_limits", self.speed_limits, self.length_m, tile=True, width=3)
+        _check_intervals("line.curves", self.curves, self.length_m, tile=False, width=3)
+        _check_intervals("line.tunnels", self.tunnels, self.length_m, tile=False, width=2)
+        _check_intervals("line.neutral_sections", self.neutral_sections, self.length_m, tile=False, width=2)
+        for k, row in enumerate(self.speed_limits):
+            if row[2] <= 0:
+                raise CaseError(f"line.speed_limits[{k}]", list(row), "the limit must be > 0 km/h")
+        for k, row in enumerate(self.curves):
+            if row[2] <= 0:
+                raise CaseError(f"line.curves[{k}]", list(row), "the radius must be > 0 m")
+        if self.gradient_model not in GRADIENT_MODELS:
+            raise CaseError("line.gradient_model", self.gradient_model, f"must be one of {GRADIENT_MODELS}")
+
+    def breakpoints_m(self) -> list[float]:
+        """Every position where the gradient or the speed limit changes, with 0 and the length."""
+        points = {0.0, float(self.length_m)}
+        for rows in (self.gradients, self.speed_limits):
+            for row in rows:
+                points.update((row[0], row[1]))
+        return sorted(points)
+
+    def limit_kmh_at(self, position_m: float) -> float:
+        """The speed limit at one point of the track."""
+        for start, end, limit in self.speed_limits:
+            if start <= position_m < end:
+                return limit
+        return self.speed_limits[-1][2]
+
+    def altitude_m(self, position_m):
+        """Altitude relative to the start, integrating the gradients (point values, not averaged)."""
+        import numpy as np
+
+        x = np.asarray(position_m, dtype=float)
+        knots = [0.0] + [row[1] for row in self.gradients]
+        heights = [0.0]
+        for start, end, permille in self.gradients:
+            heights.append(heights[-1] + (end - start) * permille / 1000.0)
+        return np.interp(x, knots, heights)
+
+    def slice(self, start_m: float, end_m: float) -> Line:
+        """The part of the line between two positions, re-based to start at 0."""
+        if not (0 <= start_m < end_m <= self.length_m + 1e-9):
+            raise CaseError("slice", (start_m, end_m), f"must satisfy 0 <= start < end <= {self.length_m}")
+
+        def cut(rows):
+            out = []
+            for row in rows:
+                a, b = max(row[0], start_m), min(row[1], end_m)
+                if b > a:
+                    out.append((a - start_m, b - start_m, *row[2:]))
+            return tuple(out)
+
+        return replace(self, length_m=end_m - start_m, gradients=cut(self.gradients),
+                       speed_limits=cut(self.speed_limits), curves=cut(self.curves),
+                       tunnels=cut(self.tunnels), neutral_sections=cut(self.neutral_sections))

@@ -1,0 +1,203 @@
+"""Reading and writing case files (TOML, DESIGN.md section 5)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+from pymoo_rail.model.case import Case, Leg
+from pymoo_rail.model.curves import DavisResistance, ForceCurve
+from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.line import Line
+from pymoo_rail.model.train import Train
+
+_TOP = {"name", "source", "description", "run", "train", "line"}
+_RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs"}
+_LEG = {"start_m", "end_m", "planned_time_s", "dwell_s"}
+_TRAIN = {"name", "mass_t", "rotary_factor", "length_m", "max_speed_kmh", "max_accel_ms2", "max_decel_ms2",
+          "traction_efficiency", "regen_efficiency", "regen_min_speed_kmh", "aux_power_kw",
+          "resistance", "traction", "braking"}
+_RESISTANCE = {"a", "b", "c", "unit", "speed_unit"}
+_CURVE = {"segments", "table", "max_force_kn", "max_power_kw"}
+_BRAKING = _CURVE | {"regen_max_force_kn", "regen_max_power_kw"}
+_SEGMENT = {"v_max_kmh", "poly"}
+_LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_sections", "gradient_model"}
+
+
+def _table(data: Any, field: str, allowed: set[str], required: set[str], source: str) -> dict:
+    if not isinstance(data, dict):
+        raise CaseError(field, data, "must be a table", source)
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise CaseError(f"{field}.{unknown[0]}" if field else unknown[0], data[unknown[0]],
+                        f"unknown key (allowed: {', '.join(sorted(allowed))})", source)
+    missing = sorted(required - set(data))
+    if missing:
+        raise CaseError(f"{field}.{missing[0]}" if field else missing[0], None, "is required", source)
+    return data
+
+
+def _curve(data: Any, field: str, allowed: set[str], source: str) -> ForceCurve:
+    data = _table(data, field, allowed, set(), source)
+    segments = None
+    if "segments" in data:
+        rows = []
+        for k, seg in enumerate(data["segments"]):
+            seg = _table(seg, f"{field}.segments[{k}]", _SEGMENT, _SEGMENT, source)
+            rows.append((float(seg["v_max_kmh"]), tuple(float(c) for c in seg["poly"])))
+        segments = tuple(rows)
+    table = None
+    if "table" in data:
+        table = tuple((float(v), float(f)) for v, f in data["table"])
+    try:
+        return ForceCurve(segments=segments, table=table, max_force_kn=data.get("max_force_kn"),
+                          max_power_kw=data.get("max_power_kw"))
+    except CaseError as err:
+        raise CaseError(f"{field}.{err.field}", err.value, err.reason, source) from None
+
+
+def case_from_dict(data: dict, source: str = "<dict>") -> Case:
+    """Build a :class:`Case` from the parsed TOML structure; every error names the field."""
+    data = _table(data, "", _TOP, {"name", "run", "train", "line"}, source)
+    run = _table(data["run"], "run", _RUN, {"planned_time_s"}, source)
+    tr = _table(data["train"], "train", _TRAIN,
+                {"mass_t", "length_m", "max_speed_kmh", "resistance", "traction", "braking"}, source)
+    res = _table(tr["resistance"], "train.resistance", _RESISTANCE, _RESISTANCE, source)
+    braking = tr["braking"]
+    line = _table(data["line"], "line", _LINE, {"length_m", "gradients", "speed_limits"}, source)
+    try:
+        legs = tuple(Leg(**_table(leg, f"run.legs[{k}]", _LEG, {"start_m", "end_m", "planned_time_s"}, source))
+                     for k, leg in enumerate(run.get("legs", [])))
+        train = Train(
+            name=tr.get("name", ""),
+            mass_t=tr["mass_t"], length_m=tr["length_m"], max_speed_kmh=tr["max_speed_kmh"],
+            rotary_factor=tr.get("rotary_factor", 0.0),
+            max_accel_ms2=tr.get("max_accel_ms2"), max_decel_ms2=tr.get("max_decel_ms2"),
+            traction_efficiency=tr.get("traction_efficiency", 1.0),
+            regen_efficiency=tr.get("regen_efficiency", 0.0),
+            regen_min_speed_kmh=tr.get("regen_min_speed_kmh", 0.0),
+            aux_power_kw=tr.get("aux_power_kw", 0.0),
+            resistance=DavisResistance(res["a"], res["b"], res["c"], res["unit"], res["speed_unit"]),
+            traction=_curve(tr["traction"], "train.traction", _CURVE, source),
+            braking=_curve(braking, "train.braking", _BRAKING, source),
+            regen_max_force_kn=braking.get("regen_max_force_kn"),
+            regen_max_power_kw=braking.get("regen_max_power_kw"),
+        )
+        line_obj = Line(
+            length_m=line["length_m"], gradients=tuple(map(tuple, line["gradients"])),
+            speed_limits=tuple(map(tuple, line["speed_limits"])),
+            curves=tuple(map(tuple, line.get("curves", []))), tunnels=tuple(map(tuple, line.get("tunnels", []))),
+            neutral_sections=tuple(map(tuple, line.get("neutral_sections", []))),
+            gradient_model=line.get("gradient_model", "train_length"),
+        )
+        return Case(name=data["name"], source=data.get("source", ""), description=data.get("description", ""),
+                    train=train, line=line_obj, planned_time_s=run["planned_time_s"],
+                    dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs)
+    except CaseError as err:
+        if err.source is None:
+            raise CaseError(err.field, err.value, err.reason, source) from None
+        raise
+    except (TypeError, ValueError) as err:  # wrong types inside rows, e.g. a string where a number goes
+        raise CaseError("<entry>", None, f"malformed value: {err}", source) from None
+
+
+def read_case(path: str | Path) -> Case:
+    """Read a case file."""
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as err:
+        raise CaseError("<file>", str(path), f"is not valid TOML: {err}", str(path)) from None
+    return case_from_dict(data, source=str(path))
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(value, (int, float)):
+        return repr(float(value))
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + "}"
+    return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+
+
+def case_to_dict(case: Case) -> dict:
+    """The TOML structure of a case (inverse of :func:`case_from_dict`)."""
+    t = case.train
+
+    def curve(c: ForceCurve) -> dict:
+        out: dict[str, Any] = {}
+        if c.segments is not None:
+            out["segments"] = [{"v_max_kmh": v, "poly": list(p)} for v, p in c.segments]
+        if c.table is not None:
+            out["table"] = [list(r) for r in c.table]
+        if c.max_force_kn is not None:
+            out["max_force_kn"] = c.max_force_kn
+        if c.max_power_kw is not None:
+            out["max_power_kw"] = c.max_power_kw
+        return out
+
+    braking = curve(t.braking)
+    if t.regen_max_force_kn is not None:
+        braking["regen_max_force_kn"] = t.regen_max_force_kn
+    if t.regen_max_power_kw is not None:
+        braking["regen_max_power_kw"] = t.regen_max_power_kw
+    train = {"name": t.name, "mass_t": t.mass_t, "rotary_factor": t.rotary_factor, "length_m": t.length_m,
+             "max_speed_kmh": t.max_speed_kmh, "traction_efficiency": t.traction_efficiency,
+             "regen_efficiency": t.regen_efficiency, "regen_min_speed_kmh": t.regen_min_speed_kmh,
+             "aux_power_kw": t.aux_power_kw}
+    if t.max_accel_ms2 is not None:
+        train["max_accel_ms2"] = t.max_accel_ms2
+    if t.max_decel_ms2 is not None:
+        train["max_decel_ms2"] = t.max_decel_ms2
+    r = t.resistance
+    train["resistance"] = {"a": r.a, "b": r.b, "c": r.c, "unit": r.unit, "speed_unit": r.speed_unit}
+    train["traction"] = curve(t.traction)
+    train["braking"] = braking
+    ln = case.line
+    run: dict[str, Any] = {"planned_time_s": case.planned_time_s, "dwell_s": case.dwell_s,
+                           "time_margin_s": case.time_margin_s}
+    if case.legs:
+        run["legs"] = [{"start_m": g.start_m, "end_m": g.end_m, "planned_time_s": g.planned_time_s,
+                        "dwell_s": g.dwell_s} for g in case.legs]
+    return {"name": case.name, "source": case.source, "description": case.description, "run": run,
+            "train": train,
+            "line": {"length_m": ln.length_m, "gradient_model": ln.gradient_model,
+                     "gradients": [list(r) for r in ln.gradients], "speed_limits": [list(r) for r in ln.speed_limits],
+                     "curves": [list(r) for r in ln.curves], "tunnels": [list(r) for r in ln.tunnels],
+                     "neutral_sections": [list(r) for r in ln.neutral_sections]}}
+
+
+def write_case(case: Case, path: str | Path) -> Path:
+    """Write a case file that :func:`read_case` reads back to an equal case."""
+    data = case_to_dict(case)
+    lines: list[str] = []
+    for key in ("name", "source", "description"):
+        lines.append(f"{key} = {_toml_value(data[key])}")
+
+    def section(title: str, table: dict) -> None:
+        lines.append(f"\n[{title}]")
+        nested = []
+        for k, v in table.items():
+            if isinstance(v, dict):
+                nested.append((k, v))
+            else:
+                lines.append(f"{k} = {_toml_value(v)}")
+        for k, v in nested:
+            section(f"{title}.{k}", v)
+
+    section("run", data["run"])
+    section("train", data["train"])
+    section("line", data["line"])
+    path = Path(path)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path

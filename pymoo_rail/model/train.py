@@ -1,0 +1,84 @@
+"""The train: mass, inertia, length, limits, efficiencies."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
+from pymoo_rail.model.errors import CaseError
+
+GRAVITY_MS2 = 9.81
+
+
+def _require(field: str, value: float | None, *, positive: bool = False, nonneg: bool = False,
+             upper: float | None = None, optional: bool = False) -> None:
+    if value is None:
+        if optional:
+            return
+        raise CaseError(field, value, "is required")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise CaseError(field, value, "must be a finite number")
+    if positive and value <= 0:
+        raise CaseError(field, value, "must be > 0")
+    if nonneg and value < 0:
+        raise CaseError(field, value, "must be >= 0")
+    if upper is not None and value > upper:
+        raise CaseError(field, value, f"must be <= {upper}")
+
+
+@dataclass(frozen=True)
+class Train:
+    """A train as a point mass with a length (for limits and averaged gradients).
+
+    Units follow the case file: tonnes, metres, km/h, kN, kW; ``*_si`` properties give SI.
+    ``rotary_factor`` is gamma: the effective inertial mass is ``mass (1 + gamma)``.
+    """
+
+    mass_t: float
+    length_m: float
+    max_speed_kmh: float
+    resistance: DavisResistance
+    traction: ForceCurve
+    braking: ForceCurve
+    rotary_factor: float = 0.0
+    max_accel_ms2: float | None = None
+    max_decel_ms2: float | None = None
+    traction_efficiency: float = 1.0
+    regen_efficiency: float = 0.0
+    regen_min_speed_kmh: float = 0.0
+    regen_max_force_kn: float | None = None
+    regen_max_power_kw: float | None = None
+    aux_power_kw: float = 0.0
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        _require("train.mass_t", self.mass_t, positive=True)
+        _require("train.length_m", self.length_m, positive=True)
+        _require("train.max_speed_kmh", self.max_speed_kmh, positive=True)
+        _require("train.rotary_factor", self.rotary_factor, nonneg=True, upper=1.0)
+        _require("train.max_accel_ms2", self.max_accel_ms2, positive=True, optional=True)
+        _require("train.max_decel_ms2", self.max_decel_ms2, positive=True, optional=True)
+        _require("train.traction_efficiency", self.traction_efficiency, positive=True, upper=1.0)
+        _require("train.regen_efficiency", self.regen_efficiency, nonneg=True, upper=1.0)
+        _require("train.regen_min_speed_kmh", self.regen_min_speed_kmh, nonneg=True)
+        _require("train.braking.regen_max_force_kn", self.regen_max_force_kn, positive=True, optional=True)
+        _require("train.braking.regen_max_power_kw", self.regen_max_power_kw, positive=True, optional=True)
+        _require("train.aux_power_kw", self.aux_power_kw, nonneg=True)
+
+    @property
+    def mass_kg(self) -> float:
+        return self.mass_t * 1000.0
+
+    @property
+    def effective_mass_kg(self) -> float:
+        """Mass including rotating inertia, ``m (1 + gamma)``."""
+        return self.mass_kg * (1.0 + self.rotary_factor)
+
+    @property
+    def max_speed_ms(self) -> float:
+        return self.max_speed_kmh / KMH_PER_MS
+
+    @property
+    def weight_kn(self) -> float:
+        return self.mass_kg * GRAVITY_MS2 / 1000.0

@@ -1,0 +1,306 @@
+"""The simulation kernel: one run of a driving program over the grid, and a parallel batch.
+
+Integration is over distance on the kinetic-energy variable u = v^2 with a two-stage
+(midpoint) scheme per cell; time per cell is ``2 dx / (v0 + v1)``, exact for constant
+acceleration. Forces are recorded at the speeds the scheme used, so the work balance
+(traction - braking - resistance = change of kinetic energy) holds to rounding.
+
+A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applies until the
+cell midpoint passes ``end_m``. Modes:
+
+- ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
+  (the speed-code connection strategy of seed 000 fig. 4-5);
+- ``MODE_TRACTION``: maximum traction (speed limits still hold);
+- ``MODE_HOLD``: hold the speed the train had on entering the row (partial traction or braking);
+- ``MODE_COAST``: no force;
+- ``MODE_BRAKE``: maximum service braking until standstill.
+
+Whatever the program says, the train never rises above the braking envelope: it brakes onto every
+lower limit ahead and onto the platform at the latest moment the braking curve allows.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from pymoo_rail.sim.physics import (
+    davis_force,
+    electric_braking,
+    max_braking,
+    max_traction,
+)
+
+MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE = 0, 1, 2, 3, 4
+MODE_NAMES = ("toward", "traction", "hold", "coast", "brake")
+REGIME_TRACTION, REGIME_CRUISE, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
+REGIME_NAMES = ("traction", "cruise", "coast", "brake")
+
+# Columns of a run summary.
+OUT_TRACTION_KWH = 0
+OUT_REGEN_KWH = 1
+OUT_AUX_KWH = 2
+OUT_NET_KWH = 3
+OUT_RUNNING_TIME_S = 4
+OUT_STOP_POSITION_M = 5
+OUT_STOP_ERROR_M = 6
+OUT_JERK_MS2 = 7
+OUT_REGIME_CHANGES = 8
+OUT_LIMIT_EXCESS_MS = 9
+OUT_TRACTION_WORK_J = 10
+OUT_BRAKE_WORK_J = 11
+OUT_DAVIS_WORK_J = 12
+OUT_LINE_WORK_J = 13
+OUT_GRADE_WORK_J = 14
+OUT_FINAL_SPEED_MS = 15
+OUT_REACHED = 16
+OUT_ELECTRIC_BRAKE_WORK_J = 17
+OUT_MAX_ABS_ACCEL_MS2 = 18
+OUT_NEUTRAL_TRACTION_J = 19
+N_OUT = 20
+OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s", "stop_position_m",
+             "stop_error_m", "jerk_ms2", "regime_changes", "limit_excess_ms", "traction_work_j",
+             "brake_work_j", "davis_work_j", "line_work_j", "grade_work_j", "final_speed_ms", "reached",
+             "electric_brake_work_j", "max_abs_accel_ms2", "neutral_traction_j")
+
+_KIND_TRACTION, _KIND_COAST, _KIND_BRAKE = 0, 1, 2
+_J_PER_KWH = 3.6e6
+
+
+@njit(cache=True)
+def _full_step(m, v0, cell, kind):
+    """Two-stage step over one cell at maximum traction, coasting or maximum braking.
+
+    Returns (u1, control force N (+ traction, - braking), W0 N, mean speed m/s).
+    """
+    dx = m.dx_m
+    wl = m.line_force_n[cell]
+    if kind == _KIND_TRACTION:
+        f = max_traction(m, v0, cell)
+    elif kind == _KIND_BRAKE:
+        f = -max_braking(m, v0, cell)
+    else:
+        f = 0.0
+    u_half = v0 * v0 + dx * (f - davis_force(m, v0) - wl) / m.effective_mass_kg
+    v_half = math.sqrt(u_half) if u_half > 0.0 else 0.5 * v0
+    if kind == _KIND_TRACTION:
+        f = max_traction(m, v_half, cell)
+    elif kind == _KIND_BRAKE:
+        f = -max_braking(m, v_half, cell)
+    w0 = davis_force(m, v_half)
+    u1 = v0 * v0 + 2.0 * dx * (f - w0 - wl) / m.effective_mass_kg
+    return u1, f, w0, v_half
+
+
+@njit(cache=True)
+def _landing_force(m, v0, v1, cell):
+    """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
+
+    Returns (force, W0, feasible): feasible is False when the force exceeds what the train has.
+    """
+    v_mid = 0.5 * (v0 + v1)
+    w0 = davis_force(m, v_mid)
+    f = m.effective_mass_kg * (v1 * v1 - v0 * v0) / (2.0 * m.dx_m) + w0 + m.line_force_n[cell]
+    if f > 0.0:
+        feasible = f <= max_traction(m, v_mid, cell) + 1e-9
+    else:
+        feasible = -f <= max_braking(m, v_mid, cell) + 1e-9
+    return f, w0, feasible
+
+
+@njit(cache=True)
+def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
+    """Simulate one run; write the summary into ``out`` and, if ``record``, the trace arrays.
+
+    Returns the number of trace nodes written (nodes 0..count-1 are valid).
+    """
+    n = m.position_m.shape[0]
+    length = m.position_m[n - 1]
+    dx = m.dx_m
+    n_rows = program.shape[0]
+    v = 0.0
+    t = 0.0
+    row = 0
+    hold_speed = -1.0
+    w_trac = 0.0
+    w_brake = 0.0
+    w_elec = 0.0
+    w_davis = 0.0
+    w_line = 0.0
+    w_grade = 0.0
+    w_neutral = 0.0
+    jerk = 0.0
+    prev_acc = 0.0
+    max_abs_acc = 0.0
+    prev_regime = -1
+    changes = 0
+    excess = -1e300
+    reached = 1.0
+    stop_pos = length
+    count = 1
+    if record:
+        tr_x[0] = 0.0
+        tr_v[0] = 0.0
+        tr_t[0] = 0.0
+    for i in range(n - 1):
+        x_mid = m.position_m[i] + 0.5 * dx
+        while row < n_rows - 1 and x_mid > program[row, 0]:
+            row += 1
+            hold_speed = -1.0
+        mode = int(program[row, 1])
+        target = program[row, 2]
+        cap = m.envelope_ms[i + 1]
+
+        # 1. what the program asks for
+        landed = False
+        if mode == MODE_HOLD:
+            if hold_speed < 0.0:
+                hold_speed = v
+            if hold_speed <= 0.0:
+                mode = MODE_TRACTION  # nothing to hold from standstill
+            else:
+                mode = MODE_TOWARD
+                target = hold_speed
+        if mode == MODE_TOWARD:
+            if v < target:
+                u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
+                regime = REGIME_TRACTION
+                if u1 > target * target:
+                    landed = True
+            else:
+                u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
+                regime = REGIME_COAST
+                if u1 < target * target:
+                    landed = True
+            if landed:
+                fl, w0l, ok = _landing_force(m, v, target, i)
+                if ok:
+                    u1, f, w0 = target * target, fl, w0l
+                    regime = REGIME_CRUISE
+        elif mode == MODE_TRACTION:
+            u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
+            regime = REGIME_TRACTION
+        elif mode == MODE_BRAKE:
+            u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)
+            regime = REGIME_BRAKE
+        else:
+            u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
+            regime = REGIME_COAST
+
+        # 2. never above the braking envelope (limits ahead, the platform)
+        if u1 > cap * cap:
+            fl, w0l, ok = _landing_force(m, v, cap, i)
+            if ok:
+                u1, f, w0 = cap * cap, fl, w0l
+            else:  # cannot brake hard enough by a rounding margin: brake fully, record the excess
+                u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)
+            if f < 0.0 and cap < m.limit_ms[i + 1] - 1e-9:
+                regime = REGIME_BRAKE
+            elif f != 0.0:
+                regime = REGIME_CRUISE
+        if f == 0.0:
+            regime = REGIME_COAST
+        elif f > 0.0 and regime == REGIME_COAST:
+            regime = REGIME_CRUISE
+
+        # 3. standstill inside the cell (before the platform) ends the run
+        # (only a landing on the platform node ends at exactly zero speed without stopping short)
+        stopped = u1 < 0.0 or (u1 == 0.0 and i < n - 2)
+        a_cell = (u1 - v * v) / (2.0 * dx)  # before clamping: it sets the stopping distance
+        d = dx
+        if stopped:
+            d = -v * v / (2.0 * a_cell) if a_cell < 0.0 else 0.0
+            if d > dx:
+                d = dx
+        if u1 < 0.0:
+            u1 = 0.0
+        v1 = math.sqrt(u1)
+        dt = 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
+        t += dt
+        brake_n = -f if f < 0.0 else 0.0
+        if f > 0.0:
+            w_trac += f * d
+            if m.neutral[i] != 0:
+                w_neutral += f * d
+        w_brake += brake_n * d
+        w_elec += electric_braking(m, 0.5 * (v + v1), brake_n) * d
+        w_davis += w0 * d
+        w_line += m.line_force_n[i] * d
+        w_grade += m.grade_force_n[i] * d
+        jerk += abs(a_cell - prev_acc)
+        prev_acc = a_cell
+        if abs(a_cell) > max_abs_acc:
+            max_abs_acc = abs(a_cell)
+        if prev_regime >= 0 and regime != prev_regime:
+            changes += 1
+        prev_regime = regime
+        if v1 - m.limit_ms[i + 1] > excess:
+            excess = v1 - m.limit_ms[i + 1]
+        if record:
+            tr_x[i + 1] = m.position_m[i] + d
+            tr_v[i + 1] = v1
+            tr_t[i + 1] = t
+            tr_a[i] = a_cell
+            tr_f[i] = f
+            tr_r[i] = regime
+        count = i + 2
+        v = v1
+        if stopped:
+            reached = 0.0
+            stop_pos = m.position_m[i] + d
+            break
+    jerk += abs(prev_acc)  # back to rest
+    if record:
+        tr_a[count - 1] = 0.0
+        tr_f[count - 1] = 0.0
+        tr_r[count - 1] = REGIME_BRAKE if reached > 0.0 else REGIME_COAST
+    out[OUT_TRACTION_KWH] = w_trac / m.traction_efficiency / _J_PER_KWH
+    out[OUT_REGEN_KWH] = m.regen_efficiency * w_elec / _J_PER_KWH
+    out[OUT_AUX_KWH] = m.aux_power_w * t / _J_PER_KWH
+    out[OUT_NET_KWH] = out[OUT_TRACTION_KWH] + out[OUT_AUX_KWH] - out[OUT_REGEN_KWH]
+    out[OUT_RUNNING_TIME_S] = t
+    out[OUT_STOP_POSITION_M] = stop_pos
+    out[OUT_STOP_ERROR_M] = abs(length - stop_pos)
+    out[OUT_JERK_MS2] = jerk
+    out[OUT_REGIME_CHANGES] = changes
+    out[OUT_LIMIT_EXCESS_MS] = excess if excess > 0.0 else 0.0
+    out[OUT_TRACTION_WORK_J] = w_trac
+    out[OUT_BRAKE_WORK_J] = w_brake
+    out[OUT_DAVIS_WORK_J] = w_davis
+    out[OUT_LINE_WORK_J] = w_line
+    out[OUT_GRADE_WORK_J] = w_grade
+    out[OUT_FINAL_SPEED_MS] = v
+    out[OUT_REACHED] = reached
+    out[OUT_ELECTRIC_BRAKE_WORK_J] = w_elec
+    out[OUT_MAX_ABS_ACCEL_MS2] = max_abs_acc
+    out[OUT_NEUTRAL_TRACTION_J] = w_neutral
+    return count
+
+
+@njit(cache=True, parallel=True)
+def simulate_batch(m, programs):
+    """Summaries of many runs, one per program, in parallel. ``programs`` is (N, rows, 3)."""
+    n_runs = programs.shape[0]
+    out = np.empty((n_runs, N_OUT))
+    empty = np.empty(0)
+    empty_r = np.empty(0, dtype=np.int8)
+    for j in prange(n_runs):
+        run_program(m, programs[j], out[j], False, empty, empty, empty, empty, empty, empty_r)
+    return out
+
+
+@njit(cache=True)
+def simulate_trace(m, program):
+    """One run with its full trace: (summary, x, v, t, a, force, regime), trimmed to the run."""
+    n = m.position_m.shape[0]
+    out = np.empty(N_OUT)
+    x = np.empty(n)
+    v = np.empty(n)
+    t = np.empty(n)
+    a = np.empty(n)
+    f = np.empty(n)
+    r = np.empty(n, dtype=np.int8)
+    count = run_program(m, program, out, True, x, v, t, a, f, r)
+    return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]

@@ -1,0 +1,75 @@
+"""The user-facing simulator of one case."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
+from pymoo_rail.sim import kernel as k
+from pymoo_rail.sim.drivers import flat_out_program
+from pymoo_rail.sim.physics import KernelModel, build_kernel_model
+from pymoo_rail.sim.trajectory import Trajectory, energy_from_summary, summary_dict
+
+
+class Simulator:
+    """Runs driving programs for one case on a fixed grid.
+
+    Parameters
+    ----------
+    case : Case
+    dx_m : float, optional
+        Grid step (default 1 m up to 10 km of line, else 5 m); halving it changes energy and
+        time by far less than 0.1 % (``tests/sim/test_convergence.py``).
+    """
+
+    def __init__(self, case: Case, dx_m: float | None = None):
+        self.case = case
+        self.grid: TrackGrid = build_grid(case, dx_m)
+        self.model: KernelModel = build_kernel_model(case, self.grid)
+
+    @property
+    def length_m(self) -> float:
+        return float(self.case.line.length_m)
+
+    def run_batch(self, programs: np.ndarray) -> np.ndarray:
+        """Summaries (N, N_OUT) of programs (N, rows, 3), evaluated in parallel."""
+        programs = np.ascontiguousarray(programs, dtype=float)
+        if programs.ndim != 3 or programs.shape[2] != 3:
+            raise ValueError(f"programs must have shape (N, rows, 3), got {programs.shape}")
+        return k.simulate_batch(self.model, programs)
+
+    def run(self, program: np.ndarray) -> Trajectory:
+        """The full trajectory of one program (rows, 3)."""
+        program = np.ascontiguousarray(program, dtype=float)
+        if program.ndim != 2 or program.shape[1] != 3:
+            raise ValueError(f"a program must have shape (rows, 3), got {program.shape}")
+        out, x, v, t, a, f, r = k.simulate_trace(self.model, program)
+        return Trajectory(position_m=x, speed_ms=v, time_s=t, accel_ms2=a, force_n=f, regime=r,
+                          limit_ms=self.grid.limit_ms[: x.shape[0]], energy=energy_from_summary(out),
+                          running_time_s=float(out[k.OUT_RUNNING_TIME_S]),
+                          stop_error_m=float(out[k.OUT_STOP_ERROR_M]), summary=summary_dict(out))
+
+    def flat_out(self) -> Trajectory:
+        """The fastest run: maximum traction, held at the limits, latest braking."""
+        return self.run(flat_out_program(self.length_m))
+
+    def min_running_time_s(self) -> float:
+        """Running time of the flat-out run, the shortest the train can do on this grid."""
+        return self.flat_out().running_time_s
+
+    def check_planned_time(self, planned_time_s: float | None = None) -> float:
+        """Raise :class:`InfeasibleCaseError` when the planned time is below the minimum.
+
+        Returns the minimum running time.
+        """
+        planned = self.case.planned_time_s if planned_time_s is None else planned_time_s
+        fastest = self.flat_out()
+        if not fastest.reached:
+            raise InfeasibleCaseError("line", self.case.name,
+                                      f"the train stalls at {fastest.summary['stop_position_m']:.1f} m "
+                                      "even at full traction", self.case.name)
+        if planned < fastest.running_time_s:
+            raise InfeasibleCaseError("run.planned_time_s", planned,
+                                      f"is below the minimum running time {fastest.running_time_s:.2f} s "
+                                      f"of the train on this line", self.case.name)
+        return fastest.running_time_s
