@@ -61,7 +61,7 @@ RUN_BRAKE_START_M = 3       # P
 RUN_BRAKE_SPEED_MS = 4      # v_m
 RUN_BRAKE_DECEL_MS2 = 5
 RUN_LIMIT_EXCESS_MS = 6     # max(v - limit) over the nodes
-RUN_ACCEL_CHANGE_MS2 = 7    # largest |change of acceleration| at a gradient change between subsections
+RUN_ACCEL_CHANGE_MS2 = 7    # largest |change of mean acceleration| across a gradient change between subsections
 RUN_FORCE_EXCESS_MS2 = 8    # largest force beyond the train's traction or braking limit, per effective mass
 RUN_DECODE_EXCESS_MS = 9    # exit speeds the repair could not make feasible (m/s, summed)
 RUN_TIME_SHORTFALL_S = 10   # time the fastest profile still needs beyond the plan (> 0: cannot be on time)
@@ -458,8 +458,8 @@ def repair_batch(m, sub_start, sub_end, sub_kind, sub_cap, brake_dist_m, gamma, 
 
 @njit(cache=True)
 def drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_dist_m, gamma, v_exit, q,
-              planned_time_s, service_decel_ms2, v_floor_ms, relative, v_out, t_out, f_out, e_trac, e_regen, regime,
-              sub_out, summary):
+              planned_time_s, service_decel_ms2, v_floor_ms, relative, comfort_window_m, v_out, t_out, f_out, e_trac,
+              e_regen, regime, sub_out, summary):
     """One run of the subsection driver.
 
     Parameters
@@ -484,6 +484,8 @@ def drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_
     relative : bool
         False: ``v_exit`` are speeds (m/s), moved into the reachable range [lo, hi] when outside it.
         True: ``v_exit`` are positions in that range, 0 -> lo, 1 -> hi.
+    comfort_window_m : float
+        Distance over which the acceleration on each side of a gradient change is averaged (eq. 8).
     v_out, t_out : (n_nodes,) speed (m/s) and time (s) at every node, written.
     f_out, e_trac, e_regen, regime : (n_cells,) force (N, + traction), traction energy drawn (J),
         regenerated energy usable by another train (J) and regime code per cell, written.
@@ -651,16 +653,22 @@ def drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_
         if ex > limit_excess:
             limit_excess = ex
 
-    # eq. 8: change of acceleration where the gradient changes between subsections
+    # eq. 8: change of acceleration where the gradient changes between subsections, each side's
+    # acceleration taken as the mean over comfort_window_m (one cell alone would depend on the grid)
     accel_change = 0.0
+    w = int(round(comfort_window_m / dx))
+    if w < 1:
+        w = 1
     for j in range(1, n_active):
         if not sub_grade_change[j]:
             continue
         b = sub_start[j]
-        if b < 1 or b >= n - 1:
+        w1 = min(w, b - sub_start[j - 1])
+        w2 = min(w, ends[j] - b)
+        if w1 < 1 or w2 < 1:
             continue
-        a_before = (v_out[b] ** 2 - v_out[b - 1] ** 2) / (2.0 * dx)
-        a_after = (v_out[b + 1] ** 2 - v_out[b] ** 2) / (2.0 * dx)
+        a_before = (v_out[b] ** 2 - v_out[b - w1] ** 2) / (2.0 * w1 * dx)
+        a_after = (v_out[b + w2] ** 2 - v_out[b] ** 2) / (2.0 * w2 * dx)
         change = abs(a_after - a_before)
         if change > accel_change:
             accel_change = change
@@ -685,7 +693,7 @@ def drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_
 
 @njit(cache=True, parallel=True)
 def drive_batch(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_dist_m, gamma, v_exit, q,
-                planned_time_s, service_decel_ms2, v_floor_ms, relative):
+                planned_time_s, service_decel_ms2, v_floor_ms, relative, comfort_window_m):
     """:func:`drive_one` for a population (rows of ``brake_dist_m``, ``gamma``, ``v_exit``, ``q``).
 
     Returns (speed (N, n), time (N, n), force (N, n-1), traction J (N, n-1), regen J (N, n-1),
@@ -704,6 +712,6 @@ def drive_batch(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brak
     summary = np.empty((n_runs, N_RUN))
     for r in prange(n_runs):
         drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_dist_m[r], gamma[r], v_exit[r],
-                  q[r], planned_time_s, service_decel_ms2, v_floor_ms, relative, v[r], t[r], f[r], e_trac[r], e_regen[r],
-                  regime[r], subs[r], summary[r])
+                  q[r], planned_time_s, service_decel_ms2, v_floor_ms, relative, comfort_window_m, v[r], t[r], f[r],
+                  e_trac[r], e_regen[r], regime[r], subs[r], summary[r])
     return v, t, f, e_trac, e_regen, regime, subs, summary

@@ -16,12 +16,15 @@ from pymoo_rail.model import CaseError
 from pymoo_rail.problems import CooperativeTrainsProblem
 from pymoo_rail.problems.cooperative import (
     BrakingDistanceProblem,
+    PartialProblem,
     PunctualityRepair,
     SubsectionProblem,
+    alternating_minimize,
     nested_minimize,
     power_profiles,
     scale_gradients,
     solo_run,
+    train_genes,
 )
 from pymoo_rail.sim import cooperation as coop
 
@@ -83,7 +86,8 @@ def test_subsections_follow_the_gradient_changes(problem, pair):
     # (W0(22.2 m/s) = 18.2 kN < 16e-3 * 280 t * g = 43.9 kN)
     assert a.sub_kind[3] == 3 and b.sub_kind[1] == 3
     # level track and climbs are type 2
-    assert a.sub_kind[0] == 2 and a.sub_kind[1] == 2 and a.sub_kind[5] == 2 and b.sub_kind[0] == 2 and b.sub_kind[3] == 2
+    assert a.sub_kind[0] == a.sub_kind[1] == a.sub_kind[5] == 2
+    assert b.sub_kind[0] == b.sub_kind[3] == 2
     # braking range: r * v_lim^2 / (2 b) = 1.5 * (80 / 3.6)^2 / 2 = 370.4 m (section 3.2)
     assert a.brake_bounds_m[1] == pytest.approx(1.5 * (80 / 3.6) ** 2 / 2.0)
     assert problem.n_var == 2 + 3 * (7 + 5)
@@ -196,7 +200,7 @@ def test_uncoordinated_objective_shares_nothing(pair):
 
 
 def test_solo_baseline_credits_no_regeneration(pair):
-    run = solo_run(pair.leg(1), methods=("four_phase",), pop_size=20, n_evals=400)
+    run = solo_run(pair.leg(1), methods=("four_phase",), pop_size=20, n_evals=400, time_tolerance_s=1.0)
     assert run.trajectory.energy.regen_kwh == 0.0
     assert run.energy_kwh == pytest.approx(run.trajectory.energy.traction_kwh)
     assert abs(run.running_time_s - 100.0) <= 1.0
@@ -354,3 +358,23 @@ def test_a_nan_decision_names_the_variable(problem):
     x[6] = np.nan
     with pytest.raises(ValueError, match=r"v_a2_rel = nan"):
         problem.evaluate(x[None, :])
+
+
+def test_partial_problem_holds_the_other_genes(problem):
+    x_ref = PunctualityRepair().apply(problem, _vector(problem, 250, 200, REL_A, REL_B))[0]
+    free = train_genes(problem, 1)
+    assert free.sum() == 1 + 3 * problem.trains[1].n_sub and free[1] and not free[0]
+    part = PartialProblem(problem, free, x_ref)
+    np.testing.assert_array_equal(part.full(x_ref[free])[0], x_ref)
+    f_part = part.evaluate(x_ref[free][None, :], return_values_of=["F"])
+    np.testing.assert_array_equal(f_part, problem.evaluate(x_ref[None, :], return_values_of=["F"]))
+
+
+def test_alternating_minimize_never_makes_things_worse(problem):
+    x0 = PunctualityRepair().apply(problem, _vector(problem, 250, 200, REL_A, REL_B))[0]
+    f0 = problem.evaluate(x0[None, :], return_values_of=["F"])[0, 0]
+    x1, f1 = alternating_minimize(problem, x0, rounds=1, n_evals=(200, 200), pop_size=10, seed=4)
+    x2, f2 = alternating_minimize(problem, x0, rounds=1, n_evals=(200, 200), pop_size=10, seed=4)
+    np.testing.assert_array_equal(x1, x2)
+    assert f1 <= f0 + 1e-12
+    assert problem.evaluate(x1[None, :], return_values_of=["F"])[0, 0] == pytest.approx(f1)
