@@ -399,16 +399,16 @@ def solve(model, tables, lambda_w: float, max_targets: int, bias: float, tie_j: 
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
-    cost-to-go. Returns (modes, targets, speeds, cells done, net energy J, time s) of the forward
-    run. Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the
-    net energy, and the tables already hold it.
+    cost-to-go. Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s).
+    Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
+    energy, and the tables already hold it.
     """
-    n = model.position_m.shape[0]
     backward_sweep(model.envelope_ms, float(lambda_w), float(bias), *tables, value)
+    n = model.position_m.shape[0]
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)
     price = float(lambda_w) + model.aux_power_w
-    done, energy, time = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j), modes, targets,
-                                         speeds)
+    done, energy, time = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j), modes,
+                                         targets, speeds)
     return modes, targets, speeds, done, energy, time

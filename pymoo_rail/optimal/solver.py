@@ -23,6 +23,15 @@ import pandas as pd
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.optimal import dp
 from pymoo_rail.sim import Simulator, Trajectory
+from pymoo_rail.sim.kernel import (
+    MODE_COAST,
+    MODE_HOLD,
+    MODE_TOWARD,
+    MODE_TRACTION,
+    OUT_NET_KWH,
+    OUT_REACHED,
+    OUT_RUNNING_TIME_S,
+)
 
 DEFAULT_N_SPEEDS = 200
 DEFAULT_MAX_TARGETS = 16
@@ -37,12 +46,15 @@ _J_PER_KWH = 3.6e6
 
 @dataclass(frozen=True)
 class _Solve:
-    """One DP solve and its forward run at one price of time."""
+    """One run found at one price of time: a simulator program (one row per cell) and its figures.
+
+    ``speeds`` are the DP's forward run, which the simulator's replay must reproduce; None for a
+    run whose last switch was moved to meet the time (a simulator run from the start).
+    """
 
     lambda_w: float
-    modes: np.ndarray
-    targets: np.ndarray
-    speeds: np.ndarray
+    program: np.ndarray
+    speeds: np.ndarray | None
     energy_j: float
     time_s: float
     value_j: float
@@ -120,13 +132,70 @@ class OptimalSolver:
         if self._tables is None:
             self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
         self.n_solves += 1
-        modes, targets, speeds, done, energy, time = dp.solve(
-            self.simulator.model, self._tables, lambda_w, self.max_targets, self.top_bias, self.tie_j, self._value)
+        run = dp.solve(self.simulator.model, self._tables, lambda_w, self.max_targets, self.top_bias, self.tie_j,
+                       self._value)
+        return self._record(lambda_w, run)
+
+    def _record(self, lambda_w: float, run: tuple) -> _Solve:
+        modes, targets, speeds, done, energy, time = run
         if done < modes.shape[0]:
             x = self.simulator.grid.position_m[done]
             raise InfeasibleCaseError("line", self.case.name,
                                       f"the solver finds no way to the platform beyond {x:.1f} m", self.case.name)
-        return _Solve(lambda_w, modes, targets, speeds, energy, time, float(self._value[0, 0]))
+        program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
+        return _Solve(lambda_w, program, speeds, energy, time, float(self._value[0, 0]))
+
+    def _adjust(self, solution: _Solve, target: float) -> _Solve | None:
+        """Move the run's last switch into the final coast until it takes the requested time.
+
+        The discrete optimum can jump over the requested time (where the front is nearly straight,
+        runs on either side are tied in ``energy + lambda x time``). The last powered phase is then
+        extended (the run is too slow) or cut short (too fast) cell by cell, found by bisection. At
+        an optimum the coast point trades time for energy at the rate ``lambda``, so the moved run
+        stays on the front to first order. Returns None when the run has no powered phase.
+        """
+        program = solution.program
+        modes = program[:, 1]
+        powered = np.flatnonzero((modes == MODE_TRACTION) | (modes == MODE_HOLD) | (modes == MODE_TOWARD))
+        if powered.size == 0:
+            return None
+        last = int(powered[-1])
+        n_cells = program.shape[0]
+        if solution.time_s > target:  # extend: hold the speed reached (or keep pulling)
+            mode = MODE_TRACTION if modes[last] == MODE_TRACTION else MODE_HOLD
+            slow_end, fast_end = 0, n_cells - 1 - last
+
+            def moved(j):
+                p = program.copy()
+                p[last + 1:last + 1 + j, 1:] = (mode, 0.0)
+                return p
+        else:  # cut short: coast earlier
+            slow_end, fast_end = last + 1, 0
+
+            def moved(j):
+                p = program.copy()
+                p[last + 1 - j:last + 1, 1:] = (MODE_COAST, 0.0)
+                return p
+
+        def run(j):
+            p = moved(j)
+            out = self.simulator.run_batch(p[None])[0]
+            time = out[OUT_RUNNING_TIME_S] if out[OUT_REACHED] > 0 else math.inf
+            return p, out[OUT_NET_KWH] * _J_PER_KWH, time
+
+        runs = {slow_end: run(slow_end), fast_end: run(fast_end)}
+        if not runs[slow_end][2] >= target >= runs[fast_end][2]:
+            return None
+        lo, hi = slow_end, fast_end  # lo: run >= target, hi: run <= target
+        while abs(hi - lo) > 1:
+            mid = (lo + hi) // 2
+            runs[mid] = run(mid)
+            if runs[mid][2] >= target:
+                lo = mid
+            else:
+                hi = mid
+        p, energy, time = min((runs[lo], runs[hi]), key=lambda r: abs(r[2] - target))
+        return _Solve(solution.lambda_w, p, None, energy, time, solution.value_j)
 
     def _search(self, running_time_s: float, lambda_guess_w: float | None) -> _Solve:
         """Find ``lambda`` whose optimum takes ``running_time_s`` (within ``time_tol_s``)."""
@@ -168,7 +237,7 @@ class OptimalSolver:
         f_fast, f_slow = fast.time_s - target, slow.time_s - target
         lo, hi = math.log(slow.lambda_w), math.log(fast.lambda_w)
         for _ in range(40):
-            if hi - lo < 1e-6:  # a jump of the discrete optimum: no lambda hits the time closer
+            if hi - lo < 1e-4:  # a jump of the discrete optimum: lambda cannot hit the time closer
                 break
             x = hi - f_fast * (hi - lo) / (f_fast - f_slow)
             if not (lo < x < hi):
@@ -190,7 +259,14 @@ class OptimalSolver:
         return self._closest(slow, fast, target, "")
 
     def _closest(self, slow: _Solve | None, fast: _Solve | None, target: float, missing: str) -> _Solve:
-        best = min((s for s in (slow, fast) if s is not None), key=lambda s: abs(s.time_s - target))
+        found = [s for s in (slow, fast) if s is not None]
+        best = min(found, key=lambda s: abs(s.time_s - target))
+        if abs(best.time_s - target) > self.time_tol_s:
+            moved = [m for m in (self._adjust(s, target) for s in found) if m is not None]
+            if moved:
+                # compare at the requested time along the front's slope
+                best = min(moved + [best], key=lambda s: (max(abs(s.time_s - target) - self.time_tol_s, 0.0),
+                                                          s.energy_j + s.lambda_w * (s.time_s - target)))
         if abs(best.time_s - target) > 0.5:
             if missing == "fast":
                 raise InfeasibleCaseError("running_time_s", target,
@@ -203,15 +279,15 @@ class OptimalSolver:
 
     def trajectory(self, solution: _Solve) -> Trajectory:
         """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
-        model = self.simulator.model
-        program = np.column_stack([model.position_m[1:], solution.modes.astype(float), solution.targets])
-        tr = self.simulator.run(program)
-        mismatch = float(np.max(np.abs(tr.speed_ms - solution.speeds[: tr.speed_ms.shape[0]])))
-        if not tr.reached or tr.speed_ms.shape[0] != solution.speeds.shape[0] or mismatch > 1e-9:
+        tr = self.simulator.run(solution.program)
+        speeds = tr.speed_ms if solution.speeds is None else solution.speeds
+        mismatch = float(np.max(np.abs(tr.speed_ms - speeds[: tr.speed_ms.shape[0]])))
+        if not tr.reached or tr.speed_ms.shape[0] != speeds.shape[0] or mismatch > 1e-9:
             raise RuntimeError(f"the simulator's replay of the optimal controls departs from the solver's run "
                                f"(max speed difference {mismatch:.3g} m/s): solver and simulator disagree")
         summary = dict(tr.summary, lambda_w=solution.lambda_w, dp_value_j=solution.value_j,
-                       n_speeds=float(self.n_speeds), dx_m=float(self.dx_m))
+                       n_speeds=float(self.n_speeds), dx_m=float(self.dx_m),
+                       adjusted=float(solution.speeds is None))
         return replace(tr, summary=summary)
 
     def profile(self, running_time_s: float, lambda_guess_w: float | None = None) -> Trajectory:
