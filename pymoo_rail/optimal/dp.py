@@ -40,8 +40,9 @@ from pymoo_rail.sim.physics import electric_braking
 
 INF = math.inf
 # Tolerance for a transition that ends on the envelope but above it by rounding (the simulator
-# then brakes fully and records an excess of ~1e-9 m/s): counted as the top node.
-_TOP_RTOL = 1e-9
+# then brakes fully and records an excess of ~1e-9 m/s, or the single-precision tables round
+# the envelope up): counted as the top node.
+_TOP_RTOL = 1e-6
 
 
 @njit(cache=True)
@@ -307,15 +308,18 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float):
     fixed controls arrays (n_cells, n_speeds, 4) of the kinetic energy reached, the net energy (J,
     with auxiliary power) and the time of the cell; for partial traction onto speed nodes the same
     in flat arrays, state ``s = i * n_speeds + j`` owning entries ``offsets[s]:offsets[s + 1]``.
-    Infeasible transitions (a stop before the platform) have infinite energy.
+    Infeasible transitions (a stop before the platform) have infinite energy. Stored in single
+    precision.
     """
     n_cells = m.position_m.shape[0] - 1
     counts = np.zeros(n_cells * n_speeds, dtype=np.int64)
     _count_targets(m, n_speeds, max_targets, bias, counts)
     offsets = np.zeros(counts.shape[0] + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
-    fixed = [np.empty((n_cells, n_speeds, N_FIXED)) for _ in range(3)]
-    tgt = [np.empty(offsets[-1]) for _ in range(3)]
+    # single precision halves the memory; the tables only shape the cost-to-go (an error of 1e-7
+    # of a node spacing or of a cell's energy), the forward run recomputes every step exactly
+    fixed = [np.empty((n_cells, n_speeds, N_FIXED), dtype=np.float32) for _ in range(3)]
+    tgt = [np.empty(offsets[-1], dtype=np.float32) for _ in range(3)]
     _fill_transitions(m, n_speeds, max_targets, bias, offsets, *fixed, *tgt)
     return (*fixed, offsets, *tgt)
 
