@@ -39,6 +39,11 @@ from pymoo_rail.sim.kernel import (
 from pymoo_rail.sim.physics import electric_braking
 
 INF = math.inf
+# Cost-to-go stored for a node from which the platform cannot be reached (e.g. too slow to clear a
+# neutral section on a climb). Finite, so that linear interpolation next to such a node gives a
+# steep but finite penalty instead of spreading infinity over the whole interval (which, step by
+# step backwards, would make every slow state look infeasible); far above any energy + lambda T.
+PENALTY_J = 1.0e20
 # Tolerance for a transition that ends on the envelope but above it by rounding (the simulator
 # then brakes fully and records an excess of ~1e-9 m/s, or the single-precision tables round
 # the envelope up): counted as the top node.
@@ -350,7 +355,7 @@ def backward_sweep(envelope_ms, time_price_w, bias, fixed_u1, fixed_e, fixed_dt,
                     cost = e + time_price_w * tgt_dt[p] + interp_value(v_next, top1, tgt_u1[p], bias)
                     if cost < best:
                         best = cost
-            value[i, j] = best
+            value[i, j] = best if best < PENALTY_J else PENALTY_J
 
 
 @njit(cache=True)
@@ -373,7 +378,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     previous = MODE_TRACTION
     for i in range(n - 1):
         cost, mode, target = best_control(m, i, v, time_price_w, value[i + 1], max_targets, bias)
-        if cost == INF:
+        if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time
         tr_u, tr_f, tr_w, _ = _full_step(m, v, i, _KIND_TRACTION)
         co_u, co_f, co_w, _ = _full_step(m, v, i, _KIND_COAST)

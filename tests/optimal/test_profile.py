@@ -8,6 +8,7 @@ import pytest
 from pymoo_rail.model import GRAVITY_MS2
 from pymoo_rail.optimal import OptimalSolver, min_running_time, optimal_profile
 from pymoo_rail.sim import Simulator
+from tests.conftest import make_case
 from tests.optimal.cases import hilly_case
 
 
@@ -95,6 +96,20 @@ def test_everything_the_model_has(hilly_solver):
         work = np.sum(electric * np.diff(tr.position_m))
         assert tr.summary["electric_brake_work_j"] == pytest.approx(work, rel=1e-9)
         assert work < tr.summary["brake_work_j"]  # the rest is friction
+
+
+def test_neutral_section_on_a_climb():
+    # 60 kN on 100 t cannot restart on 12 permille: a slow train stalls in the neutral section,
+    # so slow states are infeasible there. Interpolating next to an infeasible node must not make
+    # every slow state look infeasible (it once made the solver find no way from the start).
+    case = make_case(train={"resistance": {"a": 2.0, "b": 0.06, "c": 0.0018, "unit": "kN", "speed_unit": "kmh"},
+                            "traction": {"max_force_kn": 60.0}},
+                     line={"length_m": 3000.0,
+                           "gradients": [[0.0, 1000.0, 0.0], [1000.0, 2200.0, 12.0], [2200.0, 3000.0, 0.0]],
+                           "speed_limits": [[0.0, 3000.0, 100.0]], "neutral_sections": [[1400.0, 1800.0]]})
+    solver = OptimalSolver(case, dx_m=5.0)
+    t = 1.3 * solver.min_running_time_s()
+    check_legal_run(case, solver.profile(t), t)
 
 
 def test_invariances_of_the_accounting():
