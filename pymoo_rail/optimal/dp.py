@@ -159,57 +159,6 @@ def interp_value(v_next, top_u, u, bias):
     return a + w * (b - a)
 
 
-@njit(cache=True)
-def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
-    """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
-
-    Returns ``(total_cost, mode, target_ms)``; ``total_cost`` is +inf when no control can reach the
-    platform.
-    """
-    top_u = m.envelope_ms[cell + 1] ** 2
-    k_max = v_next.shape[0] - 1
-    tr_u, tr_f, tr_w, _ = _full_step(m, v0, cell, _KIND_TRACTION)
-    co_u, co_f, co_w, _ = _full_step(m, v0, cell, _KIND_COAST)
-    br_u, br_f, br_w, _ = _full_step(m, v0, cell, _KIND_BRAKE)
-    best = INF
-    best_mode = MODE_COAST
-    best_target = 0.0
-    n_fixed = 4 if v0 > 0.0 else 3  # holding needs a speed to hold
-    for c in range(n_fixed):
-        if c == 0:
-            mode = MODE_TRACTION
-        elif c == 1:
-            mode = MODE_COAST
-        elif c == 2:
-            mode = MODE_BRAKE
-        else:
-            mode = MODE_HOLD
-        u1, f, w0 = cell_outcome(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        cost, _ = cell_cost(m, v0, u1, f, cell, time_price_w)
-        if cost < INF:
-            cost += interp_value(v_next, top_u, u1, bias)
-        if cost < best:
-            best = cost
-            best_mode = mode
-            best_target = 0.0
-    # partial traction (or braking) landing exactly on a speed node of the next position
-    if top_u > 0.0 and k_max > 0:
-        k_lo, k_hi = _target_range(top_u, k_max, v0 * v0, tr_u, co_u, bias)
-        stride = _n_targets(k_lo, k_hi, max_targets)[1]
-        for k in range(k_lo, k_hi + 1, stride):
-            target = math.sqrt(node_u(top_u, k, k_max, bias))
-            u1, f, w0 = cell_outcome(m, v0, cell, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                     br_u, br_f, br_w)
-            cost, _ = cell_cost(m, v0, u1, f, cell, time_price_w)
-            if cost < INF:
-                cost += interp_value(v_next, top_u, u1, bias)
-            if cost < best:
-                best = cost
-                best_mode = MODE_TOWARD
-                best_target = target
-    return best, best_mode, best_target
-
-
 N_FIXED = 4  # traction, coast, brake, hold
 
 
@@ -249,6 +198,50 @@ def _n_targets(k_lo, k_hi, max_targets):
     if count > max_targets:
         stride = (count + max_targets - 1) // max_targets
     return (count + stride - 1) // stride, stride
+
+
+@njit(cache=True)
+def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
+    """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
+
+    Returns ``(total_cost, mode, target_ms)``; ``total_cost`` is at least ``PENALTY_J`` when no
+    control can reach the platform.
+    """
+    top_u = m.envelope_ms[cell + 1] ** 2
+    k_max = v_next.shape[0] - 1
+    tr_u, tr_f, tr_w, _ = _full_step(m, v0, cell, _KIND_TRACTION)
+    co_u, co_f, co_w, _ = _full_step(m, v0, cell, _KIND_COAST)
+    br_u, br_f, br_w, _ = _full_step(m, v0, cell, _KIND_BRAKE)
+    best = INF
+    best_mode = MODE_COAST
+    best_target = 0.0
+    n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
+    for c in range(n_fixed):
+        mode = _fixed_mode(c)
+        u1, f, w0 = cell_outcome(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+        cost, _ = cell_cost(m, v0, u1, f, cell, time_price_w)
+        if cost < INF:
+            cost += interp_value(v_next, top_u, u1, bias)
+        if cost < best:
+            best = cost
+            best_mode = mode
+            best_target = 0.0
+    # partial traction (or braking) landing exactly on a speed node of the next position
+    if top_u > 0.0 and k_max > 0:
+        k_lo, k_hi = _target_range(top_u, k_max, v0 * v0, tr_u, co_u, bias)
+        stride = _n_targets(k_lo, k_hi, max_targets)[1]
+        for k in range(k_lo, k_hi + 1, stride):
+            target = math.sqrt(node_u(top_u, k, k_max, bias))
+            u1, f, w0 = cell_outcome(m, v0, cell, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+                                     br_u, br_f, br_w)
+            cost, _ = cell_cost(m, v0, u1, f, cell, time_price_w)
+            if cost < INF:
+                cost += interp_value(v_next, top_u, u1, bias)
+            if cost < best:
+                best = cost
+                best_mode = MODE_TOWARD
+                best_target = target
+    return best, best_mode, best_target
 
 
 @njit(cache=True, parallel=True)

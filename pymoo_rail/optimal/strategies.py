@@ -106,7 +106,7 @@ def hold_coast_search(case: Case, running_time_s: float, dx_m: float | None = No
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, n_grid - 1)]
     res = minimize_scalar(lambda v: float(energies(v)[0][0]), bounds=(lo, hi), method="bounded",
                           options={"xatol": 1e-3})
-    best_v, best_e = (res.x, res.fun) if res.fun < e[k] else (grid[k], e[k])
+    best_v = res.x if res.fun < e[k] else grid[k]
     e1, progs = energies(best_v)
     out = sim.run_batch(progs)[0]
     return StrategyResult("hold_coast", float(e1[0]), float(out[OUT_RUNNING_TIME_S]), progs[0], (float(best_v),))
