@@ -616,8 +616,8 @@ def track_to_json(lines: Sequence[Line], track_id: str, *, altitude_m: float = 0
     }
 
 
-def _identifier(text: str) -> str:
-    """TTOBench ids hold letters, numbers and underscores only."""
+def ttobench_id(text: str) -> str:
+    """A TTOBench id from any text (ids hold letters, numbers and underscores only)."""
     return re.sub(r"[^A-Za-z0-9_]+", "_", text).strip("_") or "track"
 
 
@@ -646,19 +646,26 @@ def to_ttobench(case: Case, out_dir: str | Path, *, track_id: str | None = None,
     meta = {"description": case.description or case.name}
     if license_text:
         meta["license"] = license_text
-    track_id = track_id or _identifier(case.name)
-    train_id = train_id or _identifier(train.name or f"{case.name}_train")
+    track_id = track_id or ttobench_id(case.name)
+    train_id = train_id or ttobench_id(train.name or f"{case.name}_train")
     track = track_to_json(lines, track_id, altitude_m=altitude_m, metadata=meta)
     train_json = train_to_json(train, train_id, metadata={"license": license_text} if license_text else None)
+    return write_pair(out_dir, track, train_json)
+
+
+def write_pair(out_dir: str | Path, track: Mapping, train: Mapping) -> tuple[Path, Path]:
+    """Write a track and a train object as ``<id>.json`` files in ``out_dir``."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    track_path = out / f"{track_id}.json"
-    train_path = out / f"{train_id}.json"
-    track_path.write_text(json.dumps(track, indent=2) + "\n", encoding="utf-8")
-    train_path.write_text(json.dumps(train_json, indent=2) + "\n", encoding="utf-8")
-    return track_path, train_path
+    paths = []
+    for obj in (track, train):
+        path = out / f"{obj['metadata']['id']}.json"
+        path.write_text(json.dumps(obj, indent=2) + "\n", encoding="utf-8")
+        paths.append(path)
+    return paths[0], paths[1]
 
 
 __all__ = ["from_ttobench", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
-           "track_to_json", "train_to_json", "braking_curve", "YIZHUANG_TRACK", "BEIJING_SUBWAY_TRAIN",
-           "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M", "TTOBENCH_LICENSE", "TTOBENCH_NOTICE", "DATA_DIR"]
+           "track_to_json", "train_to_json", "write_pair", "ttobench_id", "braking_curve", "YIZHUANG_TRACK",
+           "BEIJING_SUBWAY_TRAIN", "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M", "TTOBENCH_LICENSE",
+           "TTOBENCH_NOTICE", "DATA_DIR"]
