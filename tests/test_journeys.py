@@ -252,3 +252,23 @@ def test_metaheuristic_with_repair_approaches_the_exact_split(journey, fronts):
     res = minimize(problem, DE(pop_size=40, repair=BudgetRepair()), ("n_gen", 150), seed=1)
     assert abs(res.X.sum() - total) < 1e-6
     assert best.energy_kwh - 1e-9 <= res.F[0] <= best.energy_kwh * 1.01
+
+
+def test_callable_front_source_gets_times_above_the_minimum_and_the_flat_out_point(journey):
+    short = Journey(name="two", sections=journey.sections[9:11], dwell_s=(30.0,))
+    seen = []
+
+    def source(case, running_times):  # the signature of pymoo_rail.optimal.optimal_front
+        seen.append((case.name, np.asarray(running_times)))
+        return pd.DataFrame({"running_time_s": running_times, "energy_kwh": 4000.0 / running_times})
+
+    from pymoo_rail.journeys import section_fronts
+
+    fronts = section_fronts(short, source, n_times=5, max_time_factor=1.4)
+    assert [name for name, _ in seen] == [c.name for c in short.sections]
+    for case, (_, times), f in zip(short.sections, seen, fronts):
+        fastest = Simulator(case).flat_out()
+        np.testing.assert_allclose(times, fastest.running_time_s * np.linspace(1.005, 1.4, 5))
+        assert (f.running_time_s.iloc[0], f.energy_kwh.iloc[0]) == (fastest.running_time_s, fastest.energy.net_kwh)
+    best = allocate_running_time(short, sum(f.running_time_s.iloc[0] for f in fronts) + 20.0, fronts=fronts)
+    assert best.marginal_violation() <= 1e-12

@@ -27,9 +27,12 @@ FRONT_SOURCES = ("simulated", "optimal")
 DEFAULT_FRONT_SOURCE = "simulated"
 
 
-def _time_grid(case: Case, n_times: int, max_time_factor: float, dx_m: float | None) -> np.ndarray:
-    t_min = Simulator(case, dx_m).min_running_time_s()
-    return t_min * np.linspace(1.0, max_time_factor, n_times)
+def _time_grid(t_min: float, n_times: int, max_time_factor: float) -> np.ndarray:
+    """Running times asked of a front source: just above the minimum up to ``max_time_factor`` times it."""
+    return t_min * np.linspace(1.0 + _ABOVE_MIN, max_time_factor, n_times)
+
+
+_ABOVE_MIN = 0.005  # the flat-out run itself is added from the simulator (it is the unique run at T_min)
 
 
 def section_fronts(journey: Journey, fronts: FrontSource = DEFAULT_FRONT_SOURCE, *, n_times: int = 25,
@@ -46,9 +49,10 @@ def section_fronts(journey: Journey, fronts: FrontSource = DEFAULT_FRONT_SOURCE,
         (the signature of ``optimal_front``). Or one precomputed DataFrame per section. Every front
         is replaced by its lower convex hull.
     n_times, max_time_factor : int, float
-        Running times asked of a callable or of the exact solver: ``n_times`` from the section's
-        minimum running time to ``max_time_factor`` times it (the simulated search keeps runs up to
-        ``max_time_factor`` times the minimum).
+        Running times asked of a callable or of the exact solver: ``n_times`` from 0.5 % above the
+        section's minimum running time to ``max_time_factor`` times it; the flat-out run (the only
+        run at the minimum time) is added from the simulator. The simulated search keeps runs up
+        to ``max_time_factor`` times the minimum.
     running_times : callable, optional
         ``case -> running times`` for a callable source, replacing that default grid.
     """
@@ -71,9 +75,12 @@ def section_fronts(journey: Journey, fronts: FrontSource = DEFAULT_FRONT_SOURCE,
         return [convex_front(f, f"fronts[{k}]") for k, f in enumerate(fronts)]
     out = []
     for k, case in enumerate(journey.sections):
+        fastest = Simulator(case, dx_m).flat_out()
         times = running_times(case) if running_times is not None else \
-            _time_grid(case, n_times, max_time_factor, dx_m)
-        out.append(convex_front(source(case, np.asarray(times, dtype=float)), f"fronts[{k}]"))
+            _time_grid(fastest.running_time_s, n_times, max_time_factor)
+        front = source(case, np.asarray(times, dtype=float))
+        flat_out = pd.DataFrame({"running_time_s": [fastest.running_time_s], "energy_kwh": [fastest.energy.net_kwh]})
+        out.append(convex_front(pd.concat([flat_out, front], ignore_index=True), f"fronts[{k}]"))
     return out
 
 
