@@ -33,9 +33,10 @@ from pymoo_rail.sim.kernel import (
     REGIME_CRUISE,
     REGIME_TRACTION,
     _landing_force,
+    _share_above,
     run_program,
 )
-from pymoo_rail.sim.physics import davis_force, electric_braking, max_braking, max_traction
+from pymoo_rail.sim.physics import davis_force, electric_braking_capped, max_braking, max_traction
 
 _MS_TO_KMH = 3.6
 _J_PER_KWH = 3.6e6
@@ -312,7 +313,8 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             if m.neutral[i] != 0:
                 w_neutral += f * d
         w_brake += brake_n * d
-        w_elec += electric_braking(m, 0.5 * (v + v1), brake_n) * d
+        if brake_n > 0.0:  # the simulator's regen credit: the share of the cell above the cut-off
+            w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * _share_above(v, v1, m.regen_min_speed_ms)
         w_davis += w0 * d
         w_line += m.line_force_n[i] * d
         w_grade += m.grade_force_n[i] * d

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from pymoo_rail.control import PID, FuzzyPID, Hysteresis, Tracker, track
 from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs, switching_programs
-from pymoo_rail.sim.kernel import OUT_NAMES, REGIME_COAST, REGIME_CRUISE, REGIME_TRACTION
+from pymoo_rail.sim.kernel import OUT_NAMES, REGIME_BRAKE, REGIME_COAST, REGIME_CRUISE, REGIME_TRACTION
 from tests.conftest import make_case
 
 from .conftest import cruise_reference
@@ -70,12 +70,18 @@ def test_energy_terms_from_the_trace(yizhuang, yizhuang_varied):
 
 
 def test_traction_then_braking_reference_is_reproduced_exactly():
-    """No middle part: maximum traction, then the braking curve. Tracking is the reference."""
+    """No middle part: maximum traction, then the braking curve. Tracking is the reference, and
+    every figure of the summary (efficiencies, regen caps and cut-off, auxiliaries) is the
+    simulator's."""
     case = make_case(line={"length_m": 600.0, "gradients": [[0.0, 600.0, 0.0]],
-                           "speed_limits": [[0.0, 600.0, 100.0]]})
+                           "speed_limits": [[0.0, 600.0, 100.0]]},
+                     train={"traction_efficiency": 0.9, "regen_efficiency": 0.8, "regen_min_speed_kmh": 10.0,
+                            "aux_power_kw": 40.0, "braking": {"max_force_kn": 100.0, "regen_max_force_kn": 60.0}})
     sim = Simulator(case)
     ref = sim.flat_out()
     assert ref.speed_ms.max() < 100 / 3.6 - 1.0  # never reaches the limit: traction, then braking
+    assert set(np.unique(ref.regime)) == {REGIME_TRACTION, REGIME_BRAKE}
+    assert ref.energy.regen_kwh > 0.0 and ref.energy.aux_kwh > 0.0
     for controller in CONTROLLERS:
         tr = track(case, ref, controller)
         for name in OUT_NAMES:
