@@ -125,7 +125,8 @@ class Hysteresis:
         a = _check("a_kmh", self.a_kmh)
         b = _check("b_kmh", self.b_kmh)
         if a >= b:
-            raise ValueError(f"a_kmh = {a} >= b_kmh = {b}: the coast threshold A must be below the traction threshold B")
+            raise ValueError(f"a_kmh = {a} >= b_kmh = {b}: the coast threshold A must be below "
+                             "the traction threshold B")
         _check("overspeed_kmh", self.overspeed_kmh)
         _check("brake_fraction", self.brake_fraction, positive=True, upper=1.0)
 

@@ -24,7 +24,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from pymoo_rail.control.controllers import CTRL_FUZZY_PID, CTRL_HYSTERESIS, CTRL_PID
+from pymoo_rail.control.controllers import CTRL_HYSTERESIS, CTRL_PID
 from pymoo_rail.sim import kernel as sk
 from pymoo_rail.sim.kernel import (
     N_OUT,
@@ -314,7 +314,8 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
                 w_neutral += f * d
         w_brake += brake_n * d
         if brake_n > 0.0:  # the simulator's regen credit: the share of the cell above the cut-off
-            w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * _share_above(v, v1, m.regen_min_speed_ms)
+            share = _share_above(v, v1, m.regen_min_speed_ms)
+            w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
         w_davis += w0 * d
         w_line += m.line_force_n[i] * d
         w_grade += m.grade_force_n[i] * d

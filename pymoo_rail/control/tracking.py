@@ -73,8 +73,10 @@ class Tracker:
     def run(self, reference: Trajectory) -> Trajectory:
         """The tracked run of one reference curve (any :class:`Trajectory` of this line).
 
-        The summary has the simulator's keys plus ``speed_error_rms_kmh`` and
-        ``speed_error_max_kmh`` (speed minus reference at the same position, over the run).
+        The summary has the simulator's keys plus the speed error (speed minus reference at the
+        same position, km/h) over the whole run (``speed_error_rms_kmh``, ``speed_error_max_kmh``)
+        and over the part the controller drives (``control_error_rms_kmh``,
+        ``control_error_max_kmh``, between ``control_start_m`` and ``control_stop_m``).
         """
         _check_reference(reference)
         grid = self.simulator.grid
@@ -89,6 +91,9 @@ class Tracker:
         err_kmh = (v - np.interp(x, x_ref, v_ref_ms, right=0.0)) * 3.6
         summary["speed_error_rms_kmh"] = float(np.sqrt(np.mean(err_kmh**2)))
         summary["speed_error_max_kmh"] = float(np.max(np.abs(err_kmh)))
+        middle = (x >= x_start) & (x < x_stop)
+        summary["control_error_rms_kmh"] = float(np.sqrt(np.mean(err_kmh[middle] ** 2))) if middle.any() else 0.0
+        summary["control_error_max_kmh"] = float(np.max(np.abs(err_kmh[middle]))) if middle.any() else 0.0
         summary["control_start_m"] = float(x_start)
         summary["control_stop_m"] = float(x_stop)
         return Trajectory(position_m=x, speed_ms=v, time_s=t, accel_ms2=a, force_n=f, regime=r,
