@@ -25,21 +25,22 @@ import numpy as np
 from numba import njit, prange
 
 from pymoo_rail.control.controllers import CTRL_HYSTERESIS, CTRL_PID
-from pymoo_rail.sim import kernel as sk
 from pymoo_rail.sim.kernel import (
     N_OUT,
+    TOTAL_TIME,
     REGIME_BRAKE,
     REGIME_COAST,
     REGIME_CRUISE,
     REGIME_TRACTION,
-    _landing_force,
-    _share_above,
+    clamp_to_envelope,
+    complete_cell,
+    new_totals,
     run_program,
+    write_summary,
 )
-from pymoo_rail.sim.physics import davis_force, electric_braking_capped, max_braking, max_traction
+from pymoo_rail.sim.physics import davis_force, max_braking, max_traction
 
 _MS_TO_KMH = 3.6
-_J_PER_KWH = 3.6e6
 _N_STATE = 4
 # controller state slots
 _S_MODE, _S_INTEGRAL, _S_PREV_E, _S_HAS_PREV = 0, 1, 2, 3
@@ -217,8 +218,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
     Returns the number of trace nodes written.
     """
     n = m.position_m.shape[0]
-    length = m.position_m[n - 1]
-    dx = m.dx_m
+    totals = new_totals()
     state = np.zeros(_N_STATE)
     phase = 0  # 0 start, 1 middle, 2 stop
     u_cmd = 1.0
@@ -226,21 +226,8 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
     t_last = 0.0
     v = 0.0
     t = 0.0
-    w_trac = 0.0
-    w_brake = 0.0
-    w_elec = 0.0
-    w_davis = 0.0
-    w_line = 0.0
-    w_grade = 0.0
-    w_neutral = 0.0
-    jerk = 0.0
-    prev_acc = 0.0
-    max_abs_acc = 0.0
-    prev_regime = -1
-    changes = 0
-    excess = -1e300
-    reached = 1.0
-    stop_pos = length
+    reached = True
+    stop_pos = m.position_m[n - 1]
     count = 1
     if record:
         tr_x[0] = 0.0
@@ -248,7 +235,6 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
         tr_t[0] = 0.0
     for i in range(n - 1):
         x0 = m.position_m[i]
-        cap = m.envelope_ms[i + 1]
         if phase == 0 and x0 >= x_start_m - 1e-9:
             phase = 1
             _start_controller(m, code, params, state, v, i)
@@ -274,100 +260,26 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
         else:
             regime = REGIME_CRUISE
 
-        # 2. never above the braking envelope (limits ahead, the platform)
-        if u1 > cap * cap:
-            fl, w0l, ok = _landing_force(m, v, cap, i)
-            if ok:
-                u1, f, w0 = cap * cap, fl, w0l
-            else:
-                u1, f, w0 = _command_step(m, v, i, -1.0)
-            if f < 0.0 and cap < m.limit_ms[i + 1] - 1e-9:
-                regime = REGIME_BRAKE
-            elif f != 0.0:
-                regime = REGIME_CRUISE
-            if phase == 1 and x0 >= x_stop_m - 1e-9:
-                phase = 2
+        # 2. never above the braking envelope (limits ahead, the platform): the simulator's rule
+        u1, f, w0, regime, clamped = clamp_to_envelope(m, v, i, u1, f, w0, regime)
+        if clamped and phase == 1 and x0 >= x_stop_m - 1e-9:
+            phase = 2
         if phase == 2:
             u_cmd = -1.0 if f < 0.0 else 0.0
-        if f == 0.0:
-            regime = REGIME_COAST
-        elif f > 0.0 and regime == REGIME_COAST:
-            regime = REGIME_CRUISE
 
-        # 3. standstill inside the cell ends the run (as in the simulator)
-        stopped = u1 < 0.0 or (u1 == 0.0 and i < n - 2)
-        a_cell = (u1 - v * v) / (2.0 * dx)
-        d = dx
-        if stopped:
-            d = -v * v / (2.0 * a_cell) if a_cell < 0.0 else 0.0
-            if d > dx:
-                d = dx
-        if u1 < 0.0:
-            u1 = 0.0
-        v1 = math.sqrt(u1)
-        dt = 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
-        t += dt
-        brake_n = -f if f < 0.0 else 0.0
-        if f > 0.0:
-            w_trac += f * d
-            if m.neutral[i] != 0:
-                w_neutral += f * d
-        w_brake += brake_n * d
-        if brake_n > 0.0:  # the simulator's regen credit: the share of the cell above the cut-off
-            share = _share_above(v, v1, m.regen_min_speed_ms)
-            w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
-        w_davis += w0 * d
-        w_line += m.line_force_n[i] * d
-        w_grade += m.grade_force_n[i] * d
-        jerk += abs(a_cell - prev_acc)
-        prev_acc = a_cell
-        if abs(a_cell) > max_abs_acc:
-            max_abs_acc = abs(a_cell)
-        if prev_regime >= 0 and regime != prev_regime:
-            changes += 1
-        prev_regime = regime
-        if v1 - m.limit_ms[i + 1] > excess:
-            excess = v1 - m.limit_ms[i + 1]
+        # 3. the rest of the cell exactly as the simulator does it
+        v, stopped, x1 = complete_cell(m, totals, i, v, u1, f, w0, regime, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r)
+        t = totals[TOTAL_TIME]
         if record:
-            tr_x[i + 1] = x0 + d
-            tr_v[i + 1] = v1
-            tr_t[i + 1] = t
-            tr_a[i] = a_cell
-            tr_f[i] = f
-            tr_r[i] = regime
             tr_u[i] = u_cmd
         count = i + 2
-        v = v1
         if stopped:
-            reached = 0.0
-            stop_pos = x0 + d
+            reached = False
+            stop_pos = x1
             break
-    jerk += abs(prev_acc)
+    write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r)
     if record:
-        tr_a[count - 1] = 0.0
-        tr_f[count - 1] = 0.0
-        tr_r[count - 1] = REGIME_BRAKE if reached > 0.0 else REGIME_COAST
         tr_u[count - 1] = 0.0
-    out[sk.OUT_TRACTION_KWH] = w_trac / m.traction_efficiency / _J_PER_KWH
-    out[sk.OUT_REGEN_KWH] = m.regen_efficiency * w_elec / _J_PER_KWH
-    out[sk.OUT_AUX_KWH] = m.aux_power_w * t / _J_PER_KWH
-    out[sk.OUT_NET_KWH] = out[sk.OUT_TRACTION_KWH] + out[sk.OUT_AUX_KWH] - out[sk.OUT_REGEN_KWH]
-    out[sk.OUT_RUNNING_TIME_S] = t
-    out[sk.OUT_STOP_POSITION_M] = stop_pos
-    out[sk.OUT_STOP_ERROR_M] = abs(length - stop_pos)
-    out[sk.OUT_JERK_MS2] = jerk
-    out[sk.OUT_REGIME_CHANGES] = changes
-    out[sk.OUT_LIMIT_EXCESS_MS] = excess if excess > 0.0 else 0.0
-    out[sk.OUT_TRACTION_WORK_J] = w_trac
-    out[sk.OUT_BRAKE_WORK_J] = w_brake
-    out[sk.OUT_DAVIS_WORK_J] = w_davis
-    out[sk.OUT_LINE_WORK_J] = w_line
-    out[sk.OUT_GRADE_WORK_J] = w_grade
-    out[sk.OUT_FINAL_SPEED_MS] = v
-    out[sk.OUT_REACHED] = reached
-    out[sk.OUT_ELECTRIC_BRAKE_WORK_J] = w_elec
-    out[sk.OUT_MAX_ABS_ACCEL_MS2] = max_abs_acc
-    out[sk.OUT_NEUTRAL_TRACTION_J] = w_neutral
     return count
 
 
