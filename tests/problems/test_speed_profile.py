@@ -172,3 +172,20 @@ def test_de_constrained_yizhuang_within_a_second(yizhuang):
     assert abs(tr.running_time_s - 150.0) <= 1.0 and tr.stop_error_m <= 0.25
     # it saves energy against the flat-out run
     assert tr.energy.net_kwh < 0.8 * problem.simulator.flat_out().energy.net_kwh
+
+
+@pytest.mark.parametrize("name,planned_s", [("metro-a", 70.0), ("wuguang-crh3", 1050.0)])
+def test_de_constrained_other_cases(name, planned_s):
+    from pymoo_rail.cases import load_case
+
+    case = load_case(name)
+    assert case.planned_time_s == planned_s
+    problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=1.0)
+    res = minimize(problem, DE(pop_size=40), ("n_evals", 4000), seed=1)
+    tr = problem.trajectory(res.X)
+    assert abs(tr.running_time_s - planned_s) <= 1.0 and tr.reached
+    # no traction in a neutral section (seed 003): check the trace itself, not just the counter
+    for start, end in case.line.neutral_sections:
+        inside = (tr.position_m >= start) & (tr.position_m < end)
+        assert inside.any() and np.all(tr.force_n[inside] <= 0.0)
+    assert tr.summary["neutral_traction_j"] == 0.0
