@@ -13,75 +13,154 @@ segments in the same order). The price is minus the slope of the last segment us
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable, Sequence
 
 import numpy as np
 import pandas as pd
 
-from pymoo_rail.journeys.fronts import FrontSource, convex_front, front_energy, front_slopes, strategy_front
+from pymoo_rail.journeys.fronts import (
+    FRONT_COLUMNS,
+    FrontSource,
+    convex_front,
+    front_energy,
+    front_slopes,
+    strategy_front,
+)
 from pymoo_rail.journeys.journey import Journey
 from pymoo_rail.model import Case, CaseError, InfeasibleCaseError
 from pymoo_rail.sim import Simulator
 
-FRONT_SOURCES = ("simulated", "optimal")
-DEFAULT_FRONT_SOURCE = "simulated"
+FRONT_SOURCES = ("optimal", "simulated", "combined")
+DEFAULT_FRONT_SOURCE = "optimal"
 
 
 def _time_grid(t_min: float, n_times: int, max_time_factor: float) -> np.ndarray:
-    """Running times asked of a front source: just above the minimum up to ``max_time_factor`` times it."""
-    return t_min * np.linspace(1.0 + _ABOVE_MIN, max_time_factor, n_times)
+    """Running times asked of a front source, from just above the minimum to ``max_time_factor`` times it.
+
+    Spaced quadratically: the front bends most near the minimum time, and a chord across a bend
+    overestimates the energy of a convex front (with even spacing and 16 times, by up to 2 % just
+    above the minimum on this project's metro sections).
+    """
+    u = np.linspace(0.0, 1.0, n_times)
+    return t_min * (1.0 + _ABOVE_MIN + (max_time_factor - 1.0 - _ABOVE_MIN) * u * u)
 
 
 _ABOVE_MIN = 0.005  # the flat-out run itself is added from the simulator (it is the unique run at T_min)
+_GRID = "quadratic"  # recorded in front caches: a cache made with another spacing is not reused
 
 
-def section_fronts(journey: Journey, fronts: FrontSource = DEFAULT_FRONT_SOURCE, *, n_times: int = 25,
+def section_fronts(journey: Journey, fronts: FrontSource = DEFAULT_FRONT_SOURCE, *, n_times: int = 16,
                    max_time_factor: float = 1.5, dx_m: float | None = None,
-                   running_times: Callable[[Case], np.ndarray] | None = None) -> list[pd.DataFrame]:
+                   running_times: Callable[[Case], np.ndarray] | None = None,
+                   cache_path: str | Path | None = None) -> list[pd.DataFrame]:
     """Convex energy-time fronts of a journey's sections.
 
     Parameters
     ----------
     fronts : str, callable or sequence of DataFrame
-        ``"simulated"``: :func:`~pymoo_rail.journeys.fronts.strategy_front` (direct search over
-        traction - hold - coast - brake runs). ``"optimal"``: the exact solver
-        ``pymoo_rail.optimal.optimal_front``. A callable ``f(case, running_times) -> DataFrame``
-        (the signature of ``optimal_front``). Or one precomputed DataFrame per section. Every front
-        is replaced by its lower convex hull.
+        ``"optimal"`` (default): the exact solver ``pymoo_rail.optimal.optimal_front`` (about a
+        second per running time on a 2 km section, so minutes for a whole line: pass
+        ``cache_path``). ``"simulated"``: :func:`~pymoo_rail.journeys.fronts.strategy_front`, a
+        direct search over traction - hold - coast - brake runs (seconds for a whole line; on the
+        Yizhuang sections its mean gap to the exact front is below 1 %, locally a few %).
+        ``"combined"``: the lower hull of both point sets; every point is a simulated run (the
+        exact solver returns the simulator's replay of its controls), so the hull stays an upper
+        estimate of the optimal front, at least as close as either. A callable
+        ``f(case, running_times) -> DataFrame`` (the signature of ``optimal_front``). Or one
+        precomputed DataFrame per section. Every front is replaced by its lower convex hull.
     n_times, max_time_factor : int, float
         Running times asked of a callable or of the exact solver: ``n_times`` from 0.5 % above the
-        section's minimum running time to ``max_time_factor`` times it; the flat-out run (the only
-        run at the minimum time) is added from the simulator. The simulated search keeps runs up
+        section's minimum running time to ``max_time_factor`` times it, spaced quadratically (denser
+        near the minimum, where the front bends most); the flat-out run (the only run at the
+        minimum time) is added from the simulator. The simulated search keeps runs up
         to ``max_time_factor`` times the minimum.
     running_times : callable, optional
         ``case -> running times`` for a callable source, replacing that default grid.
+    cache_path : path, optional
+        A CSV file of finished section fronts: sections already there (same source and settings)
+        are read back, each new one is appended as soon as it is computed, so an interrupted run
+        loses nothing that had finished. The cache keeps the columns ``running_time_s`` and
+        ``energy_kwh`` of each convex front.
     """
     if isinstance(fronts, str):
         if fronts == "simulated":
-            return [strategy_front(c, dx_m=dx_m, max_time_factor=max_time_factor) for c in journey.sections]
-        if fronts == "optimal":
-            from pymoo_rail.optimal import optimal_front  # the exact solver (branch 'optimal')
+            def compute(k: int, case: Case) -> pd.DataFrame:
+                return strategy_front(case, dx_m=dx_m, max_time_factor=max_time_factor)
+        elif fronts in ("optimal", "combined"):
+            from pymoo_rail.optimal import optimal_front  # the exact solver
 
-            source: Callable = optimal_front
+            exact = _sampled(lambda case, times: optimal_front(case, times, dx_m=dx_m), n_times,
+                             max_time_factor, dx_m, running_times)
+            if fronts == "optimal":
+                compute = exact
+            else:
+                def compute(k: int, case: Case) -> pd.DataFrame:
+                    searched = strategy_front(case, dx_m=dx_m, max_time_factor=max_time_factor)
+                    return pd.concat([exact(k, case)[list(FRONT_COLUMNS)], searched[list(FRONT_COLUMNS)]],
+                                     ignore_index=True)
         else:
             raise CaseError("fronts", fronts, f"unknown front source (known: {', '.join(FRONT_SOURCES)}, "
                                               "a callable, or one DataFrame per section)")
+        label = fronts
     elif callable(fronts):
-        source = fronts
+        compute = _sampled(fronts, n_times, max_time_factor, dx_m, running_times)
+        label = getattr(fronts, "__qualname__", repr(fronts))
     else:
         fronts = list(fronts)
         if len(fronts) != journey.n_sections:
             raise CaseError("fronts", len(fronts), f"needs one front per section ({journey.n_sections})")
         return [convex_front(f, f"fronts[{k}]") for k, f in enumerate(fronts)]
+    key = {"source": label, "grid": _GRID if running_times is None else "custom", "n_times": n_times,
+           "max_time_factor": max_time_factor, "dx_m": dx_m or 0.0}
+    cached = _read_cache(cache_path, key) if cache_path is not None else {}
     out = []
     for k, case in enumerate(journey.sections):
+        front = cached.get((k, case.name))
+        if front is None:
+            front = convex_front(compute(k, case), f"fronts[{k}]")
+            if cache_path is not None:
+                _append_cache(cache_path, front[list(FRONT_COLUMNS)].assign(section=k, case=case.name, **key))
+        out.append(front)
+    return out
+
+
+def _sampled(source: Callable, n_times: int, max_time_factor: float, dx_m: float | None,
+             running_times: Callable[[Case], np.ndarray] | None) -> Callable[[int, Case], pd.DataFrame]:
+    """A section-front function from a source evaluated at chosen running times, plus the flat-out run."""
+    def compute(k: int, case: Case) -> pd.DataFrame:
         fastest = Simulator(case, dx_m).flat_out()
         times = running_times(case) if running_times is not None else \
             _time_grid(fastest.running_time_s, n_times, max_time_factor)
         front = source(case, np.asarray(times, dtype=float))
         flat_out = pd.DataFrame({"running_time_s": [fastest.running_time_s], "energy_kwh": [fastest.energy.net_kwh]})
-        out.append(convex_front(pd.concat([flat_out, front], ignore_index=True), f"fronts[{k}]"))
+        return pd.concat([flat_out, front], ignore_index=True)
+    return compute
+
+
+_CACHE_KEYS = ("section", "case", "source", "grid", "n_times", "max_time_factor", "dx_m")
+
+
+def _read_cache(path: str | Path, key: dict) -> dict[tuple[int, str], pd.DataFrame]:
+    path = Path(path)
+    if not path.is_file():
+        return {}
+    table = pd.read_csv(path)
+    match = np.ones(len(table), dtype=bool)
+    for name, value in key.items():
+        column = table[name]
+        match &= np.isclose(column.astype(float), float(value)) if isinstance(value, (int, float)) \
+            else (column.astype(str) == str(value)).to_numpy()
+    out = {}
+    for (section, case), rows in table[match].groupby(["section", "case"]):
+        out[(int(section), str(case))] = rows.drop(columns=list(_CACHE_KEYS)).reset_index(drop=True)
     return out
+
+
+def _append_cache(path: str | Path, rows: pd.DataFrame) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    rows.to_csv(path, mode="a", header=not path.is_file(), index=False)
 
 
 def allocate_on_fronts(fronts: Sequence[pd.DataFrame], total_time_s: float) -> tuple[np.ndarray, np.ndarray, float]:
