@@ -62,12 +62,13 @@ def main(argv: list[str] | None = None) -> None:
     equal = supplement_split(journey, best.total_time_s, fronts=fronts, rule="equal")
     table = best.table.assign(equal_split_time_s=equal.running_times_s, equal_split_energy_kwh=equal.energies_kwh)
     table.to_csv(args.out / "allocation.csv", index=False)
-    with pd.option_context("display.width", 140, "display.precision", 2):
+    with pd.option_context("display.width", 140):
         print(table[["label", "length_m", "min_time_s", "running_time_s", "energy_kwh", "equal_split_time_s",
-                     "equal_split_energy_kwh"]].to_string(index=False))
+                     "equal_split_energy_kwh"]].to_string(index=False, float_format=lambda v: f"{v:.2f}"))
+    saved = 100 * (equal.energy_kwh - best.energy_kwh) / equal.energy_kwh
     print(f"trip {best.trip_time_s:.1f} s: optimal split {best.energy_kwh:.2f} kWh, equal supplement "
-          f"{equal.energy_kwh:.2f} kWh ({100 * (equal.energy_kwh - best.energy_kwh) / equal.energy_kwh:.2f} % "
-          f"more); marginal price {1000 * best.price_kwh_per_s:.1f} Wh per extra second")
+          f"{equal.energy_kwh:.2f} kWh (the optimal split saves {saved:.2f} %); marginal price "
+          f"{1000 * best.price_kwh_per_s:.1f} Wh per extra second")
 
     # energy against trip time, as far as the equal split stays inside every front
     widest_equal = lo + journey.n_sections * min(f.running_time_s.iloc[-1] - f.running_time_s.iloc[0] for f in fronts)
