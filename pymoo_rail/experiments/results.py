@@ -56,6 +56,7 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
 def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
     """One row per run: ids, labels, budget, evaluations, wall time, one column per indicator.
 
+    ``problem_spec`` and ``algorithm_spec`` hold the specs (dicts) the run was built from.
     With ``fronts``, the columns ``F`` and ``X`` hold the final front as arrays, ``extras`` a
     dict of per-member arrays (rail problems: ``energy_kwh``, ``running_time_s``,
     ``stop_error_m``) and ``history`` the per-generation dict of lists.
@@ -67,7 +68,7 @@ def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
         row = {"run_id": r["run_id"], "problem": r["problem_label"], "algorithm": r["algorithm_label"],
                "seed": r["seed"], "budget": f"{budget_kind}={budget_value}", "n_var": r["n_var"],
                "n_obj": r["n_obj"], "n_eval": r["n_eval"], "n_gen": r["n_gen"], "wall_time_s": r["wall_time_s"],
-               "feasible": r["feasible"]}
+               "feasible": r["feasible"], "problem_spec": r["problem"], "algorithm_spec": r["algorithm"]}
         row.update(r["indicators"])
         if fronts:
             n_obj, n_var = r["n_obj"], r["n_var"]
