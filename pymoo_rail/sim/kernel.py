@@ -28,7 +28,7 @@ from numba import njit, prange
 
 from pymoo_rail.sim.physics import (
     davis_force,
-    electric_braking,
+    electric_braking_capped,
     max_braking,
     max_traction,
 )
@@ -92,6 +92,17 @@ def _full_step(m, v0, cell, kind):
     w0 = davis_force(m, v_half)
     u1 = v0 * v0 + 2.0 * dx * (f - w0 - wl) / m.effective_mass_kg
     return u1, f, w0, v_half
+
+
+@njit(cache=True)
+def _share_above(v0, v1, v_cut):
+    """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
+    lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
+    if lo >= v_cut:
+        return 1.0
+    if hi <= v_cut:
+        return 0.0
+    return (hi * hi - v_cut * v_cut) / (hi * hi - lo * lo)
 
 
 @njit(cache=True)
@@ -225,7 +236,8 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
             if m.neutral[i] != 0:
                 w_neutral += f * d
         w_brake += brake_n * d
-        w_elec += electric_braking(m, 0.5 * (v + v1), brake_n) * d
+        if brake_n > 0.0:
+            w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * _share_above(v, v1, m.regen_min_speed_ms)
         w_davis += w0 * d
         w_line += m.line_force_n[i] * d
         w_grade += m.grade_force_n[i] * d

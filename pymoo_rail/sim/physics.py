@@ -129,16 +129,26 @@ def max_braking(m, v, cell):
 
 
 @njit(cache=True)
-def electric_braking(m, v, brake_n):
-    """The part of a braking force the motors take (and regenerate); the rest is friction."""
-    if v < m.regen_min_speed_ms:
-        return 0.0
+def electric_braking_capped(m, v, brake_n):
+    """The part of a braking force within the motors' regen force and power caps."""
     f = brake_n
     if f > m.regen_max_n:
         f = m.regen_max_n
     if v > 0.0 and f * v > m.regen_max_w:
         f = m.regen_max_w / v
     return f
+
+
+@njit(cache=True)
+def electric_braking(m, v, brake_n):
+    """The part of a braking force the motors take (and regenerate) at speed v; the rest is friction.
+
+    Zero below the regen cut-off speed. (The simulator credits the share of a cell run above the
+    cut-off instead, so that results do not jump with the grid.)
+    """
+    if v < m.regen_min_speed_ms:
+        return 0.0
+    return electric_braking_capped(m, v, brake_n)
 
 
 @njit(cache=True)
