@@ -190,8 +190,8 @@ class GoldenRatioNSGA2(NSGA2):
     1. ``P_{k+1}`` = NSGA-II survival (fast non-dominated sorting, crowding distance,
        :class:`~pymoo.operators.survival.rank_and_crowding.RankAndCrowding`) of
        ``P_k + Q_k`` (``Z_k`` takes no part in it);
-    2. the Metropolis criterion offers each point of ``Z_k`` in turn the place of the worst
-       remaining member of ``P_{k+1}``;
+    2. the Metropolis criterion offers each point of ``Z_k`` in turn the place of the
+       current worst member of ``P_{k+1}``;
     3. P_z for the next generation is the best ``local_size`` (= 2m) members of the
        population, ordered by feasibility, constraint violation, rank, then descending
        crowding distance (so rank 0 whenever there are at least 2m of them).
@@ -314,7 +314,9 @@ class GoldenRatioNSGA2(NSGA2):
         pop_size = _check_int("pop_size", pop_size, 2)
         local_size = _check_int("local_size", local_size, 0)
         if local_size % 2 != 0:
-            raise ValueError(f"local_size must be even (P_z holds 2m individuals), got {local_size}")
+            raise ValueError(
+                f"local_size must be even (P_z holds 2m individuals), got {local_size}"
+            )
         if local_size > pop_size:
             raise ValueError(
                 f"local_size must not exceed pop_size ({pop_size}), got {local_size}"
@@ -339,14 +341,17 @@ class GoldenRatioNSGA2(NSGA2):
             raise ValueError(f"cooling must lie in (0, 1], got {cooling!r}")
 
         crossover = SBX(eta=15) if crossover is None else crossover
-        if not isinstance(crossover, Crossover) or (crossover.n_parents, crossover.n_offsprings) != (2, 2):
+        shape = (getattr(crossover, "n_parents", None), getattr(crossover, "n_offsprings", None))
+        if not isinstance(crossover, Crossover) or shape != (2, 2):
             raise ValueError(
-                f"crossover must be a pymoo Crossover with 2 parents and 2 offspring, got {crossover!r}"
+                "crossover must be a pymoo Crossover with 2 parents and 2 offspring, "
+                f"got {crossover!r}"
             )
         mutation = PM(eta=20) if mutation is None else mutation
         if not isinstance(mutation, PolynomialMutation):
             raise ValueError(
-                f"mutation must be a pymoo PolynomialMutation (eq. 9 sets its probability), got {mutation!r}"
+                "mutation must be a pymoo PolynomialMutation (eq. 9 sets its probability), "
+                f"got {mutation!r}"
             )
 
         self.fixed_genes = self._check_fixed_genes(fixed_genes)
@@ -374,7 +379,9 @@ class GoldenRatioNSGA2(NSGA2):
         self.fixed_mask: np.ndarray | None = None
         # ranking used by the Metropolis step: the survival's own, else NSGA-II's defaults
         self._nds = getattr(self.survival, "nds", None) or NonDominatedSorting()
-        self._crowding = getattr(self.survival, "crowding_func", None) or get_crowding_function("cd")
+        self._crowding = (
+            getattr(self.survival, "crowding_func", None) or get_crowding_function("cd")
+        )
         self._reset_state()
 
     # -- parameters ---------------------------------------------------------------------------

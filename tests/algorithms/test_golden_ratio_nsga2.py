@@ -27,7 +27,8 @@ def small(**kwargs):
 @pytest.mark.parametrize("name", ["zdt1", "zdt2", "zdt3"])
 def test_converges_on_zdt(name):
     problem = get_problem(name)
-    res = minimize(problem, GoldenRatioNSGA2(pop_size=100, local_size=20), ("n_eval", 12000), seed=1)
+    alg = GoldenRatioNSGA2(pop_size=100, local_size=20)
+    res = minimize(problem, alg, ("n_eval", 12000), seed=1)
     assert res.algorithm.evaluator.n_eval <= 25000
     assert IGD(problem.pareto_front())(res.F) < 0.05
 
@@ -305,6 +306,18 @@ def test_bad_parameters(kwargs, words):
         GoldenRatioNSGA2(**kwargs)
     for w in words:
         assert w in str(err.value)
+
+
+def test_bad_operators():
+    from pymoo.operators.crossover.sbx import SBX
+    from pymoo.operators.mutation.gauss import GaussianMutation
+
+    with pytest.raises(ValueError, match="crossover"):
+        GoldenRatioNSGA2(crossover=SBX(n_offsprings=1))
+    with pytest.raises(ValueError, match="crossover"):
+        GoldenRatioNSGA2(crossover="sbx")
+    with pytest.raises(ValueError, match="mutation"):
+        GoldenRatioNSGA2(mutation=GaussianMutation())
 
 
 @pytest.mark.parametrize(
