@@ -59,18 +59,21 @@ def as_trace(run) -> Trace:
 
 
 def _regime_line(ax, x: np.ndarray, v: np.ndarray, regime: np.ndarray, lw: float = 2.0) -> None:
-    """The speed curve coloured by regime, one segment per grid cell."""
+    """The speed curve coloured by regime: one polyline per stretch of constant regime (cell k
+    from node k to node k + 1 carries ``regime[k]``)."""
     from matplotlib.collections import LineCollection
     from matplotlib.colors import ListedColormap
 
+    codes = np.clip(np.asarray(regime[: len(x) - 1], dtype=int), 0, len(REGIME_COLORS) - 1)
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(codes)) + 1])
+    ends = np.concatenate([starts[1:], [len(codes)]])
     points = np.column_stack([x, v])
-    segments = np.stack([points[:-1], points[1:]], axis=1)
-    codes = np.clip(regime[: len(segments)], 0, len(REGIME_COLORS) - 1)
-    lines = LineCollection(segments, cmap=ListedColormap(REGIME_COLORS), linewidths=lw, zorder=3)
-    lines.set_array(codes.astype(float))
+    lines = LineCollection([points[a: b + 1] for a, b in zip(starts, ends)], cmap=ListedColormap(REGIME_COLORS),
+                           linewidths=lw, zorder=3, capstyle="round", joinstyle="round")
+    lines.set_array(codes[starts].astype(float))
     lines.set_clim(-0.5, len(REGIME_COLORS) - 0.5)
     ax.add_collection(lines)
-    ax.set_xlim(min(x.min(), ax.get_xlim()[0]) if ax.has_data() else x.min(), x.max())
+    ax.set_xlim(x.min(), x.max())
 
 
 def _regime_legend(ax, extra=()) -> None:
@@ -112,16 +115,16 @@ def _gradient_panel(ax, line) -> None:
     ax.fill_between(x, h, h.min() - 0.1 * (np.ptp(h) + 1.0), color="0.85", zorder=1)
     ax.plot(x, h, color="0.25", lw=1.2, zorder=2)
     span = np.ptp(h) + 1.0
-    for start, end, permille in line.gradients:
-        if end - start < 0.04 * line.length_m:
-            continue  # too short to label legibly
-        mid = 0.5 * (start + end)
-        ax.text(mid, float(line.altitude_m(mid)) + 0.08 * span, f"{permille:+g}‰", ha="center", va="bottom",
-                fontsize="x-small", color="0.2")
+    top = ax.get_xaxis_transform()  # x in metres, y as a fraction of the panel
+    labelled = [row for row in line.gradients if row[1] - row[0] >= 0.035 * line.length_m]  # legible ones
+    stagger = len(labelled) > 12  # many sections: alternate two rows so neighbours do not touch
+    for k, (start, end, permille) in enumerate(labelled):
+        ax.text(0.5 * (start + end), 0.97 - (0.14 if stagger and k % 2 else 0.0), f"{permille:+g}‰",
+                transform=top, ha="center", va="top", fontsize="x-small", color="0.2")
     for row in line.gradients[1:]:
         ax.axvline(row[0], color="0.7", lw=0.5, zorder=0)
     ax.set_ylabel("altitude (m)")
-    ax.set_ylim(h.min() - 0.1 * span, h.max() + 0.35 * span)
+    ax.set_ylim(h.min() - 0.1 * span, h.max() + 0.6 * span)
 
 
 def plot_speed_profile(run, case=None, label: str | None = None, others: Sequence = (), other_labels=None,
