@@ -171,8 +171,22 @@ def _moabc(problem, **params):
     return _rail_algorithm("MOABC", "moabc")(**params)
 
 
+def _fixed_genes(problem):
+    """Genes a rail encoding holds constant (speed codes inside neutral sections), if any."""
+    fixed = getattr(getattr(problem, "encoding", None), "fixed", None)
+    if not callable(fixed):
+        return None
+    mask = fixed()
+    return mask if mask.any() else None
+
+
 def _grnsga2(problem, **params):
-    """``pymoo_rail.algorithms.GoldenRatioNSGA2`` (seed 003, 3.1)."""
+    """``pymoo_rail.algorithms.GoldenRatioNSGA2`` (seed 003, 3.1); on a rail problem the genes of
+    neutral sections are passed as ``fixed_genes`` unless given."""
+    if "fixed_genes" not in params:
+        fixed = _fixed_genes(problem)
+        if fixed is not None:
+            params["fixed_genes"] = fixed
     return _rail_algorithm("GoldenRatioNSGA2", "golden_ratio_nsga2")(**params)
 
 

@@ -16,6 +16,7 @@ import socket
 import time
 import traceback
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -284,6 +285,12 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
                 futures[executor.submit(execute_run_safely, run)] = run
             for future in as_completed(futures):
                 store_result(*future.result())
+        except BrokenProcessPool as err:
+            raise RuntimeError(
+                "a worker process of the local pool died, so the study stopped (finished runs are stored; "
+                "run again to resume). If it died at start-up: the pool starts fresh interpreters that "
+                "import your main script, so call run_study under `if __name__ == \"__main__\":` and not "
+                "from standard input; or use workers=1 or a Dask scheduler.") from err
         except BaseException:
             for f in futures:
                 f.cancel()

@@ -3,12 +3,13 @@ pymoo result run with ``save_history=True``."""
 
 from __future__ import annotations
 
+import re
 from typing import Sequence
 
 import numpy as np
 import pandas as pd
 
-from pymoo_rail.plotting.style import indicator_label, new_figure
+from pymoo_rail.plotting.style import indicator_label, new_figure, objective_label
 
 
 def _step_values(n_eval: np.ndarray, values: np.ndarray, grid: np.ndarray) -> np.ndarray:
@@ -82,12 +83,27 @@ def plot_convergence(results: pd.DataFrame, indicator: str = "igd", problems: Se
             ax.set_yscale("log")
         ax.set_title(problem)
         ax.set_xlabel("function evaluations")
-        ax.set_ylabel(ylabel or indicator_label(indicator))
+        ax.set_ylabel(ylabel or _panel_label(results, problem, indicator))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
     for k in range(n, nrows * ncols):
         axes[k // ncols, k % ncols].set_visible(False)
     return fig
+
+
+def _panel_label(results: pd.DataFrame, problem: str, indicator: str) -> str:
+    """``f0_min`` -> "best energy (kWh)" when the problem's spec names its objectives."""
+    match = re.fullmatch(r"f(\d+)_min", indicator)
+    if not match:
+        return indicator_label(indicator)
+    index = int(match.group(1))
+    names = None
+    if "problem_spec" in results.columns:
+        spec = results.loc[results["problem"] == problem, "problem_spec"].iloc[0]
+        names = spec.get("objectives") if isinstance(spec, dict) else None
+    if isinstance(names, list) and index < len(names):
+        return f"best {objective_label(names[index], index)}"
+    return f"best f{index + 1}"
 
 
 def history_curve(res, indicator: str = "igd", pf: np.ndarray | None = None) -> pd.DataFrame:
