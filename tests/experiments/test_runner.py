@@ -189,3 +189,11 @@ def test_results_follow_the_current_study(pool_study_dir):
                    budget=study.budget)
     assert load_results(pool_study_dir, study=edited).empty  # other parameters: not the same runs
     assert len(load_results(pool_study_dir, all_runs=True)) == 45
+
+
+@pytest.mark.slow
+def test_scheduler_local_starts_its_own_cluster(pool_study_dir, tmp_path):
+    pytest.importorskip("distributed")
+    report = run_study(small_study(), tmp_path, workers=2, scheduler="local", progress=False)
+    assert report.n_finished == 45
+    _fronts_equal(load_results(pool_study_dir), load_results(tmp_path))
