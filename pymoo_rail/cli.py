@@ -348,7 +348,7 @@ def cmd_optimize(args) -> int:
     try:
         algorithm = build_algorithm(AlgorithmSpec(args.algorithm, {"pop_size": args.pop_size}), problem)
     except StudyError as err:
-        raise UsageError("--algorithm", f"{args.algorithm!r} {err.reason}") from None
+        raise UsageError("--algorithm", f"{args.algorithm!r}: {err.reason}") from None
     except ValueError as err:
         raise UsageError("--pop-size", f"{args.pop_size} with {args.algorithm}: {err}") from None
 
