@@ -102,8 +102,9 @@ def build_parser() -> argparse.ArgumentParser:
             Optimise the recommended speed profile of one case and write into --out:
               front.csv        every front member: objectives, running time, energy, stop error,
                                constraint violation and decision vector
-              trajectory.csv   the chosen run (the front member closest to the planned time, or the
-                               best one for a single objective), one row per metre of track
+              trajectory.csv   the chosen run (the least energy within --time-tolerance, default 1 s,
+                               of the planned time; else the member closest to it; for a single
+                               objective the best one), one row per grid node
               front.png        the front in objective space, the chosen member circled
               profile.png      speed against distance over the line (limits, gradients, regimes)
               speed_time.png   speed against time with the planned time"""),
@@ -298,9 +299,13 @@ class _Progress:
 
 
 def choose_member(F: "np.ndarray", CV: "np.ndarray", running_time_s: "np.ndarray", energy_kwh: "np.ndarray",
-                  planned_time_s: float) -> int:
-    """Index of the front member to show: best for one objective, else closest to the planned
-    time (ties: least energy). Feasible members first."""
+                  planned_time_s: float, window_s: float = 1.0) -> int:
+    """Index of the front member to show.
+
+    One objective: the best. Several: the least energy among the members within ``window_s`` of
+    the planned time (what an operator would pick: punctual, then frugal); if none is that close,
+    the one closest to the planned time (ties: least energy). Feasible members first.
+    """
     import numpy as np
 
     candidates = np.flatnonzero(CV <= 0)
@@ -308,7 +313,11 @@ def choose_member(F: "np.ndarray", CV: "np.ndarray", running_time_s: "np.ndarray
         candidates = np.array([int(np.argmin(CV))])
     if F.shape[1] == 1:
         return int(candidates[np.argmin(F[candidates, 0])])
-    order = np.lexsort((energy_kwh[candidates], np.abs(running_time_s[candidates] - planned_time_s)))
+    error = np.abs(running_time_s[candidates] - planned_time_s)
+    punctual = candidates[error <= window_s]
+    if len(punctual):
+        return int(punctual[np.argmin(energy_kwh[punctual])])
+    order = np.lexsort((energy_kwh[candidates], error))
     return int(candidates[order[0]])
 
 
@@ -383,7 +392,8 @@ def cmd_optimize(args) -> int:
     front["cv"] = CV
     for j in range(X.shape[1]):
         front[f"x{j}_{unit}"] = X[:, j]
-    chosen = choose_member(F, CV, running, energy, case.planned_time_s)
+    chosen = choose_member(F, CV, running, energy, case.planned_time_s,
+                           args.time_tolerance if args.time_tolerance is not None else 1.0)
     front.insert(0, "chosen", np.arange(len(front)) == chosen)
     trajectory = trajectories[chosen]
 
