@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from pymoo.core.algorithm import Algorithm
 from pymoo.core.population import Population
+from pymoo.core.replacement import parameter_less
 from pymoo.core.sampling import Sampling
 from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.util.display.column import Column
@@ -62,6 +63,22 @@ def rank_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
     return fitness / fitness.sum()
 
 
+def inverse_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
+    """Onlooker probabilities of seed 000, eqs. 3-3 and 3-5 (Karaboga's fitness).
+
+    ``fit = 1 / (1 + f)`` for ``f >= 0`` and ``1 + |f|`` otherwise, ``P_i = fit_i / sum(fit)``.
+    Infeasible sources are first given pymoo's parameter-less value ``max(f) + CV``, so they
+    rank below every feasible one. Near ``f = 0`` all fitness values approach 1 and the
+    choice becomes uniform.
+    """
+    f = parameter_less(F, CV) if np.any(CV > 0) else F
+    fitness = np.where(f >= 0, 1.0 / (1.0 + np.abs(f)), 1.0 + np.abs(f))
+    return fitness / fitness.sum()
+
+
+ONLOOKER_FITNESS = {"rank": rank_probabilities, "inverse": inverse_probabilities}
+
+
 class ABC(Algorithm):
     """Artificial Bee Colony (Karaboga 2005; seed 000, sections 3.2-3.3).
 
@@ -76,6 +93,10 @@ class ABC(Algorithm):
     limit : int, optional
         A food source whose trial counter exceeds ``limit`` is abandoned and replaced by a
         random one (scout bee). Default ``SN * n_var``.
+    onlooker_fitness : {"rank", "inverse"}
+        Fitness behind the onlookers' roulette. ``"rank"`` (default): linear ranking, see
+        :func:`rank_probabilities`. ``"inverse"``: the seed's ``1 / (1 + f)`` (eq. 3-3), see
+        :func:`inverse_probabilities`; kept to reproduce the seed.
     sampling : pymoo Sampling
         Draws the initial colony and the scouts' new food sources.
     output : pymoo Output
@@ -97,7 +118,8 @@ class ABC(Algorithm):
       which saturates near 0. A candidate equal to its source is a failed trial.
     * Onlooker bees: ``SN`` onlookers pick food sources by roulette on linear-ranking
       fitness (see :func:`rank_probabilities`; works for negative ``F`` and with
-      constraints) and move like employed bees. Several onlookers on the same source are
+      constraints; ``onlooker_fitness="inverse"`` selects the seed's eq. 3-3) and move
+      like employed bees. Several onlookers on the same source are
       applied one after another in draw order.
     * Scout bees: every source whose trial counter exceeds ``limit`` is replaced by a
       random point (seed 000 step 7-8 abandons each such source, not only the worst).
@@ -112,6 +134,7 @@ class ABC(Algorithm):
         self,
         pop_size: int = 40,
         limit: int | None = None,
+        onlooker_fitness: str = "rank",
         sampling: Sampling = FloatRandomSampling(),
         output=ABCOutput(),
         **kwargs,
@@ -120,6 +143,12 @@ class ABC(Algorithm):
         self.n_sources = check_colony_size(pop_size, minimum=4)
         self.pop_size = int(pop_size)
         self.limit = check_limit(limit)
+        if onlooker_fitness not in ONLOOKER_FITNESS:
+            raise ValueError(
+                f"onlooker_fitness must be one of {tuple(ONLOOKER_FITNESS)}, "
+                f"got {onlooker_fitness!r}"
+            )
+        self.onlooker_fitness = onlooker_fitness
         self.sampling = sampling
 
         self.trials: np.ndarray | None = None
@@ -160,7 +189,7 @@ class ABC(Algorithm):
             self._parents = np.arange(self.n_sources)
         else:
             F, CV = self.pop.get("F")[:, 0], self.pop.get("CV")[:, 0]
-            P = rank_probabilities(F, CV)
+            P = ONLOOKER_FITNESS[self.onlooker_fitness](F, CV)
             self._parents = roulette(P, self.n_sources, self.random_state)
 
         X = self.pop.get("X")

@@ -61,10 +61,26 @@ def test_sphere_10d_reaches_1e_12_within_500_cycles(seed):
     assert res.F[0] < 1e-12
 
 
-def test_negative_objective_values_work():
+@pytest.mark.parametrize("fitness", ["rank", "inverse"])
+def test_negative_objective_values_work(fitness):
     # the onlooker fitness must not assume f >= 0 (seed eq. 3-3 needs a special case)
-    res = minimize(Sphere(5, shift=-100.0), ABC(pop_size=20), ("n_gen", 300), seed=1)
+    algorithm = ABC(pop_size=20, onlooker_fitness=fitness)
+    res = minimize(Sphere(5, shift=-100.0), algorithm, ("n_gen", 300), seed=1)
     assert res.F[0] == pytest.approx(-100.0, abs=1e-8)
+
+
+def test_onlooker_probabilities():
+    from pymoo_rail.algorithms.abc import inverse_probabilities, rank_probabilities
+
+    F, CV = np.array([3.0, 0.0, 1.0]), np.zeros(3)
+    # linear ranking: best gets 3, then 2, then 1, out of 6
+    np.testing.assert_allclose(rank_probabilities(F, CV), [1 / 6, 3 / 6, 2 / 6])
+    # eq. 3-3: 1/4, 1, 1/2 out of 7/4
+    np.testing.assert_allclose(inverse_probabilities(F, CV), [1 / 7, 4 / 7, 2 / 7])
+    # an infeasible source ranks last whatever its objective
+    CV = np.array([0.0, 2.0, 0.0])
+    assert np.argmin(rank_probabilities(F, CV)) == 1
+    assert np.argmin(inverse_probabilities(F, CV)) == 1
 
 
 def test_minimize_loop_and_ask_tell_are_identical():
@@ -189,6 +205,11 @@ def test_bad_pop_size_raises(pop_size):
 def test_bad_limit_raises(limit):
     with pytest.raises(ValueError, match="limit"):
         ABC(pop_size=10, limit=limit)
+
+
+def test_bad_onlooker_fitness_raises():
+    with pytest.raises(ValueError, match="onlooker_fitness.*'roulette'"):
+        ABC(pop_size=10, onlooker_fitness="roulette")
 
 
 def test_multi_objective_problem_rejected():
