@@ -35,6 +35,7 @@ from pymoo_rail.sim.kernel import (
     clamp_to_envelope,
     complete_cell,
     new_totals,
+    record_cell,
     run_program,
     write_summary,
 )
@@ -268,7 +269,9 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             u_cmd = -1.0 if f < 0.0 else 0.0
 
         # 3. the rest of the cell exactly as the simulator does it
-        v, stopped, x1 = complete_cell(m, totals, i, v, u1, f, w0, regime, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r)
+        v, stopped, x1, a_cell, totals = complete_cell(m, totals, i, v, u1, f, w0, regime)
+        if record:
+            record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[TOTAL_TIME], a_cell, f, regime)
         t = totals[TOTAL_TIME]
         if record:
             tr_u[i] = u_cmd

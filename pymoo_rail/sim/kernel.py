@@ -69,7 +69,7 @@ _KIND_TRACTION, _KIND_COAST, _KIND_BRAKE = 0, 1, 2
 _J_PER_KWH = 3.6e6
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _full_step(m, v0, cell, kind):
     """Two-stage step over one cell at maximum traction, coasting or maximum braking.
 
@@ -94,7 +94,7 @@ def _full_step(m, v0, cell, kind):
     return u1, f, w0, v_half
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _share_above(v0, v1, v_cut):
     """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
     lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
@@ -105,7 +105,7 @@ def _share_above(v0, v1, v_cut):
     return (hi * hi - v_cut * v_cut) / (hi * hi - lo * lo)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _landing_force(m, v0, v1, cell):
     """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
 
@@ -135,14 +135,14 @@ TOTAL_TIME = _T_TIME  # the clock, for kernels that drive the train themselves (
 
 @njit(cache=True)
 def new_totals():
-    """Running totals of a run: time, works, comfort and limit figures."""
-    totals = np.zeros(N_TOTALS)
-    totals[_T_PREV_REGIME] = -1.0
-    totals[_T_EXCESS] = -1e300
-    return totals
+    """Running totals of a run (time, works, comfort and limit figures) as a tuple.
+
+    A tuple, not an array: the kernels rebind it every cell and Numba keeps it in registers.
+    """
+    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     """Keep a step under the braking envelope and name its regime by the force applied.
 
@@ -168,11 +168,12 @@ def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     return u1, f, w0, regime, clamped
 
 
-@njit(cache=True)
-def complete_cell(m, totals, cell, v, u1, f, w0, regime, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
-    """Finish one cell: standstill inside it, time, energy accounting, comfort, trace.
+@njit(cache=True, inline="always")
+def complete_cell(m, totals, cell, v, u1, f, w0, regime):
+    """Finish one cell: standstill inside it, time, energy accounting, comfort.
 
-    Returns (v1, stopped, position reached).
+    Returns (v1, stopped, position reached, acceleration, updated totals). No arrays beyond the
+    model go in: array arguments of a per-cell function cost reference counting every cell.
     """
     n = m.position_m.shape[0]
     dx = m.dx_m
@@ -187,37 +188,43 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime, record, tr_x, tr_v, tr_
     if u1 < 0.0:
         u1 = 0.0
     v1 = math.sqrt(u1)
-    totals[_T_TIME] += 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
+    (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
+     jerk, prev_acc, max_acc, prev_regime, changes, excess) = totals
+    time_s += 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
     brake_n = -f if f < 0.0 else 0.0
     if f > 0.0:
-        totals[_T_TRAC] += f * d
+        w_trac += f * d
         if m.neutral[cell] != 0:
-            totals[_T_NEUTRAL] += f * d
-    totals[_T_BRAKE] += brake_n * d
+            w_neutral += f * d
+    w_brake += brake_n * d
     if brake_n > 0.0:
         share = _share_above(v, v1, m.regen_min_speed_ms)
-        totals[_T_ELEC] += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
-    totals[_T_DAVIS] += w0 * d
-    totals[_T_LINE] += m.line_force_n[cell] * d
-    totals[_T_GRADE] += m.grade_force_n[cell] * d
-    totals[_T_JERK] += abs(a_cell - totals[_T_PREV_ACC])
-    totals[_T_PREV_ACC] = a_cell
-    if abs(a_cell) > totals[_T_MAX_ACC]:
-        totals[_T_MAX_ACC] = abs(a_cell)
-    if totals[_T_PREV_REGIME] >= 0.0 and regime != totals[_T_PREV_REGIME]:
-        totals[_T_CHANGES] += 1.0
-    totals[_T_PREV_REGIME] = regime
-    if v1 - m.limit_ms[cell + 1] > totals[_T_EXCESS]:
-        totals[_T_EXCESS] = v1 - m.limit_ms[cell + 1]
+        w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
+    w_davis += w0 * d
+    w_line += m.line_force_n[cell] * d
+    w_grade += m.grade_force_n[cell] * d
+    jerk += abs(a_cell - prev_acc)
+    if abs(a_cell) > max_acc:
+        max_acc = abs(a_cell)
+    if prev_regime >= 0.0 and regime != prev_regime:
+        changes += 1.0
+    if v1 - m.limit_ms[cell + 1] > excess:
+        excess = v1 - m.limit_ms[cell + 1]
     x1 = m.position_m[cell] + d
-    if record:
-        tr_x[cell + 1] = x1
-        tr_v[cell + 1] = v1
-        tr_t[cell + 1] = totals[_T_TIME]
-        tr_a[cell] = a_cell
-        tr_f[cell] = f
-        tr_r[cell] = regime
-    return v1, stopped, x1
+    totals = (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
+              jerk, a_cell, max_acc, float(regime), changes, excess)
+    return v1, stopped, x1, a_cell, totals
+
+
+@njit(cache=True)
+def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime):
+    """Write one cell into the trace arrays."""
+    tr_x[cell + 1] = x1
+    tr_v[cell + 1] = v1
+    tr_t[cell + 1] = t
+    tr_a[cell] = a_cell
+    tr_f[cell] = f
+    tr_r[cell] = regime
 
 
 @njit(cache=True)
@@ -252,7 +259,9 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
     out[OUT_NEUTRAL_TRACTION_J] = totals[_T_NEUTRAL]
 
 
-@njit(cache=True)
+# No reference counting inside: the run allocates nothing, and NRT incref/decref pairs on the
+# model's arrays in every inlined helper call were half the cost of a cell (benchmarks/simulator.py).
+@njit(cache=True, _nrt=False)
 def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     """Simulate one run; write the summary into ``out`` and, if ``record``, the trace arrays.
 
@@ -314,7 +323,9 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
             regime = REGIME_COAST
 
         u1, f, w0, regime, _ = clamp_to_envelope(m, v, i, u1, f, w0, regime)
-        v, stopped, x1 = complete_cell(m, totals, i, v, u1, f, w0, regime, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r)
+        v, stopped, x1, a_cell, totals = complete_cell(m, totals, i, v, u1, f, w0, regime)
+        if record:
+            record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[_T_TIME], a_cell, f, regime)
         count = i + 2
         if stopped:
             reached = False
