@@ -28,15 +28,21 @@ from pymoo_rail.sim.kernel import (
     _KIND_BRAKE,
     _KIND_COAST,
     _KIND_TRACTION,
+    _T_ELEC,
+    _T_TIME,
+    _T_TRAC,
     MODE_BRAKE,
     MODE_COAST,
     MODE_HOLD,
     MODE_TOWARD,
     MODE_TRACTION,
+    REGIME_COAST,
     _full_step,
     _landing_force,
+    clamp_to_envelope,
+    complete_cell,
+    new_totals,
 )
-from pymoo_rail.sim.physics import electric_braking
 
 INF = math.inf
 # Cost-to-go stored for a node from which the platform cannot be reached (e.g. too slow to clear a
@@ -76,8 +82,10 @@ def node_position(top_u, u, k_max, bias):
 
 @njit(cache=True)
 def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w):
-    """Steps 1-2 of the simulator's ``run_program`` for one cell, one row per cell.
+    """What the simulator's ``run_program`` does in one cell for a program row of its own.
 
+    The mode logic of ``run_program`` (a hold row holds the speed on entering it; ``toward`` pulls
+    or coasts to its target and lands on it), then the simulator's ``clamp_to_envelope``.
     ``tr_*``, ``co_*``, ``br_*`` are the cell's full traction, coast and brake steps from ``v0``
     (``_full_step``), computed once and shared by every control. Returns ``(u1, force_n, w0_n)``.
     """
@@ -104,34 +112,23 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
         u1, f, w0 = br_u, br_f, br_w
     else:
         u1, f, w0 = co_u, co_f, co_w
-    cap = m.envelope_ms[cell + 1]
-    if u1 > cap * cap:
-        fl, w0l, ok = _landing_force(m, v0, cap, cell)
-        if ok:
-            u1, f, w0 = cap * cap, fl, w0l
-        else:
-            u1, f, w0 = br_u, br_f, br_w
+    u1, f, w0, _, _ = clamp_to_envelope(m, v0, cell, u1, f, w0, REGIME_COAST)
     return u1, f, w0
 
 
 @njit(cache=True)
-def cell_cost(m, v0, u1, f, cell, time_price_w):
+def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     """Net energy of the cell plus ``time_price_w`` x its time (J), and its time (s).
 
-    Infinite when the train stops inside the cell before the platform (the simulator ends the run
-    there).
+    The simulator's own accounting (``complete_cell``): traction work / eta_traction minus
+    eta_regen x the electric braking work above the regen cut-off. Infinite when the train stops
+    inside the cell before the platform (the simulator ends the run there).
     """
-    n = m.position_m.shape[0]
-    if u1 < 0.0 or (u1 == 0.0 and cell < n - 2):
+    v1, stopped, _, _, totals = complete_cell(m, new_totals(), cell, v0, u1, f, w0, REGIME_COAST)
+    if stopped or v0 + v1 <= 0.0:  # (at rest in the last cell: it never arrives)
         return INF, INF
-    v1 = math.sqrt(u1)
-    if v0 + v1 <= 0.0:  # at rest in the last cell: it never arrives
-        return INF, INF
-    dt = 2.0 * m.dx_m / (v0 + v1)
-    if f > 0.0:
-        e = f * m.dx_m / m.traction_efficiency
-    else:
-        e = -m.regen_efficiency * electric_braking(m, 0.5 * (v0 + v1), -f) * m.dx_m
+    dt = totals[_T_TIME]
+    e = totals[_T_TRAC] / m.traction_efficiency - m.regen_efficiency * totals[_T_ELEC]
     return e + time_price_w * dt, dt
 
 
@@ -219,7 +216,7 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
     for c in range(n_fixed):
         mode = _fixed_mode(c)
         u1, f, w0 = cell_outcome(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        cost, _ = cell_cost(m, v0, u1, f, cell, time_price_w)
+        cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
         if cost < INF:
             cost += interp_value(v_next, top_u, u1, bias)
         if cost < best:
@@ -234,7 +231,7 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
             target = math.sqrt(node_u(top_u, k, k_max, bias))
             u1, f, w0 = cell_outcome(m, v0, cell, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                      br_u, br_f, br_w)
-            cost, _ = cell_cost(m, v0, u1, f, cell, time_price_w)
+            cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
             if cost < INF:
                 cost += interp_value(v_next, top_u, u1, bias)
             if cost < best:
@@ -278,7 +275,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
             for c in range(N_FIXED):
                 u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
-                e, dt = cell_cost(m, v0, u1, f, i, aux)
+                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
                 fixed_u1[i, j, c] = u1
                 fixed_e[i, j, c] = e
                 fixed_dt[i, j, c] = dt
@@ -292,7 +289,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
                 target = math.sqrt(node_u(top1, k, k_max, bias))
                 u1, f, w0 = cell_outcome(m, v0, i, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
-                e, dt = cell_cost(m, v0, u1, f, i, aux)
+                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
                 tgt_u1[p] = u1
                 tgt_e[p] = e
                 tgt_dt[p] = dt
@@ -380,13 +377,13 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
             keep = MODE_HOLD if previous == MODE_TOWARD else previous
             if keep != mode:
                 u1, f, w0 = cell_outcome(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-                c_keep, _ = cell_cost(m, v, u1, f, i, time_price_w)
+                c_keep, _ = cell_cost(m, v, u1, f, w0, i, time_price_w)
                 if c_keep < INF:
                     c_keep += interp_value(value[i + 1], m.envelope_ms[i + 1] ** 2, u1, bias)
                     if c_keep <= cost + tie_j:
                         mode, target = keep, 0.0
         u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        c_energy, dt = cell_cost(m, v, u1, f, i, m.aux_power_w)
+        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
         energy += c_energy
         time += dt
         modes[i] = mode

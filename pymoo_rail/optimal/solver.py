@@ -282,9 +282,12 @@ class OptimalSolver:
         tr = self.simulator.run(solution.program)
         speeds = tr.speed_ms if solution.speeds is None else solution.speeds
         mismatch = float(np.max(np.abs(tr.speed_ms - speeds[: tr.speed_ms.shape[0]])))
-        if not tr.reached or tr.speed_ms.shape[0] != speeds.shape[0] or mismatch > 1e-9:
+        energy_j = tr.energy.net_kwh * _J_PER_KWH
+        if (not tr.reached or tr.speed_ms.shape[0] != speeds.shape[0] or mismatch > 1e-9
+                or abs(energy_j - solution.energy_j) > 1e-9 * max(abs(energy_j), 1.0)):
             raise RuntimeError(f"the simulator's replay of the optimal controls departs from the solver's run "
-                               f"(max speed difference {mismatch:.3g} m/s): solver and simulator disagree")
+                               f"(max speed difference {mismatch:.3g} m/s, energy {tr.energy.net_kwh:.6f} against "
+                               f"{solution.energy_j / _J_PER_KWH:.6f} kWh): solver and simulator disagree")
         summary = dict(tr.summary, lambda_w=solution.lambda_w, dp_value_j=solution.value_j,
                        n_speeds=float(self.n_speeds), dx_m=float(self.dx_m),
                        adjusted=float(solution.speeds is None))
