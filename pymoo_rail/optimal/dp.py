@@ -1,9 +1,9 @@
 """Numba kernels of the exact solver: dynamic programming over (position, kinetic energy).
 
 The state at grid node ``i`` is the speed; the cost-to-go ``V_i`` is stored on ``n_speeds``
-nodes equally spaced in ``u = v^2`` between 0 and the braking envelope ``env_i^2`` (the highest
-speed from which every limit ahead and the platform can still be met), and interpolated linearly
-in ``u`` between them. Interpolating, rather than snapping transitions to the nearest node, is what
+nodes in ``u = v^2`` between 0 and the braking envelope ``env_i^2`` (the highest speed from which
+every limit ahead and the platform can still be met; the nodes are packed towards it by
+``bias``, see :func:`node_u`), and interpolated linearly in ``u`` between them. Interpolating, rather than snapping transitions to the nearest node, is what
 lets the solver represent coasting and gentle partial traction, whose changes of speed over one
 cell are far smaller than the node spacing (DESIGN.md section 8). Interpolating in ``u`` rather
 than ``v`` makes the kinetic-energy part of the cost-to-go, which is linear in ``u``, exact.
@@ -12,9 +12,10 @@ Controls of one cell are exactly the simulator's driving modes (``pymoo_rail.sim
 maximum traction, coasting, maximum braking, holding the entry speed, and ``toward`` a target
 speed, which lands exactly on a speed node of the next position by partial traction (or partial
 braking). Each transition is computed by the simulator's own step functions, including its
-braking-envelope override, so a control sequence chosen here replays bit for bit in the
-simulator. The cost of a cell is ``traction work / eta_traction - eta_regen * electric braking work
-+ (P_aux + lambda) * dt``, exactly the simulator's net-energy accounting plus ``lambda`` times time.
+braking-envelope override (``clamp_to_envelope``), so a control sequence chosen here replays bit
+for bit in the simulator. The cost of a cell is the simulator's own accounting
+(``complete_cell``): ``traction work / eta_traction - eta_regen * electric braking work +
+(P_aux + lambda) * dt``, the net energy plus ``lambda`` times time.
 """
 
 from __future__ import annotations
