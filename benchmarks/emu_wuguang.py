@@ -69,7 +69,8 @@ ENCODINGS = {  # label -> SpeedProfileProblem keyword arguments
     "speed codes <= 1000 m": {"encoding": "speed_codes", "max_section_m": 1000.0},
     "switching points": {"encoding": "switching_points"},
 }
-MAIN_ENCODING = "speed codes"
+MAIN_ENCODING = "speed codes"  # figs. 10-12 are drawn on it
+MAIN_ENCODINGS = ("speed codes", "switching points")
 STOP_TOLERANCE_M = 0.25
 SPEED_TOLERANCE_MS = 1e-6
 
@@ -309,54 +310,74 @@ def median_run(rows, problem: str, algorithm: str, indicator: str = "hv_ref") ->
     return runs[(len(runs) - 1) // 2]
 
 
-def make_figures(results, rows, problem, out: Path, prefix: str) -> dict:
+def stored_run(results, problem: str, algorithm: str, seed: int):
+    return results[(results["problem"] == problem) & (results["algorithm"] == algorithm)
+                   & (results["seed"] == seed)].iloc[0]
+
+
+def punctual_choices(results, rows, problems_by_label: dict) -> dict:
+    """Per (encoding, algorithm): the most punctual member of the median-HV run, re-simulated."""
+    chosen = {}
+    for enc in sorted({r["problem"] for r in rows}):
+        problem = problems_by_label[enc]
+        for alg in (NSGA2_LABEL, GR_LABEL):
+            med = median_run(rows, enc, alg)
+            run = stored_run(results, enc, alg, med["seed"])
+            feasible = run["CV"] <= 0
+            F, X = run["F"][feasible], run["X"][feasible]
+            k = most_punctual(F, problem.case.planned_time_s)
+            chosen[enc, alg] = {"seed": med["seed"], "x": X[k], "F": F[k], "front": F,
+                                "trajectory": problem.trajectory(X[k])}
+    return chosen
+
+
+def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path, prefix: str) -> dict:
     import matplotlib.pyplot as plt
 
     from pymoo_rail.experiments import stats
     from pymoo_rail.plotting import plot_boxplots, plot_fronts, plot_speed_profile, save_figure
 
     label = MAIN_ENCODING
-    ref = stats.reference_fronts(results)[label]
+    problem = problems_by_label[label]
+    refs = stats.reference_fronts(results)
     planned = problem.case.planned_time_s
-    chosen, paths = {}, {}
+    paths = {}
     fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.8), layout="constrained", sharex=True, sharey=True)
     for ax, alg, number in zip(axes, (NSGA2_LABEL, GR_LABEL), (10, 11)):
-        med = median_run(rows, label, alg)
-        run = results[(results["problem"] == label) & (results["algorithm"] == alg)
-                      & (results["seed"] == med["seed"])].iloc[0]
-        feasible = run["CV"] <= 0
-        F, X = run["F"][feasible], run["X"][feasible]
-        k = most_punctual(F, planned)
-        chosen[alg] = {"seed": med["seed"], "x": X[k], "F": F[k]}
-        plot_fronts({f"{alg}, seed {med['seed']} (median HV)": F}, OBJECTIVES, reference=ref,
-                    reference_label="union of all runs' fronts", highlight=F[k],
-                    highlight_label=f"most punctual: {F[k, 0]:.1f} kWh, {F[k, 1]:.1f} s",
-                    title=f"fig. {number}: {alg} front ({len(F)} points)", ax=ax)
+        c = chosen[label, alg]
+        F = c["front"]
+        plot_fronts({f"{alg}, seed {c['seed']} (median HV)": F}, OBJECTIVES, reference=refs[label],
+                    reference_label="union of all runs' fronts", highlight=c["F"],
+                    highlight_label=f"most punctual: {c['F'][0]:.1f} kWh, {c['F'][1]:.1f} s",
+                    title=f"fig. {number}: {alg} front, {label} ({len(F)} points)", ax=ax)
         ax.axhline(planned, color="0.5", lw=0.8, ls=":")
     paths["fronts"] = save_figure(fig, out / f"{prefix}_fronts.png")
 
-    both = {}
-    for alg in (NSGA2_LABEL, GR_LABEL):
-        med = median_run(rows, label, alg)
-        run = results[(results["problem"] == label) & (results["algorithm"] == alg)
-                      & (results["seed"] == med["seed"])].iloc[0]
-        both[f"{alg} (seed {med['seed']})"] = run["F"][run["CV"] <= 0]
-    fig = plot_fronts(both, OBJECTIVES, reference=ref, reference_label="union of all runs' fronts",
-                      title="median runs of both algorithms")
+    fronts = {f"{alg}, {enc} (seed {c['seed']})": c["front"] for (enc, alg), c in chosen.items()}
+    fig = plot_fronts(fronts, OBJECTIVES, title="median-HV run of each algorithm and encoding")
     fig.axes[0].axhline(planned, color="0.5", lw=0.8, ls=":")
     paths["fronts_overlay"] = save_figure(fig, out / f"{prefix}_fronts_overlay.png")
 
-    gr_traj = problem.trajectory(chosen[GR_LABEL]["x"])
-    ns_traj = problem.trajectory(chosen[NSGA2_LABEL]["x"])
+    # the seed's fig. 12 only covers the neighbourhood of the planned time: zoom there too
+    fig = plot_fronts(fronts, OBJECTIVES, title="near the planned time (1050 s)")
+    ax = fig.axes[0]
+    near = np.vstack([F[np.abs(F[:, 1] - planned) <= 15] for F in fronts.values()])
+    if len(near):
+        ax.set_xlim(near[:, 0].min() - 2, near[:, 0].max() + 2)
+        ax.set_ylim(planned - 15, planned + 15)
+    ax.axhline(planned, color="0.5", lw=0.8, ls=":")
+    paths["fronts_zoom"] = save_figure(fig, out / f"{prefix}_fronts_zoom.png")
+
+    gr_traj = chosen[label, GR_LABEL]["trajectory"]
+    ns_traj = chosen[label, NSGA2_LABEL]["trajectory"]
     fig = plot_speed_profile(gr_traj, problem.case, label=f"fig. 12: {GR_LABEL} most punctual", others=[ns_traj],
                              other_labels=[f"{NSGA2_LABEL} most punctual ({ns_traj.running_time_s:.1f} s, "
                                            f"{ns_traj.energy.net_kwh:.1f} kWh)"])
     paths["profile"] = save_figure(fig, out / f"{prefix}_profile.png")
 
-    sub = results[results["problem"] == label]
-    fig = plot_boxplots(sub, "hv_ref")
+    fig = plot_boxplots(results, "hv_ref")
     paths["box_hv"] = save_figure(fig, out / f"{prefix}_box_hv.png")
-    return {"chosen": chosen, "paths": paths, "trajectories": {GR_LABEL: gr_traj, NSGA2_LABEL: ns_traj}}
+    return paths
 
 
 # ------------------------------------------------------------------------------ report
@@ -371,24 +392,63 @@ def encoding_section(rows, n_var: dict, n_fixed: dict) -> list[str]:
             if not rs:
                 continue
             enc_rows.append([enc, n_var[enc], n_fixed[enc], alg, len(rs), mean_std(r.get("hv_ref", np.nan) for r in rs),
-                             mean_std(r.get("e_at_plan", np.nan) for r in rs), mean_std(r.get("e_min", np.nan) for r in rs),
-                             mean_std(r.get("t_min", np.nan) for r in rs), mean_std(r.get("wall_time_s", np.nan) for r in rs)])
+                             mean_std(r.get("e_at_plan", np.nan) for r in rs),
+                             mean_std(r.get("e_min", np.nan) for r in rs), mean_std(r.get("t_min", np.nan) for r in rs),
+                             mean_std(r.get("wall_time_s", np.nan) for r in rs)])
+    if not enc_rows:
+        return out + ["(encoding study not run)"]
     out.append(md_table(["encoding", "n_var", "fixed genes", "algorithm", "runs",
                          "hv (union of this study)", "least E with T <= 1050 s (kWh)", "E min (kWh)",
                          "T min (s)", "wall s"], enc_rows))
     return out
 
 
+TABLE4 = [("points in the front", "n_points"), ("SP (Schott, kWh and s)", "spacing"),
+          ("GD (eq. 13) to the union front", "gd_seed"), ("IGD to the union front", "igd_ref"),
+          ("HV (normalised)", "hv_ref"), ("max running time (s)", "t_max"), ("min running time (s)", "t_min"),
+          ("max energy (kWh)", "e_max"), ("min energy (kWh)", "e_min"),
+          ("least energy with T <= 1050 s (kWh)", "e_at_plan"), ("evaluations", "n_eval"),
+          ("generations", "n_gen"), ("wall time (s)", "wall_time_s")]
+SEED_KEYS = {"spacing": "sp", "gd_seed": "gd", "t_max": "t_max", "t_min": "t_min", "e_max": "e_max", "e_min": "e_min"}
+TESTED = (("hv_ref", False), ("igd_ref", True), ("gd_ref", True), ("gd_seed", True), ("spacing", True),
+          ("e_at_plan", True), ("punctual_e", True), ("e_min", True))
+
+
+def table4(rows, enc: str) -> str:
+    main = [r for r in rows if r["problem"] == enc]
+    t4 = []
+    for name, key in TABLE4:
+        a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
+        b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
+        sk = SEED_KEYS.get(key)
+        t4.append([name, mean_std(a), mean_std(b), fmt(SEED_TABLE4[NSGA2_LABEL][sk]) if sk else "",
+                   fmt(SEED_TABLE4[GR_LABEL][sk]) if sk else ""])
+    return md_table(["statistic", NSGA2_LABEL, GR_LABEL, f"seed {NSGA2_LABEL}", f"seed {GR_LABEL}"], t4)
+
+
+def tests_table(rows, enc: str) -> str:
+    main = [r for r in rows if r["problem"] == enc]
+    st = []
+    for key, lower in TESTED:
+        a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
+        b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
+        p, verdict, rel = rank_sum(rows, enc, key, lower)
+        st.append([key, "lower" if lower else "higher", mean_std(a), mean_std(b),
+                   f"{100 * rel:+.3f} %" if np.isfinite(rel) else "", fmt(p, 3), verdict])
+    return md_table(["indicator", "better", NSGA2_LABEL, GR_LABEL, "GR vs NSGA-II (means)", "p", "verdict"], st)
+
+
 def write_report(path: Path, ctx: dict) -> None:
     rows, enc_rows = ctx["rows"], ctx["enc_rows"]
     label = MAIN_ENCODING
-    main = [r for r in rows if r["problem"] == label]
-    case, problem = ctx["case"], ctx["problem"]
+    encodings = [e for e in ENCODINGS if any(r["problem"] == e for r in rows)]
+    case, problem = ctx["case"], ctx["problems"][label]
+    paths = ctx["paths"]
     lines = [
         "# CRH3 EMU on the Wuhan-Guangzhou line: golden-ratio NSGA-II vs NSGA-II (seed 003, 4.2)",
         "",
         f"Generated by `benchmarks/emu_wuguang.py` on {time.strftime('%Y-%m-%d')}; one row per run in "
-        f"`{ctx['csv_name']}`. Discussion written by hand: see the end of this page.",
+        f"`{ctx['csv_name']}`.",
         "",
         "## Set-up",
         "",
@@ -398,19 +458,23 @@ def write_report(path: Path, ctx: dict) -> None:
         + ". Gradients and curves reconstructed, 8800 kW power cap assumed (see `docs/cases.md`). "
         f"Shortest possible run {problem.min_running_time_s:.1f} s.",
         f"- Problem: `SpeedProfileProblem(case, objectives=(\"energy\", \"running_time\"), "
-        f"time_tolerance_s={case.time_margin_s:g})`: minimise net energy (kWh) and running time (s) subject "
+        f"time_tolerance_s={case.time_margin_s:g}, ...)`: minimise net energy (kWh) and running time (s) subject "
         f"to |T - {case.planned_time_s:g}| <= {case.time_margin_s:g} s (seed 003 4.2: planned 1050 s, 60 s margin; "
         "its fronts span 1008-1105 s), stop within 0.25 m, never above a limit. The seed's second objective "
         "f_T = T - T_0 (eq. 6) differs from T by a constant.",
-        f"- Encoding of the main study: **{label}**, {problem.n_var} variables (one target speed per section "
-        f"between gradient, limit and neutral-section break points), {int(problem.encoding.fixed().sum())} "
-        "fixed (the two sections inside the neutral sections, coasted, seed 003 3.2.1). Why: section 1.",
+        f"- Encodings of the main study: **{label}** ({problem.n_var} variables: one target speed per section "
+        f"between gradient, limit and neutral-section break points, {int(problem.encoding.fixed().sum())} "
+        "of them fixed: the two sections inside the neutral sections, coasted, seed 003 3.2.1), used for "
+        "figs. 10-12; and "
+        + ", ".join(f"**{e}** ({ctx['n_var'][e]} variables, {ctx['n_fixed'][e]} fixed)" for e in encodings
+                    if e != label)
+        + " as a check. Why: section 1.",
         f"- Budget: {ctx['budget']:,} evaluations per run for both algorithms (`(\"n_eval\", {ctx['budget']})`"
         + ("; the seed's 200 x 300 generations" if ctx["budget"] == BUDGET and ctx["pop_size"] == POP_SIZE
            else f"; the seed's is {BUDGET:,} with population {POP_SIZE}")
         + f"); population {ctx['pop_size']}; seeds "
-        f"{', '.join(str(s) for s in ctx['seeds'])} ({len(ctx['seeds'])} runs per algorithm, the same seeds "
-        "for both). Mean evaluations actually used are in table 4 (pymoo stops after the generation "
+        f"{', '.join(str(s) for s in ctx['seeds'])} ({len(ctx['seeds'])} runs per algorithm and encoding, the "
+        "same seeds for both). Evaluations actually used are in table 4 (pymoo stops after the generation "
         "that reaches the budget).",
         f"- `{NSGA2_LABEL}`: pymoo NSGA2, SBX (prob 0.9, eta 15), polynomial mutation (eta 20, per-variable "
         "probability 0.01), the seed's settings.",
@@ -418,83 +482,63 @@ def write_report(path: Path, ctx: dict) -> None:
         "pc_max=0.9, pm_max=0.1)`, same operators, neutral-section genes fixed "
         "(`fixed_genes = problem.encoding.fixed()`, passed by the study runner).",
         f"- Runs: `pymoo_rail.experiments.run_study`, {ctx['workers']} worker processes under `nice -n 10` on "
-        "the shared 2-core machine; wall times are those of a loaded machine.",
-        "- Indicators against the non-dominated union of every final front of both algorithms (the exact "
-        "optimal front is not available: `pymoo_rail.optimal` has no `optimal_front` yet): `hv_ref` "
+        "the shared 2-core machine (load average 8-10); wall times are those of a loaded machine.",
+        "- Indicators against the non-dominated union of every final front of both algorithms on that encoding "
+        "(the exact optimal front is not available: `pymoo_rail.optimal` has no `optimal_front` yet): `hv_ref` "
         "hypervolume normalised to the union's ideal and nadir (reference point 1.1), `igd_ref` and `gd_ref` "
         "(pymoo, mean distance, raw units kWh and s), `gd_seed` the seed's eq. 13 (sqrt(sum d^2) / n), "
-        "`spacing` Schott's SP (eqs. 11-12). Test: two-sided Wilcoxon rank-sum "
-        "(`pymoo_rail.experiments.stats.rank_sum`), `+` GR-NSGA-II significantly better at alpha = 0.05, "
-        "`-` worse, `=` no significant difference.",
+        "`spacing` Schott's SP (eqs. 11-12, raw units), `e_at_plan` the least energy of a member with "
+        "T <= 1050 s, `punctual_e` the energy of the member closest to 1050 s. Test: two-sided Wilcoxon "
+        "rank-sum (`pymoo_rail.experiments.stats.rank_sum`): `+` GR-NSGA-II significantly better at "
+        "alpha = 0.05, `-` worse, `=` no significant difference.",
         "",
     ]
     lines += encoding_section(enc_rows, ctx["n_var"], ctx["n_fixed"])
-    lines += ["", ctx.get("encoding_note", ""), ""]
+    lines += ["", ctx.get("encoding_note", "").strip(), ""]
 
-    # table 4
     lines += ["## 2. Fronts (figs. 10-11) and table 4", "",
-              f"![fronts]({ctx['figs']['paths']['fronts'].name})", "",
-              f"![fronts overlaid]({ctx['figs']['paths']['fronts_overlay'].name})", "",
-              "Table 4 (ours): mean +- std over the runs; the seed's values in the last columns (its line "
-              "profile differs: only magnitudes compare).", ""]
-    t4 = []
-    specs = [("points in the front", "n_points"), ("SP (Schott, kWh and s)", "spacing"),
-             ("GD (eq. 13) to the union front", "gd_seed"), ("IGD to the union front", "igd_ref"),
-             ("HV (normalised)", "hv_ref"), ("max running time (s)", "t_max"), ("min running time (s)", "t_min"),
-             ("max energy (kWh)", "e_max"), ("min energy (kWh)", "e_min"),
-             ("least energy with T <= 1050 s (kWh)", "e_at_plan"), ("evaluations", "n_eval"),
-             ("generations", "n_gen"), ("wall time (s)", "wall_time_s")]
-    seed_keys = {"spacing": "sp", "gd_seed": "gd", "t_max": "t_max", "t_min": "t_min", "e_max": "e_max",
-                 "e_min": "e_min"}
-    for name, key in specs:
-        a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
-        b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
-        sk = seed_keys.get(key)
-        t4.append([name, mean_std(a), mean_std(b), fmt(SEED_TABLE4[NSGA2_LABEL][sk]) if sk else "",
-                   fmt(SEED_TABLE4[GR_LABEL][sk]) if sk else ""])
-    lines += [md_table(["statistic", NSGA2_LABEL, GR_LABEL, f"seed {NSGA2_LABEL}", f"seed {GR_LABEL}"], t4), ""]
+              f"![fronts]({paths['fronts'].name})", "",
+              f"![fronts overlaid]({paths['fronts_overlay'].name})", "",
+              f"![fronts near 1050 s]({paths['fronts_zoom'].name})", ""]
+    for enc in encodings:
+        lines += [f"Table 4 ({enc}): mean +- std over the runs; the seed's values in the last columns (its line "
+                  "profile differs: only magnitudes compare).", "", table4(rows, enc), ""]
 
-    # statistics
     lines += ["## 3. Does GR-NSGA-II beat NSGA-II? (rank-sum test)", ""]
-    st = []
-    for key, lower in (("hv_ref", False), ("igd_ref", True), ("gd_ref", True), ("gd_seed", True),
-                       ("spacing", True), ("e_at_plan", True), ("punctual_e", True), ("e_min", True)):
-        a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
-        b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
-        p, verdict, rel = rank_sum(main, label, key, lower)
-        st.append([key, mean_std(a), mean_std(b), f"{100 * rel:+.3f} %" if np.isfinite(rel) else "",
-                   fmt(p, 3), verdict])
-    lines += [md_table(["indicator", NSGA2_LABEL, GR_LABEL, "GR vs NSGA-II (means)", "p", "verdict"], st), "",
-              f"![hypervolume]({ctx['figs']['paths']['box_hv'].name})", ""]
+    for enc in encodings:
+        lines += [f"**{enc}**", "", tests_table(rows, enc), ""]
+    lines += [f"![hypervolume]({paths['box_hv'].name})", ""]
 
-    # table 5
     lines += ["## 4. Most punctual solutions (table 5) and fig. 12", "",
-              "The front member closest to 1050 s (ties: lower energy). First the two median-HV runs drawn in "
-              "fig. 12, then the mean over all runs.", ""]
+              "The front member closest to 1050 s (ties: lower energy) of each algorithm's median-HV run (the "
+              "runs of figs. 10-11), re-simulated; then the mean over all runs.", ""]
     t5 = []
-    for alg in (NSGA2_LABEL, GR_LABEL):
-        c = ctx["figs"]["chosen"][alg]
-        traj = ctx["figs"]["trajectories"][alg]
-        rs = [r for r in main if r["algorithm"] == alg]
-        se, stt = SEED_TABLE5[alg]
-        t5.append([alg, c["seed"], f"{traj.energy.net_kwh:.2f}", f"{traj.running_time_s:.1f}",
-                   f"{traj.energy.traction_kwh:.1f} / {traj.energy.regen_kwh:.1f}",
-                   mean_std(r.get("punctual_e", np.nan) for r in rs), mean_std(r.get("punctual_t", np.nan) for r in rs), f"{se} at {stt}"])
-    lines += [md_table(["algorithm", "run (seed)", "energy (kWh)", "running time (s)", "traction / regen (kWh)",
-                        "all runs: energy (kWh)", "all runs: time (s)", "seed 003 table 5"], t5), "",
-              f"![profile]({ctx['figs']['paths']['profile'].name})", ""]
+    for enc in encodings:
+        for alg in (NSGA2_LABEL, GR_LABEL):
+            c = ctx["chosen"][enc, alg]
+            traj = c["trajectory"]
+            rs = [r for r in rows if r["problem"] == enc and r["algorithm"] == alg]
+            se, stt = SEED_TABLE5[alg]
+            t5.append([enc, alg, c["seed"], f"{traj.energy.net_kwh:.2f}", f"{traj.running_time_s:.1f}",
+                       f"{traj.energy.traction_kwh:.1f} / {traj.energy.regen_kwh:.1f}",
+                       mean_std(r.get("punctual_e", np.nan) for r in rs),
+                       mean_std(r.get("punctual_t", np.nan) for r in rs),
+                       mean_std(r.get("e_at_plan", np.nan) for r in rs), f"{se} at {stt}"])
+    lines += [md_table(["encoding", "algorithm", "run (seed)", "energy (kWh)", "running time (s)",
+                        "traction / regen (kWh)", "all runs: energy (kWh)", "all runs: time (s)",
+                        "all runs: least E with T <= 1050 s", "seed 003 table 5"], t5), "",
+              f"![profile]({paths['profile'].name})", ""]
 
-    # verification
     ver = ctx["verification"]
     lines += ["## 5. Verification of every front member", "",
-              f"Each feasible member of every final front ({ver['n_members']} members of {ver['n_runs']} runs, both "
-              "studies) is re-simulated with `problem.trajectory(x)` and checked:", "",
-              "- neutral sections: the kernel's `summary[\"neutral_traction_j\"]` and the largest "
-              "`trajectory.force_n` over every cell that touches a neutral section (traction > 0, braking < 0);",
-              "- limits: the kernel's `summary[\"limit_excess_ms\"]` (max of v - limit over the run; negative "
-              "when the train never reaches a limit), and an independent check of the speed at every node "
-              "against the lowest limit of `case.line.speed_limits` under the train (head at the node, tail "
-              f"{case.train.length_m:g} m behind) and the train's maximum speed;",
+              f"Each feasible member of every final front ({ver['n_members']} members of {ver['n_runs']} runs, the "
+              "main and the encoding study) is re-simulated with `problem.trajectory(x)` and checked:", "",
+              "- neutral sections: the kernel's `summary[\"neutral_traction_j\"]`, and the largest "
+              "`trajectory.force_n` over every grid cell that touches a neutral section (traction > 0, braking < 0);",
+              "- limits: the kernel's `summary[\"limit_excess_ms\"]` (max of v - limit over the run), and an "
+              "independent check of the speed at every node against the lowest limit of `case.line.speed_limits` "
+              f"under the train (head at the node, tail {case.train.length_m:g} m behind) and the train's maximum "
+              "speed;",
               "- the stop: `stop_error_m <= 0.25` (distance between the stopping point and the platform mark);",
               "- the stored objectives equal the re-simulated energy and running time.", ""]
     lines += [md_table(["check", "worst value over all members", "required", "result"], [
@@ -507,7 +551,7 @@ def write_report(path: Path, ctx: dict) -> None:
         ["stored vs re-simulated energy (kWh)", fmt(ver["energy_mismatch_kwh"]), "0", ver["energy_ok"]],
         ["stored vs re-simulated running time (s)", fmt(ver["time_mismatch_s"]), "0", ver["time_ok"]],
     ]), "", f"**All {ver['n_members']} members pass: {'yes' if ver['all_ok'] else 'NO'}.**", ""]
-    lines += ["## 6. Verdict", "", ctx.get("verdict", ""), ""]
+    lines += ["## 6. Verdict", "", ctx["verdict"].strip(), ""]
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -516,7 +560,7 @@ def verification_summary(rows) -> dict:
     v = {"n_runs": len(vr), "n_members": sum(r["n_points"] for r in vr)}
     for key in ("neutral_traction_j_max", "neutral_force_n_max", "limit_excess_ms_max", "independent_excess_ms_max",
                 "stop_error_m_max", "energy_mismatch_kwh", "time_mismatch_s"):
-        v[key] = max(r[key] for r in vr)
+        v[key] = float(max(r[key] for r in vr))
     v["neutral_ok"] = "pass" if v["neutral_traction_j_max"] == 0 else "FAIL"
     v["force_ok"] = "pass" if v["neutral_force_n_max"] <= 0 else "FAIL"
     v["limit_ok"] = "pass" if v["limit_excess_ms_max"] <= SPEED_TOLERANCE_MS else "FAIL"
@@ -529,15 +573,17 @@ def verification_summary(rows) -> dict:
 
 
 def verdict_text(rows) -> str:
-    main = [r for r in rows if r["problem"] == MAIN_ENCODING]
-    parts = []
-    for key, lower, name in (("hv_ref", False, "hypervolume"), ("igd_ref", True, "IGD"),
-                             ("e_at_plan", True, "least energy at T <= 1050 s")):
-        p, verdict, rel = rank_sum(main, MAIN_ENCODING, key, lower)
-        word = {"+": "better (significant)", "-": "worse (significant)", "=": "not significantly different"}.get(
-            verdict, "untested")
-        parts.append(f"{name}: GR-NSGA-II {word}, means differ by {100 * rel:+.3f} % (p = {fmt(p, 3)})")
-    return "Measured: " + "; ".join(parts) + "."
+    lines = []
+    for enc in [e for e in ENCODINGS if any(r["problem"] == e for r in rows)]:
+        parts = []
+        for key, lower, name in (("hv_ref", False, "hypervolume"), ("igd_ref", True, "IGD"),
+                                 ("e_at_plan", True, "least energy with T <= 1050 s")):
+            p, verdict, rel = rank_sum(rows, enc, key, lower)
+            word = {"+": "better (significant)", "-": "worse (significant)",
+                    "=": "not significantly different"}.get(verdict, "untested")
+            parts.append(f"{name}: GR-NSGA-II {word}, means differ by {100 * rel:+.3f} % (p = {fmt(p, 3)})")
+        lines.append(f"- Measured on {enc}: " + "; ".join(parts) + ".")
+    return "\n".join(lines)
 
 
 def summarise(results_main, results_enc, problems_by_label, args, out: Path, prefix: str) -> dict:
@@ -548,23 +594,22 @@ def summarise(results_main, results_enc, problems_by_label, args, out: Path, pre
     enc_rows = []
     if results_enc is not None and len(results_enc):
         _, enc_rows, _ = analyse(results_enc, problems_by_label)
-    problem = problems_by_label[MAIN_ENCODING]
-    figs = make_figures(results_main, rows, problem, out, prefix)
+    chosen = punctual_choices(results_main, rows, problems_by_label)
+    paths = make_figures(results_main, rows, chosen, problems_by_label, out, prefix)
     csv_path = out / f"{prefix}_runs.csv"
     write_csv(csv_path, [{"study": "main", **r} for r in rows] + [{"study": "encodings", **r} for r in enc_rows])
-    ctx = {"rows": rows, "enc_rows": enc_rows, "case": case, "problem": problem, "figs": figs,
-           "csv_name": csv_path.name, "budget": args.budget, "pop_size": args.pop_size, "local_size": args.local_size,
-           "seeds": sorted({r["seed"] for r in rows}), "workers": args.workers,
+    ctx = {"rows": rows, "enc_rows": enc_rows, "case": case, "problems": problems_by_label, "paths": paths,
+           "chosen": chosen, "csv_name": csv_path.name, "budget": args.budget, "pop_size": args.pop_size,
+           "local_size": args.local_size, "seeds": sorted({r["seed"] for r in rows}), "workers": args.workers,
            "n_var": {k: p.n_var for k, p in problems_by_label.items()},
            "n_fixed": {k: int(p.encoding.fixed().sum()) for k, p in problems_by_label.items()},
            "verification": verification_summary(rows + enc_rows), "verdict": verdict_text(rows)}
     notes = out / f"{prefix}_notes.md"
-    if notes.exists():  # the hand-written discussion, kept across re-runs
-        text = notes.read_text()
-        ctx["encoding_note"], _, ctx["verdict"] = (text.split("<!-- verdict -->") + ["", ""])[:3]
-        ctx["verdict"] = verdict_text(rows) + "\n\n" + ctx["verdict"].strip()
-    report = out / f"{prefix}.md"
-    write_report(report, ctx)
+    if notes.exists():  # the hand-written discussion: "<encoding note> <!-- verdict --> <verdict discussion>"
+        encoding_note, _, discussion = notes.read_text().partition("<!-- verdict -->")
+        ctx["encoding_note"] = encoding_note
+        ctx["verdict"] = ctx["verdict"] + "\n\n" + discussion.strip()
+    write_report(out / f"{prefix}.md", ctx)
     return ctx
 
 
@@ -582,11 +627,13 @@ def build_problems():
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=int, default=10, help="runs per algorithm in the main study")
+    parser.add_argument("--seeds", type=int, default=10, help="runs per algorithm and encoding in the main study")
     parser.add_argument("--budget", type=int, default=BUDGET, help="evaluations per run (main study)")
     parser.add_argument("--pop-size", type=int, default=POP_SIZE)
     parser.add_argument("--local-size", type=int, default=LOCAL_SIZE)
-    parser.add_argument("--encoding-seeds", type=int, default=ENCODING_SEEDS)
+    parser.add_argument("--encodings", nargs="+", default=list(MAIN_ENCODINGS), choices=list(ENCODINGS),
+                        help=f"encodings of the main study (the first one is drawn; default: {MAIN_ENCODINGS})")
+    parser.add_argument("--encoding-seeds", type=int, default=ENCODING_SEEDS, help="0 skips the encoding study")
     parser.add_argument("--encoding-budget", type=int, default=ENCODING_BUDGET)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--work", type=Path, default=ROOT / "out" / "emu_wuguang", help="study directories")
@@ -595,27 +642,31 @@ def main(argv=None) -> int:
     parser.add_argument("--report-only", action="store_true", help="analyse the stored runs only")
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
+    if args.encodings[0] != MAIN_ENCODING:
+        parser.error(f"--encodings: the first encoding must be {MAIN_ENCODING!r} (figs. 10-12 are drawn on it)")
 
     from pymoo_rail.experiments import load_results
 
     enc_study = make_study("emu_wuguang_encodings", list(ENCODINGS), range(1, args.encoding_seeds + 1),
-                           args.encoding_budget, args.pop_size, args.local_size)
-    main_study = make_study("emu_wuguang", [MAIN_ENCODING], range(1, args.seeds + 1), args.budget, args.pop_size,
+                           args.encoding_budget, args.pop_size, args.local_size) if args.encoding_seeds > 0 else None
+    main_study = make_study("emu_wuguang", args.encodings, range(1, args.seeds + 1), args.budget, args.pop_size,
                             args.local_size)
     enc_dir, main_dir = args.work / "encodings", args.work / "main"
     if not args.report_only:
         t0 = time.perf_counter()
-        if args.encoding_seeds > 0:
+        if enc_study is not None:
             print(run_seed_major(enc_study, enc_dir, args.workers, not args.no_progress), flush=True)
         print(run_seed_major(main_study, main_dir, args.workers, not args.no_progress), flush=True)
         print(f"studies done in {time.perf_counter() - t0:.0f} s", flush=True)
-    results_enc = load_results(enc_dir, study=enc_study) if args.encoding_seeds > 0 else None
+    results_enc = load_results(enc_dir, study=enc_study) if enc_study is not None else None
     results_main = load_results(main_dir, study=main_study)
     args.out.mkdir(parents=True, exist_ok=True)
     ctx = summarise(results_main, results_enc, build_problems(), args, args.out, args.prefix)
     print(ctx["verdict"])
-    print("verification:", "all pass" if ctx["verification"]["all_ok"] else "FAILURES", ctx["verification"])
-    return 0 if ctx["verification"]["all_ok"] else 1
+    ver = ctx["verification"]
+    print(f"verification of {ver['n_members']} members in {ver['n_runs']} runs:",
+          "all pass" if ver["all_ok"] else "FAILURES")
+    return 0 if ver["all_ok"] else 1
 
 
 if __name__ == "__main__":
