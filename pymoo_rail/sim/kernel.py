@@ -110,14 +110,19 @@ def _landing_force(m, v0, v1, cell):
     """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
 
     Returns (force, W0, feasible): feasible is False when the force exceeds what the train has.
+    The tolerance is relative (1e-8): the braking envelope is built with the maximum braking force
+    at an iterated mid-speed, and landing on it can need that force plus a rounding residue far
+    above 1e-9 N when the force depends on speed (power caps, no deceleration cap).
     """
     v_mid = 0.5 * (v0 + v1)
     w0 = davis_force(m, v_mid)
     f = m.effective_mass_kg * (v1 * v1 - v0 * v0) / (2.0 * m.dx_m) + w0 + m.line_force_n[cell]
     if f > 0.0:
-        feasible = f <= max_traction(m, v_mid, cell) + 1e-9
+        f_max = max_traction(m, v_mid, cell)
+        feasible = f <= f_max + 1e-9 + 1e-8 * f_max
     else:
-        feasible = -f <= max_braking(m, v_mid, cell) + 1e-9
+        f_max = max_braking(m, v_mid, cell)
+        feasible = -f <= f_max + 1e-9 + 1e-8 * f_max
     return f, w0, feasible
 
 
