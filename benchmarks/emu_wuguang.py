@@ -1,5 +1,5 @@
 """Golden-ratio NSGA-II vs NSGA-II on the CRH3 EMU run of seed 003 (section 4.2, figs. 10-12,
-tables 4 and 5), at equal evaluation budgets, through the study runner.
+tables 4 and 5), at equal evaluation budgets, through the study runner, against the exact front.
 
 Problem: ``SpeedProfileProblem(load_case("wuguang-crh3"), objectives=("energy", "running_time"),
 time_tolerance_s=case.time_margin_s)``: the seed's energy / running-time front inside its 60 s
@@ -11,8 +11,12 @@ run, resumable):
 * ``encodings`` (quick): NSGA-II and GR-NSGA-II on speed codes with the default partition,
   speed codes split at ``max_section_m = 1000`` and switching points, a few seeds, a smaller
   budget. It chooses the encoding of the main study.
-* ``main``: NSGA-II vs GR-NSGA-II on the chosen encoding, population 200, 60,000 evaluations
-  (the seed's 200 x 300 generations), ``--seeds`` seeds (default 10).
+* ``main``: NSGA-II vs GR-NSGA-II, population 200, 60,000 evaluations (the seed's 200 x 300
+  generations), ``--seeds`` seeds (default 10), on speed codes (the chosen encoding, figs. 10-12)
+  and on switching points (the best fronts of the encoding study, as a check).
+
+The exact front of ``pymoo_rail.optimal`` at 13 running times from 990 to 1110 s is computed once
+and cached in ``reports/emu_wuguang_optimal.csv`` (``--no-exact`` leaves it out).
 
 Algorithms (seed 003, 4.1: crossover 0.9, mutation 0.01; 2m = 40, Pc_max 0.9, Pm_max 0.1):
 
@@ -23,9 +27,11 @@ Algorithms (seed 003, 4.1: crossover 0.9, mutation 0.01; 2m = 40, Pc_max 0.9, Pm
 
 Then, for the report: fronts (figs. 10-11), table 4 (front statistics), table 5 (most punctual
 solution of each algorithm), fig. 12 (speed-distance profile of the most punctual solutions),
-hypervolume / IGD / GD against the union front with the rank-sum test, and a check of every
-front member of every run: no traction in either neutral section, never above a limit over
-the train length, stopped at the platform.
+hypervolume / IGD / GD against the union front and the energy gap to the exact front with the
+rank-sum test, and a check of every front member of every run: no traction in either neutral
+section, never above a limit over the train length, stopped at the platform, neutral-section
+genes at their fixed value. A hand-written discussion in ``reports/emu_wuguang_notes.md`` (an
+encoding note, then ``<!-- verdict -->`` and the verdict) is folded into the report.
 
 Usage::
 
@@ -133,6 +139,62 @@ def run_seed_major(study, directory: Path, workers: int, progress: bool = True):
 # ------------------------------------------------------------------------------ analysis
 
 
+EXACT_TIMES_S = (990.0, 995.0, 1000.0, 1010.0, 1020.0, 1030.0, 1040.0, 1050.0, 1060.0, 1070.0, 1080.0, 1095.0,
+                 1110.0)
+# 4x the solver's default speed nodes: with the default 200 the front moves by up to 0.15 % between
+# refinements on this 47.6 km line, as much as the optimisers' fronts differ from it (see the report)
+EXACT_N_SPEEDS = 800
+
+
+def exact_front(path: Path, times_s=EXACT_TIMES_S, profile_path: Path | None = None, n_speeds: int = EXACT_N_SPEEDS):
+    """The exact solver's front (``pymoo_rail.optimal``) at ``times_s``, cached row by row in ``path``.
+
+    Each finished running time is written at once (a temporary file renamed over ``path``), so an
+    interrupted computation resumes where it stopped; rows of another ``n_speeds`` are recomputed.
+    With ``profile_path``, the optimal run at the planned time is also kept there as a trajectory
+    table (for fig. 12).
+    """
+    import pandas as pd
+
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.optimal import OptimalSolver
+
+    case = load_case(CASE)
+    rows = pd.read_csv(path).to_dict("records") if path.exists() else []
+    rows = [r for r in rows if int(r.get("n_speeds", -1)) == n_speeds]
+    done = {float(r["requested_time_s"]) for r in rows}
+    want = sorted(float(t) for t in times_s)
+    if profile_path is not None and not profile_path.exists():
+        done.discard(case.planned_time_s)
+        want = sorted(set(want) | {case.planned_time_s})
+    solver, guess = None, None
+    for t in want:
+        if t in done:
+            continue
+        if solver is None:
+            solver = OptimalSolver(case, n_speeds=n_speeds)
+        start = time.perf_counter()
+        traj = solver.profile(t, lambda_guess_w=guess)
+        guess = traj.summary["lambda_w"]
+        row = {"requested_time_s": t, "running_time_s": traj.running_time_s, "energy_kwh": traj.energy.net_kwh,
+               "traction_kwh": traj.energy.traction_kwh, "regen_kwh": traj.energy.regen_kwh,
+               "lambda_kwh_per_s": guess / 3.6e6, "neutral_traction_j": traj.summary["neutral_traction_j"],
+               "limit_excess_ms": traj.summary["limit_excess_ms"], "stop_error_m": traj.stop_error_m,
+               "n_speeds": n_speeds, "solve_s": time.perf_counter() - start}
+        rows = [r for r in rows if float(r["requested_time_s"]) != t] + [row]
+        rows.sort(key=lambda r: float(r["requested_time_s"]))
+        write_csv(path, rows)
+        if profile_path is not None and t == case.planned_time_s:
+            tmp = profile_path.with_suffix(".tmp")
+            traj.to_frame().to_csv(tmp, index=False)
+            tmp.replace(profile_path)
+        print(f"exact front: {t:g} s -> {traj.running_time_s:.2f} s, {traj.energy.net_kwh:.2f} kWh "
+              f"({row['solve_s']:.0f} s)", flush=True)
+    frame = pd.DataFrame(rows)
+    return frame[frame["requested_time_s"].isin(times_s)].sort_values("running_time_s").reset_index(drop=True)
+
+
+
 @dataclass(frozen=True)
 class MemberCheck:
     """Verification of one front member's trajectory."""
@@ -203,8 +265,27 @@ def gd_seed(F: np.ndarray, reference: np.ndarray) -> float:
     return gd_van_veldhuizen(F, reference)
 
 
-def analyse(results, problems_by_label: dict, verify: bool = True):
-    """Per-run statistics (one dict per run) with reference indicators and member checks."""
+def exact_energy_kwh(exact, time_s: float) -> float:
+    """The exact front's energy at ``time_s`` (linear between its points; NaN outside them)."""
+    t, e = exact["running_time_s"].to_numpy(float), exact["energy_kwh"].to_numpy(float)
+    return float(np.interp(time_s, t, e)) if t[0] <= time_s <= t[-1] else float("nan")
+
+
+def gap_to_exact(F: np.ndarray, exact) -> dict:
+    """Energy gap of a front (energy, running time) to the exact front: ``pymoo_rail.indicators.energy``."""
+    from pymoo_rail.indicators.energy import energy_gap
+
+    gap = energy_gap(F[:, ::-1], exact[["running_time_s", "energy_kwh"]].to_numpy(float))
+    return {"gap_mean_pct": 100 * gap["mean_gap_rel"], "gap_min_pct": 100 * gap["min_gap_rel"],
+            "gap_max_pct": 100 * gap["max_gap_rel"], "hv_ratio_exact": gap["hv_ratio"]}
+
+
+def analyse(results, problems_by_label: dict, verify: bool = True, exact=None):
+    """Per-run statistics (one dict per run) with reference indicators and member checks.
+
+    ``exact``: the exact front (DataFrame with ``running_time_s``, ``energy_kwh``), optional;
+    adds each run's energy gap to it.
+    """
     from pymoo_rail.experiments import stats
 
     results = stats.add_reference_indicators(results)
@@ -225,11 +306,16 @@ def analyse(results, problems_by_label: dict, verify: bool = True):
             k = most_punctual(F, planned)
             row.update(e_min=F[:, 0].min(), e_max=F[:, 0].max(), t_min=F[:, 1].min(), t_max=F[:, 1].max(),
                        punctual_e=F[k, 0], punctual_t=F[k, 1], e_at_plan=least_energy_within(F, planned))
+            if exact is not None:
+                row.update(gap_to_exact(F, exact))
+                row["punctual_gap_pct"] = 100 * (F[k, 0] / exact_energy_kwh(exact, F[k, 1]) - 1)
         if verify and len(F):
             member_checks = [check_member(problem, x) for x in X]
             checks[index] = member_checks
+            fixed = problem.encoding.fixed()
+            fixed_ok = bool(np.all(X[:, fixed] == problem.xl[fixed]))
             row.update(
-                verified=all(c.ok for c in member_checks),
+                verified=all(c.ok for c in member_checks) and fixed_ok, fixed_genes_ok=fixed_ok,
                 neutral_traction_j_max=max(c.neutral_traction_j for c in member_checks),
                 neutral_force_n_max=max(c.neutral_max_force_n for c in member_checks),
                 limit_excess_ms_max=max(c.limit_excess_ms for c in member_checks),
@@ -286,7 +372,11 @@ def write_csv(path: Path, rows: list[dict]) -> None:
 
 
 def rank_sum(rows, problem: str, indicator: str, lower_better: bool):
-    """(p, verdict, relative difference of means) of GR-NSGA-II against NSGA-II."""
+    """(p, verdict, difference of means) of GR-NSGA-II against NSGA-II.
+
+    The difference is relative ((GR - NSGA-II) / |NSGA-II|) except for indicators already in
+    percent (``*_pct``), where it is the difference in percentage points.
+    """
     from pymoo_rail.experiments.stats import rank_sum as _rank_sum
 
     gr = [r.get(indicator, np.nan) for r in rows if r["problem"] == problem and r["algorithm"] == GR_LABEL]
@@ -296,8 +386,16 @@ def rank_sum(rows, problem: str, indicator: str, lower_better: bool):
     if len(gr) < 2 or len(base) < 2:
         return np.nan, "", np.nan
     _, p, verdict = _rank_sum(gr, base, lower_better=lower_better)
+    if indicator.endswith("_pct"):
+        return p, verdict, gr.mean() - base.mean()
     rel = (gr.mean() - base.mean()) / abs(base.mean()) if base.mean() != 0 else np.nan
     return p, verdict, rel
+
+
+def difference(indicator: str, value: float) -> str:
+    if not np.isfinite(value):
+        return ""
+    return f"{value:+.3f} points" if indicator.endswith("_pct") else f"{100 * value:+.3f} %"
 
 
 # ------------------------------------------------------------------------------ figures
@@ -331,8 +429,10 @@ def punctual_choices(results, rows, problems_by_label: dict) -> dict:
     return chosen
 
 
-def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path, prefix: str) -> dict:
+def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path, prefix: str, exact=None,
+                 exact_profile=None) -> dict:
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
     from pymoo_rail.experiments import stats
     from pymoo_rail.plotting import plot_boxplots, plot_fronts, plot_speed_profile, save_figure
@@ -342,6 +442,7 @@ def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path
     refs = stats.reference_fronts(results)
     planned = problem.case.planned_time_s
     paths = {}
+    exact_F = exact[["energy_kwh", "running_time_s"]].to_numpy(float) if exact is not None else None
     fig, axes = plt.subplots(1, 2, figsize=(12.5, 4.8), layout="constrained", sharex=True, sharey=True)
     for ax, alg, number in zip(axes, (NSGA2_LABEL, GR_LABEL), (10, 11)):
         c = chosen[label, alg]
@@ -350,16 +451,22 @@ def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path
                     reference_label="union of all runs' fronts", highlight=c["F"],
                     highlight_label=f"most punctual: {c['F'][0]:.1f} kWh, {c['F'][1]:.1f} s",
                     title=f"fig. {number}: {alg} front, {label} ({len(F)} points)", ax=ax)
+        if exact_F is not None:
+            ax.plot(exact_F[:, 0], exact_F[:, 1], "x--", color="black", lw=1.0, ms=6,
+                    label="exact optimum (pymoo_rail.optimal)")
+            ax.legend(fontsize="small")
         ax.axhline(planned, color="0.5", lw=0.8, ls=":")
     paths["fronts"] = save_figure(fig, out / f"{prefix}_fronts.png")
 
     fronts = {f"{alg}, {enc} (seed {c['seed']})": c["front"] for (enc, alg), c in chosen.items()}
-    fig = plot_fronts(fronts, OBJECTIVES, title="median-HV run of each algorithm and encoding")
+    fig = plot_fronts(fronts, OBJECTIVES, reference=exact_F, reference_label="exact optimum (pymoo_rail.optimal)",
+                      title="median-HV run of each algorithm and encoding")
     fig.axes[0].axhline(planned, color="0.5", lw=0.8, ls=":")
     paths["fronts_overlay"] = save_figure(fig, out / f"{prefix}_fronts_overlay.png")
 
     # the seed's fig. 12 only covers the neighbourhood of the planned time: zoom there too
-    fig = plot_fronts(fronts, OBJECTIVES, title="near the planned time (1050 s)")
+    fig = plot_fronts(fronts, OBJECTIVES, reference=exact_F, reference_label="exact optimum (pymoo_rail.optimal)",
+                      title="near the planned time (1050 s)")
     ax = fig.axes[0]
     near = np.vstack([F[np.abs(F[:, 1] - planned) <= 15] for F in fronts.values()])
     if len(near):
@@ -370,9 +477,26 @@ def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path
 
     gr_traj = chosen[label, GR_LABEL]["trajectory"]
     ns_traj = chosen[label, NSGA2_LABEL]["trajectory"]
-    fig = plot_speed_profile(gr_traj, problem.case, label=f"fig. 12: {GR_LABEL} most punctual", others=[ns_traj],
-                             other_labels=[f"{NSGA2_LABEL} most punctual ({ns_traj.running_time_s:.1f} s, "
-                                           f"{ns_traj.energy.net_kwh:.1f} kWh)"])
+    others = [ns_traj]
+    other_labels = [f"{NSGA2_LABEL} most punctual ({ns_traj.running_time_s:.1f} s, {ns_traj.energy.net_kwh:.1f} kWh)"]
+    if exact_profile is not None:
+        others.append(exact_profile)
+        other_labels.append(f"exact optimum at {planned:g} s" + (
+            f" ({exact_energy_kwh(exact, planned):.1f} kWh)" if exact is not None else ""))
+    fig = plot_speed_profile(gr_traj, problem.case, label=f"fig. 12: {GR_LABEL} most punctual", others=others,
+                             other_labels=other_labels)
+    # the optimum in its own colour; the legend above the runs (the default one hides the stations)
+    ax = fig.axes[0]
+    style = {"color": "tab:purple", "linestyle": "-", "lw": 1.4}
+    for line in ax.lines:
+        if exact_profile is not None and line.get_label() == other_labels[-1]:
+            line.set(**style)
+    legend = ax.get_legend()
+    labels = [t.get_text() for t in legend.get_texts()]
+    handles = [Line2D([], [], **style) if exact_profile is not None and lab == other_labels[-1] else h
+               for h, lab in zip(legend.legend_handles, labels)]
+    ax.set_ylim(0.0, 420.0)
+    ax.legend(handles, labels, fontsize="small", loc="upper center", ncol=3, framealpha=0.9)
     paths["profile"] = save_figure(fig, out / f"{prefix}_profile.png")
 
     fig = plot_boxplots(results, "hv_ref")
@@ -407,17 +531,24 @@ TABLE4 = [("points in the front", "n_points"), ("SP (Schott, kWh and s)", "spaci
           ("GD (eq. 13) to the union front", "gd_seed"), ("IGD to the union front", "igd_ref"),
           ("HV (normalised)", "hv_ref"), ("max running time (s)", "t_max"), ("min running time (s)", "t_min"),
           ("max energy (kWh)", "e_max"), ("min energy (kWh)", "e_min"),
-          ("least energy with T <= 1050 s (kWh)", "e_at_plan"), ("evaluations", "n_eval"),
+          ("least energy with T <= 1050 s (kWh)", "e_at_plan"),
+          ("mean energy gap to the exact front (%)", "gap_mean_pct"),
+          ("largest energy gap to the exact front (%)", "gap_max_pct"),
+          ("smallest energy gap to the exact front (%)", "gap_min_pct"),
+          ("HV / HV of the exact front", "hv_ratio_exact"), ("evaluations", "n_eval"),
           ("generations", "n_gen"), ("wall time (s)", "wall_time_s")]
 SEED_KEYS = {"spacing": "sp", "gd_seed": "gd", "t_max": "t_max", "t_min": "t_min", "e_max": "e_max", "e_min": "e_min"}
 TESTED = (("hv_ref", False), ("igd_ref", True), ("gd_ref", True), ("gd_seed", True), ("spacing", True),
-          ("e_at_plan", True), ("punctual_e", True), ("e_min", True))
+          ("gap_mean_pct", True), ("hv_ratio_exact", False), ("e_at_plan", True), ("punctual_e", True),
+          ("e_min", True))
 
 
 def table4(rows, enc: str) -> str:
     main = [r for r in rows if r["problem"] == enc]
     t4 = []
     for name, key in TABLE4:
+        if not any(np.isfinite(r.get(key, np.nan)) for r in main):
+            continue
         a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
         b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
         sk = SEED_KEYS.get(key)
@@ -430,11 +561,13 @@ def tests_table(rows, enc: str) -> str:
     main = [r for r in rows if r["problem"] == enc]
     st = []
     for key, lower in TESTED:
+        if not any(np.isfinite(r.get(key, np.nan)) for r in main):
+            continue
         a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
         b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
         p, verdict, rel = rank_sum(rows, enc, key, lower)
-        st.append([key, "lower" if lower else "higher", mean_std(a), mean_std(b),
-                   f"{100 * rel:+.3f} %" if np.isfinite(rel) else "", fmt(p, 3), verdict])
+        st.append([key, "lower" if lower else "higher", mean_std(a), mean_std(b), difference(key, rel), fmt(p, 3),
+                   verdict])
     return md_table(["indicator", "better", NSGA2_LABEL, GR_LABEL, "GR vs NSGA-II (means)", "p", "verdict"], st)
 
 
@@ -448,7 +581,7 @@ def write_report(path: Path, ctx: dict) -> None:
         "# CRH3 EMU on the Wuhan-Guangzhou line: golden-ratio NSGA-II vs NSGA-II (seed 003, 4.2)",
         "",
         f"Generated by `benchmarks/emu_wuguang.py` on {time.strftime('%Y-%m-%d')}; one row per run in "
-        f"`{ctx['csv_name']}`.",
+        f"`{ctx['csv_name']}`. The closing discussion is written by hand (`emu_wuguang_notes.md`).",
         "",
         "## Set-up",
         "",
@@ -483,8 +616,17 @@ def write_report(path: Path, ctx: dict) -> None:
         "(`fixed_genes = problem.encoding.fixed()`, passed by the study runner).",
         f"- Runs: `pymoo_rail.experiments.run_study`, {ctx['workers']} worker processes under `nice -n 10` on "
         "the shared 2-core machine (load average 8-10); wall times are those of a loaded machine.",
-        "- Indicators against the non-dominated union of every final front of both algorithms on that encoding "
-        "(the exact optimal front is not available: `pymoo_rail.optimal` has no `optimal_front` yet): `hv_ref` "
+        "- The exact front: `pymoo_rail.optimal` (dynamic programming over position and speed on the simulator's "
+        "own physics, replayed in the simulator) at "
+        + (", ".join(f"{t:g}" for t in ctx["exact"]["requested_time_s"]) + " s, cached in "
+           f"`{ctx['exact_csv']}` (section 5). Against it: `gap_mean_pct` / `gap_max_pct` / `gap_min_pct`, the mean / "
+           "largest / smallest energy of a front member above the exact front at its running time (linear between "
+           "the exact points), and `hv_ratio_exact`, the front's hypervolume over the exact front's (both in raw "
+           "units, `pymoo_rail.indicators.energy.energy_gap`)." if ctx["exact"] is not None else "(not computed).")
+        + " Since the exact front is a chord between 13 points, it lies slightly above the true optimum "
+        "between them, and a member may show a small negative gap there.",
+        "- Indicators against the non-dominated union of every final front of both algorithms on that encoding: "
+        "`hv_ref` "
         "hypervolume normalised to the union's ideal and nadir (reference point 1.1), `igd_ref` and `gd_ref` "
         "(pymoo, mean distance, raw units kWh and s), `gd_seed` the seed's eq. 13 (sqrt(sum d^2) / n), "
         "`spacing` Schott's SP (eqs. 11-12, raw units), `e_at_plan` the least energy of a member with "
@@ -519,18 +661,35 @@ def write_report(path: Path, ctx: dict) -> None:
             traj = c["trajectory"]
             rs = [r for r in rows if r["problem"] == enc and r["algorithm"] == alg]
             se, stt = SEED_TABLE5[alg]
-            t5.append([enc, alg, c["seed"], f"{traj.energy.net_kwh:.2f}", f"{traj.running_time_s:.1f}",
+            opt = exact_energy_kwh(ctx["exact"], traj.running_time_s) if ctx["exact"] is not None else np.nan
+            gap = f"{opt:.2f} (+{100 * (traj.energy.net_kwh / opt - 1):.2f} %)" if np.isfinite(opt) else ""
+            t5.append([enc, alg, c["seed"], f"{traj.energy.net_kwh:.2f}", f"{traj.running_time_s:.1f}", gap,
                        f"{traj.energy.traction_kwh:.1f} / {traj.energy.regen_kwh:.1f}",
                        mean_std(r.get("punctual_e", np.nan) for r in rs),
                        mean_std(r.get("punctual_t", np.nan) for r in rs),
                        mean_std(r.get("e_at_plan", np.nan) for r in rs), f"{se} at {stt}"])
     lines += [md_table(["encoding", "algorithm", "run (seed)", "energy (kWh)", "running time (s)",
+                        "exact optimum at that time (kWh)",
                         "traction / regen (kWh)", "all runs: energy (kWh)", "all runs: time (s)",
                         "all runs: least E with T <= 1050 s", "seed 003 table 5"], t5), "",
               f"![profile]({paths['profile'].name})", ""]
 
+    if ctx["exact"] is not None:
+        ex = ctx["exact"]
+        lines += ["## 5. The exact front", "",
+                  "The minimum net energy at each running time (`pymoo_rail.optimal.OptimalSolver`, 5 m grid, "
+                  f"{int(ex['n_speeds'].iloc[0])} speed nodes), each run replayed in the simulator, so it obeys the "
+                  "same limits, neutral sections and energy accounting as the optimisers' runs; `lambda` is the slope "
+                  "-dE/dT, the energy one more second of running time saves.", "",
+                  md_table(["requested (s)", "running time (s)", "net energy (kWh)", "traction / regen (kWh)",
+                            "lambda (kWh/s)", "neutral traction (J)", "limit excess (m/s)", "stop error (m)",
+                            "solve (s)"],
+                           [[f"{r.requested_time_s:g}", f"{r.running_time_s:.2f}", f"{r.energy_kwh:.2f}",
+                             f"{r.traction_kwh:.1f} / {r.regen_kwh:.1f}", f"{r.lambda_kwh_per_s:.3f}",
+                             fmt(r.neutral_traction_j), fmt(r.limit_excess_ms), fmt(r.stop_error_m),
+                             f"{r.solve_s:.0f}"] for r in ex.itertuples()]), ""]
     ver = ctx["verification"]
-    lines += ["## 5. Verification of every front member", "",
+    lines += ["## 6. Verification of every front member", "",
               f"Each feasible member of every final front ({ver['n_members']} members of {ver['n_runs']} runs, the "
               "main and the encoding study) is re-simulated with `problem.trajectory(x)` and checked:", "",
               "- neutral sections: the kernel's `summary[\"neutral_traction_j\"]`, and the largest "
@@ -540,7 +699,9 @@ def write_report(path: Path, ctx: dict) -> None:
               f"under the train (head at the node, tail {case.train.length_m:g} m behind) and the train's maximum "
               "speed;",
               "- the stop: `stop_error_m <= 0.25` (distance between the stopping point and the platform mark);",
-              "- the stored objectives equal the re-simulated energy and running time.", ""]
+              "- the stored objectives equal the re-simulated energy and running time;",
+              "- the genes of the sections inside the neutral sections (speed codes) still hold their fixed value.",
+              ""]
     lines += [md_table(["check", "worst value over all members", "required", "result"], [
         ["neutral traction work (J)", fmt(ver["neutral_traction_j_max"]), "0", ver["neutral_ok"]],
         ["largest force in a neutral section (N)", fmt(ver["neutral_force_n_max"]), "<= 0", ver["force_ok"]],
@@ -550,8 +711,9 @@ def write_report(path: Path, ctx: dict) -> None:
         ["stop error (m)", fmt(ver["stop_error_m_max"]), "<= 0.25", ver["stop_ok"]],
         ["stored vs re-simulated energy (kWh)", fmt(ver["energy_mismatch_kwh"]), "0", ver["energy_ok"]],
         ["stored vs re-simulated running time (s)", fmt(ver["time_mismatch_s"]), "0", ver["time_ok"]],
+        ["neutral-section genes at their fixed value (10 km/h, coast)", "", "all members", ver["fixed_ok"]],
     ]), "", f"**All {ver['n_members']} members pass: {'yes' if ver['all_ok'] else 'NO'}.**", ""]
-    lines += ["## 6. Verdict", "", ctx["verdict"].strip(), ""]
+    lines += ["## 7. Verdict", "", ctx["verdict"].strip(), ""]
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -568,6 +730,7 @@ def verification_summary(rows) -> dict:
     v["stop_ok"] = "pass" if v["stop_error_m_max"] <= STOP_TOLERANCE_M else "FAIL"
     v["energy_ok"] = "pass" if v["energy_mismatch_kwh"] <= 1e-9 else "FAIL"
     v["time_ok"] = "pass" if v["time_mismatch_s"] <= 1e-9 else "FAIL"
+    v["fixed_ok"] = "pass" if all(r["fixed_genes_ok"] for r in vr) else "FAIL"
     v["all_ok"] = all(r["verified"] for r in vr) and v["energy_ok"] == v["time_ok"] == "pass"
     return v
 
@@ -577,25 +740,29 @@ def verdict_text(rows) -> str:
     for enc in [e for e in ENCODINGS if any(r["problem"] == e for r in rows)]:
         parts = []
         for key, lower, name in (("hv_ref", False, "hypervolume"), ("igd_ref", True, "IGD"),
+                                 ("gap_mean_pct", True, "mean energy gap to the exact front"),
                                  ("e_at_plan", True, "least energy with T <= 1050 s")):
+            if not any(np.isfinite(r.get(key, np.nan)) for r in rows):
+                continue
             p, verdict, rel = rank_sum(rows, enc, key, lower)
             word = {"+": "better (significant)", "-": "worse (significant)",
                     "=": "not significantly different"}.get(verdict, "untested")
-            parts.append(f"{name}: GR-NSGA-II {word}, means differ by {100 * rel:+.3f} % (p = {fmt(p, 3)})")
+            parts.append(f"{name}: GR-NSGA-II {word}, means differ by {difference(key, rel)} (p = {fmt(p, 3)})")
         lines.append(f"- Measured on {enc}: " + "; ".join(parts) + ".")
     return "\n".join(lines)
 
 
-def summarise(results_main, results_enc, problems_by_label, args, out: Path, prefix: str) -> dict:
+def summarise(results_main, results_enc, problems_by_label, args, out: Path, prefix: str, exact=None,
+              exact_profile=None) -> dict:
     from pymoo_rail.cases import load_case
 
     case = load_case(CASE)
-    results_main, rows, _ = analyse(results_main, problems_by_label)
+    results_main, rows, _ = analyse(results_main, problems_by_label, exact=exact)
     enc_rows = []
     if results_enc is not None and len(results_enc):
-        _, enc_rows, _ = analyse(results_enc, problems_by_label)
+        _, enc_rows, _ = analyse(results_enc, problems_by_label, exact=exact)
     chosen = punctual_choices(results_main, rows, problems_by_label)
-    paths = make_figures(results_main, rows, chosen, problems_by_label, out, prefix)
+    paths = make_figures(results_main, rows, chosen, problems_by_label, out, prefix, exact, exact_profile)
     csv_path = out / f"{prefix}_runs.csv"
     write_csv(csv_path, [{"study": "main", **r} for r in rows] + [{"study": "encodings", **r} for r in enc_rows])
     ctx = {"rows": rows, "enc_rows": enc_rows, "case": case, "problems": problems_by_label, "paths": paths,
@@ -603,7 +770,8 @@ def summarise(results_main, results_enc, problems_by_label, args, out: Path, pre
            "local_size": args.local_size, "seeds": sorted({r["seed"] for r in rows}), "workers": args.workers,
            "n_var": {k: p.n_var for k, p in problems_by_label.items()},
            "n_fixed": {k: int(p.encoding.fixed().sum()) for k, p in problems_by_label.items()},
-           "verification": verification_summary(rows + enc_rows), "verdict": verdict_text(rows)}
+           "verification": verification_summary(rows + enc_rows), "verdict": verdict_text(rows), "exact": exact,
+           "exact_csv": f"{prefix}_optimal.csv"}
     notes = out / f"{prefix}_notes.md"
     if notes.exists():  # the hand-written discussion: "<encoding note> <!-- verdict --> <verdict discussion>"
         encoding_note, _, discussion = notes.read_text().partition("<!-- verdict -->")
@@ -640,6 +808,8 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "reports", help="report directory")
     parser.add_argument("--prefix", default="emu_wuguang")
     parser.add_argument("--report-only", action="store_true", help="analyse the stored runs only")
+    parser.add_argument("--no-exact", action="store_true",
+                        help="leave out the exact front of pymoo_rail.optimal (about 1-2 min per running time)")
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     if args.encodings[0] != MAIN_ENCODING:
@@ -661,7 +831,15 @@ def main(argv=None) -> int:
     results_enc = load_results(enc_dir, study=enc_study) if enc_study is not None else None
     results_main = load_results(main_dir, study=main_study)
     args.out.mkdir(parents=True, exist_ok=True)
-    ctx = summarise(results_main, results_enc, build_problems(), args, args.out, args.prefix)
+    exact = exact_profile = None
+    if not args.no_exact:
+        import pandas as pd
+
+        profile_path = args.work / "optimal_profile.csv"
+        args.work.mkdir(parents=True, exist_ok=True)
+        exact = exact_front(args.out / f"{args.prefix}_optimal.csv", profile_path=profile_path)
+        exact_profile = pd.read_csv(profile_path)
+    ctx = summarise(results_main, results_enc, build_problems(), args, args.out, args.prefix, exact, exact_profile)
     print(ctx["verdict"])
     ver = ctx["verification"]
     print(f"verification of {ver['n_members']} members in {ver['n_runs']} runs:",
