@@ -21,7 +21,7 @@ import numpy as np
 
 HV_REFERENCE = 1.1
 LOWER_IS_BETTER = {"igd": True, "gd": True, "gd_vv": True, "hv": False, "spacing": True, "f_best": True,
-                   "error": True, "energy_gap": True, "energy_gap_pct": True, "n_front": False,
+                   "error": True, "energy_gap": True, "energy_gap_max": True, "hv_ratio": False, "energy_gap_pct": True, "n_front": False,
                    "igd_ref": True, "gd_ref": True, "hv_ref": False}
 
 

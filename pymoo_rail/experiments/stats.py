@@ -252,7 +252,11 @@ def _energy_gap_function():
 
 
 def add_energy_gap(results: pd.DataFrame, references: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
-    """Add ``energy_gap`` (kWh): the gap of each rail front to the exact optimal front.
+    """Add the gap of each rail front to the exact optimal front.
+
+    Columns: ``energy_gap`` (mean relative energy above the optimum at the same running time,
+    over the front's points inside the reference's time range), ``energy_gap_max`` and
+    ``hv_ratio`` (the front's hypervolume over the reference's).
 
     ``references`` maps a problem label to the optimal front of its case, a DataFrame with
     columns ``running_time_s`` and ``energy_kwh`` (``pymoo_rail.optimal.optimal_front``). Each
@@ -265,8 +269,9 @@ def add_energy_gap(results: pd.DataFrame, references: Mapping[str, pd.DataFrame]
     if energy_gap is None:
         raise ImportError("energy_gap needs pymoo_rail.indicators.energy (the exact reference solver part)")
     out = results.copy()
-    if "energy_gap" not in out.columns:
-        out["energy_gap"] = np.nan
+    for column in ("energy_gap", "energy_gap_max", "hv_ratio"):
+        if column not in out.columns:
+            out[column] = np.nan
     for index, row in out.iterrows():
         reference = references.get(row["problem"])
         extras = row.get("extras") or {}
@@ -277,7 +282,10 @@ def add_energy_gap(results: pd.DataFrame, references: Mapping[str, pd.DataFrame]
             continue
         front = pd.DataFrame({"running_time_s": extras["running_time_s"][feasible],
                               "energy_kwh": extras["energy_kwh"][feasible]})
-        out.at[index, "energy_gap"] = float(energy_gap(front, reference))
+        gap = energy_gap(front, reference)
+        out.at[index, "energy_gap"] = gap["mean_gap_rel"]  # mean relative energy above the optimum
+        out.at[index, "energy_gap_max"] = gap["max_gap_rel"]
+        out.at[index, "hv_ratio"] = gap["hv_ratio"]
     return out
 
 
