@@ -1,12 +1,14 @@
 """Building blocks shared by the bee-colony algorithms (ABC and MOABC).
 
-Everything here is a pure function of its arguments: random numbers come from the
-generator that is passed in (the algorithm's ``random_state``), never from global state.
+The functions here are pure: random numbers come from the generator that is passed in (the
+algorithm's ``random_state``), never from global state. ``BeeColony`` is the cycle both
+algorithms run.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from pymoo.core.algorithm import Algorithm
 
 
 def check_colony_size(pop_size: object, minimum: int) -> int:
@@ -143,3 +145,44 @@ def constraint_dominates(f_a: np.ndarray, cv_a: float, f_b: np.ndarray, cv_b: fl
 def roulette(probabilities: np.ndarray, n: int, random_state: np.random.Generator) -> np.ndarray:
     """Draw ``n`` indices with the given probabilities (with replacement)."""
     return random_state.choice(len(probabilities), size=n, replace=True, p=probabilities)
+
+
+EMPLOYED, ONLOOKER, SCOUT = "employed", "onlooker", "scout"
+
+
+class BeeColony(Algorithm):
+    """The employed - onlooker - scout cycle as one pymoo iteration.
+
+    ``_advance`` returns False between the phases, so each phase is one ask/tell and nothing is
+    evaluated inside the algorithm. Subclasses provide ``_infill`` for the current ``_phase``,
+    ``_greedy(infills)`` (keep better candidates, count trials), ``_end_cycle(n_scouts)``, and
+    may override ``_observe(infills)`` to see every evaluated candidate (MOABC's archive).
+    Subclasses set ``trials`` (per source) and ``_limit``.
+    """
+
+    def _observe(self, infills) -> None:
+        """Called with every evaluated batch before it is used."""
+
+    def _advance(self, infills=None, **kwargs) -> bool:
+        if infills is None:
+            raise ValueError(f"{type(self).__name__} uses ask/tell: tell() needs the evaluated infills")
+        self._observe(infills)
+
+        if self._phase == SCOUT:
+            self.pop[self._scouts] = infills
+            self.trials[self._scouts] = 0
+            self._end_cycle(len(self._scouts))
+            return True
+
+        self._greedy(infills)
+
+        if self._phase == EMPLOYED:
+            self._phase = ONLOOKER
+            return False
+
+        self._scouts = np.flatnonzero(self.trials > self._limit)
+        if len(self._scouts) > 0:
+            self._phase = SCOUT
+            return False
+        self._end_cycle(0)
+        return True

@@ -9,7 +9,6 @@ phase is one ``ask``/``tell`` pair and nothing is evaluated inside the algorithm
 from __future__ import annotations
 
 import numpy as np
-from pymoo.core.algorithm import Algorithm
 from pymoo.core.population import Population
 from pymoo.core.replacement import parameter_less
 from pymoo.core.sampling import Sampling
@@ -19,6 +18,10 @@ from pymoo.util.display.single import SingleObjectiveOutput
 from pymoo.util.optimum import filter_optimum
 
 from pymoo_rail.algorithms._bees import (
+    EMPLOYED,
+    ONLOOKER,
+    SCOUT,
+    BeeColony,
     check_bounds,
     check_colony_size,
     check_limit,
@@ -28,7 +31,6 @@ from pymoo_rail.algorithms._bees import (
     roulette,
 )
 
-EMPLOYED, ONLOOKER, SCOUT = "employed", "onlooker", "scout"
 
 
 class ABCOutput(SingleObjectiveOutput):
@@ -79,7 +81,7 @@ def inverse_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
 ONLOOKER_FITNESS = {"rank": rank_probabilities, "inverse": inverse_probabilities}
 
 
-class ABC(Algorithm):
+class ABC(BeeColony):
     """Artificial Bee Colony (Karaboga 2005; seed 000, sections 3.2-3.3).
 
     Parameters
@@ -198,29 +200,6 @@ class ABC(Algorithm):
             X[self._parents], X[partners], self._xl, self._xu, self.random_state
         )
         return Population.new(X=V)
-
-    def _advance(self, infills=None, **kwargs) -> bool:
-        if infills is None:
-            raise ValueError("ABC uses ask/tell: tell() needs the evaluated infills")
-
-        if self._phase == SCOUT:
-            self.pop[self._scouts] = infills
-            self.trials[self._scouts] = 0
-            self._end_cycle(len(self._scouts))
-            return True
-
-        self._greedy(infills)
-
-        if self._phase == EMPLOYED:
-            self._phase = ONLOOKER
-            return False
-
-        self._scouts = np.flatnonzero(self.trials > self._limit)
-        if len(self._scouts) > 0:
-            self._phase = SCOUT
-            return False
-        self._end_cycle(0)
-        return True
 
     def _greedy(self, infills: Population) -> None:
         """Replace sources by strictly better candidates, in draw order; count trials."""

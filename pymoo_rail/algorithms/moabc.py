@@ -9,7 +9,6 @@ one pymoo iteration is one full cycle.
 from __future__ import annotations
 
 import numpy as np
-from pymoo.core.algorithm import Algorithm
 from pymoo.core.population import Population
 from pymoo.core.sampling import Sampling
 from pymoo.operators.sampling.rnd import FloatRandomSampling
@@ -19,6 +18,10 @@ from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from pymoo_rail.algorithms._bees import (
+    EMPLOYED,
+    ONLOOKER,
+    SCOUT,
+    BeeColony,
     check_bounds,
     check_colony_size,
     check_limit,
@@ -27,7 +30,6 @@ from pymoo_rail.algorithms._bees import (
     roulette,
 )
 
-EMPLOYED, ONLOOKER, SCOUT = "employed", "onlooker", "scout"
 MOVES = ("centred", "canonical", "literal")
 
 
@@ -102,7 +104,7 @@ def truncate_by_crowding(pop: Population, max_size: int) -> Population:
     return pop
 
 
-class MOABC(Algorithm):
+class MOABC(BeeColony):
     """Multi-objective Artificial Bee Colony (seed 000, section 4.5.2).
 
     Parameters
@@ -245,30 +247,8 @@ class MOABC(Algorithm):
             scale=self.w,
         )
 
-    def _advance(self, infills=None, **kwargs) -> bool:
-        if infills is None:
-            raise ValueError("MOABC uses ask/tell: tell() needs the evaluated infills")
-
-        self._update_archive(infills)
-
-        if self._phase == SCOUT:
-            self.pop[self._scouts] = infills
-            self.trials[self._scouts] = 0
-            self._end_cycle(len(self._scouts))
-            return True
-
-        self._greedy(infills)
-
-        if self._phase == EMPLOYED:
-            self._phase = ONLOOKER
-            return False
-
-        self._scouts = np.flatnonzero(self.trials > self._limit)
-        if len(self._scouts) > 0:
-            self._phase = SCOUT
-            return False
-        self._end_cycle(0)
-        return True
+    def _observe(self, infills: Population) -> None:
+        self._update_archive(infills)  # every evaluated candidate may enter the archive
 
     def _greedy(self, infills: Population) -> None:
         """Replace a source by a candidate that constraint-dominates it; count trials."""
