@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.core.algorithm import Algorithm
+from pymoo.util.display.column import Column
 
 
 def check_colony_size(pop_size: object, minimum: int) -> int:
@@ -186,3 +187,19 @@ class BeeColony(Algorithm):
             return False
         self._end_cycle(0)
         return True
+
+
+class ScoutColumn:
+    """Mixin for a pymoo output: adds the number of scouts sent in the last cycle."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.n_scouts = Column(name="n_scouts", width=8)
+
+    def initialize(self, algorithm) -> None:
+        super().initialize(algorithm)
+        self.columns += [self.n_scouts]
+
+    def update(self, algorithm) -> None:
+        super().update(algorithm)
+        self.n_scouts.set(algorithm.n_scouts)

@@ -13,7 +13,6 @@ from pymoo.core.population import Population
 from pymoo.core.replacement import parameter_less
 from pymoo.core.sampling import Sampling
 from pymoo.operators.sampling.rnd import FloatRandomSampling
-from pymoo.util.display.column import Column
 from pymoo.util.display.single import SingleObjectiveOutput
 from pymoo.util.optimum import filter_optimum
 
@@ -22,6 +21,7 @@ from pymoo_rail.algorithms._bees import (
     ONLOOKER,
     SCOUT,
     BeeColony,
+    ScoutColumn,
     check_bounds,
     check_colony_size,
     check_limit,
@@ -33,20 +33,8 @@ from pymoo_rail.algorithms._bees import (
 
 
 
-class ABCOutput(SingleObjectiveOutput):
+class ABCOutput(ScoutColumn, SingleObjectiveOutput):
     """Verbose output of :class:`ABC`: best and mean objective plus scouts per cycle."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.n_scouts = Column(name="n_scouts", width=8)
-
-    def initialize(self, algorithm) -> None:
-        super().initialize(algorithm)
-        self.columns += [self.n_scouts]
-
-    def update(self, algorithm) -> None:
-        super().update(algorithm)
-        self.n_scouts.set(algorithm.n_scouts)
 
 
 def rank_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:

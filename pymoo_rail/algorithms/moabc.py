@@ -13,7 +13,6 @@ from pymoo.core.population import Population
 from pymoo.core.sampling import Sampling
 from pymoo.operators.sampling.rnd import FloatRandomSampling
 from pymoo.operators.survival.rank_and_crowding.metrics import calc_crowding_distance
-from pymoo.util.display.column import Column
 from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
@@ -22,6 +21,7 @@ from pymoo_rail.algorithms._bees import (
     ONLOOKER,
     SCOUT,
     BeeColony,
+    ScoutColumn,
     check_bounds,
     check_colony_size,
     check_limit,
@@ -33,20 +33,8 @@ from pymoo_rail.algorithms._bees import (
 MOVES = ("centred", "canonical", "literal")
 
 
-class MOABCOutput(MultiObjectiveOutput):
+class MOABCOutput(ScoutColumn, MultiObjectiveOutput):
     """Verbose output of :class:`MOABC`: pymoo's multi-objective columns plus scouts."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.n_scouts = Column(name="n_scouts", width=8)
-
-    def initialize(self, algorithm) -> None:
-        super().initialize(algorithm)
-        self.columns += [self.n_scouts]
-
-    def update(self, algorithm) -> None:
-        super().update(algorithm)
-        self.n_scouts.set(algorithm.n_scouts)
 
 
 def domination_counts(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
