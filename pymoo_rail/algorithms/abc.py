@@ -32,7 +32,6 @@ from pymoo_rail.algorithms._bees import (
 )
 
 
-
 class ABCOutput(ScoutColumn, SingleObjectiveOutput):
     """Verbose output of :class:`ABC`: best and mean objective plus scouts per cycle."""
 
