@@ -3,6 +3,8 @@
 Prints, measured in this one run:
 - evaluations per second for a population of 200 speed-code programs on ``yizhuang``;
 - the same with ``NUMBA_DISABLE_JIT=1`` (a subprocess running this file in ``--worker`` mode);
+- both ratios: wall clock, and CPU time per evaluation (summed over threads), which other load
+  on the machine does not distort;
 - the one-time JIT cost with an empty on-disk cache and with a warm one.
 
 Usage: ``python benchmarks/simulator.py [--pop 200] [--repeats 20]``
@@ -40,11 +42,12 @@ def worker(pop: int, repeats: int) -> dict:
     programs = _programs(case, pop)
     sim.run_batch(programs[:2])  # compile or load from cache
     first_call_s = time.perf_counter() - t0
-    t1 = time.perf_counter()
+    t1, c1 = time.perf_counter(), time.process_time()
     for _ in range(repeats):
         sim.run_batch(programs)
-    elapsed = time.perf_counter() - t1
-    return {"evals_per_s": pop * repeats / elapsed, "first_call_s": first_call_s}
+    elapsed, cpu = time.perf_counter() - t1, time.process_time() - c1
+    return {"evals_per_s": pop * repeats / elapsed, "cpu_us_per_eval": 1e6 * cpu / (pop * repeats),
+            "first_call_s": first_call_s}
 
 
 def _subprocess(args: list[str], env_extra: dict) -> dict:
@@ -72,7 +75,14 @@ def main() -> None:
     print(f"yizhuang, population {args.pop}, {cores} cores")
     print(f"  Numba batch kernel      : {warm['evals_per_s']:12.1f} evaluations/s")
     print(f"  same code, no JIT       : {nojit['evals_per_s']:12.1f} evaluations/s")
-    print(f"  speed-up (JIT / no JIT) : {warm['evals_per_s'] / nojit['evals_per_s']:12.1f} x")
+    print(f"  speed-up, wall clock    : {warm['evals_per_s'] / nojit['evals_per_s']:12.1f} x")
+    print(f"  CPU time per evaluation : {warm['cpu_us_per_eval']:12.1f} us JIT (all threads), "
+          f"{nojit['cpu_us_per_eval']:.1f} us no JIT")
+    print(f"  speed-up, CPU time      : {nojit['cpu_us_per_eval'] / warm['cpu_us_per_eval']:12.1f} x"
+          "  (independent of other load on the machine)")
+    load = os.getloadavg()[0]
+    if load > 0.5 * (cores or 1):
+        print(f"  note: load average {load:.1f} on {cores} cores while measuring; wall-clock rates are low")
     print(f"  first call, empty cache : {cold['first_call_s']:12.2f} s  (JIT compilation)")
     print(f"  first call, warm cache  : {warm['first_call_s']:12.2f} s  (cache=True)")
 

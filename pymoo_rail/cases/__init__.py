@@ -44,4 +44,13 @@ def load_case(name_or_path: str | Path) -> Case:
     return read_case(case_path(str(name_or_path)))
 
 
-__all__ = ["load_case", "list_cases", "case_path"]
+def __getattr__(name: str):
+    # TTOBench support imports json readers only when asked for
+    if name in ("from_ttobench", "to_ttobench"):
+        from pymoo_rail.cases import ttobench
+
+        return getattr(ttobench, name)
+    raise AttributeError(f"module 'pymoo_rail.cases' has no attribute {name!r}")
+
+
+__all__ = ["load_case", "list_cases", "case_path", "from_ttobench", "to_ttobench"]

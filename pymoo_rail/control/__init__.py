@@ -1,1 +1,27 @@
+"""ATO tracking layer: controllers that follow a recommended speed-distance curve.
 
+>>> from pymoo_rail.cases import load_case
+>>> from pymoo_rail.sim import Simulator
+>>> from pymoo_rail.control import Hysteresis, track
+>>> case = load_case("yizhuang")
+>>> ideal = Simulator(case).flat_out()
+>>> tracked = track(case, ideal, Hysteresis(2, 4))
+>>> tracked.stop_error_m < 0.5
+True
+"""
+
+from pymoo_rail.control.controllers import (
+    CLASSIC_RULES,
+    PID,
+    SYMMETRIC_RULES,
+    TERMS,
+    Controller,
+    FuzzyPID,
+    Hysteresis,
+    symmetric_rules,
+)
+from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S, Tracker, track, tracked_summaries
+
+__all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMMETRIC_RULES",
+           "symmetric_rules", "TERMS", "Tracker", "track",
+           "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S"]

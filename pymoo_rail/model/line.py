@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from pymoo_rail.model.errors import CaseError
 
 Interval = tuple[float, float]
@@ -90,10 +92,8 @@ class Line:
                 return limit
         return self.speed_limits[-1][2]
 
-    def altitude_m(self, position_m):
+    def altitude_m(self, position_m: float | np.ndarray) -> np.ndarray:
         """Altitude relative to the start, integrating the gradients (point values, not averaged)."""
-        import numpy as np
-
         x = np.asarray(position_m, dtype=float)
         knots = [0.0] + [row[1] for row in self.gradients]
         heights = [0.0]

@@ -73,6 +73,12 @@ class SpeedProfileProblem(Problem):
         Lowest speed code (default 10 km/h): a code below the current speed means coasting.
     dx_m : float, optional
         Simulation grid step.
+    tracking : Hysteresis, PID or FuzzyPID, optional
+        Score each decision by the run of this ATO controller tracking its ideal curve (seed 000
+        optimises the tracked curve, section 5.1.3) instead of the ideal run itself; see
+        :mod:`pymoo_rail.control`. ``trajectory(x)`` then returns the tracked run.
+    control_period_s : float
+        Control period of ``tracking`` (default 0.2 s).
 
     Notes
     -----
@@ -86,7 +92,8 @@ class SpeedProfileProblem(Problem):
                  max_section_m: float | None = None, time_tolerance_s: float | None = None,
                  weights: Sequence[float] | None = None, scales: Sequence[float] | None = None,
                  stop_tolerance_m: float | None = 0.25, regimes: Sequence[str] | None = None,
-                 floor_kmh: float = 10.0, dx_m: float | None = None, **kwargs):
+                 floor_kmh: float = 10.0, dx_m: float | None = None, tracking=None,
+                 control_period_s: float = 0.2, **kwargs):
         if isinstance(objectives, str):
             objectives = (objectives,)
         objectives = tuple(objectives)
@@ -113,6 +120,11 @@ class SpeedProfileProblem(Problem):
         self.time_tolerance_s = time_tolerance_s
         self.stop_tolerance_m = stop_tolerance_m
         self.simulator = Simulator(case, dx_m)
+        self.tracker = None
+        if tracking is not None:
+            from pymoo_rail.control import Tracker  # the tracking layer is optional
+
+            self.tracker = Tracker(case, tracking, control_period_s, dx_m)
         fastest = self.simulator.flat_out()
         if "time_error" in objectives or time_tolerance_s is not None:
             self.simulator.check_planned_time()  # raises, naming planned_time_s, when impossible
@@ -146,7 +158,10 @@ class SpeedProfileProblem(Problem):
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != self.n_var:
             raise ValueError(f"decision vectors have {X.shape[1]} values: this problem has n_var = {self.n_var}")
-        return self.simulator.run_batch(self.encoding.programs(np.ascontiguousarray(X)))
+        programs = self.encoding.programs(np.ascontiguousarray(X))
+        if self.tracker is not None:
+            return self.tracker.run_batch(programs)
+        return self.simulator.run_batch(programs)
 
     def _evaluate(self, x, out, *args, **kwargs):
         s = self.summaries(x)
@@ -171,7 +186,10 @@ class SpeedProfileProblem(Problem):
         x = np.asarray(x, dtype=float)
         if x.ndim != 1 or x.shape[0] != self.n_var:
             raise ValueError(f"x must be one decision vector of length n_var = {self.n_var}, got shape {x.shape}")
-        return self.simulator.run(self.encoding.programs(x[None, :])[0])
+        program = self.encoding.programs(x[None, :])[0]
+        if self.tracker is not None:
+            return self.tracker.run_program(program)
+        return self.simulator.run(program)
 
     def describe(self) -> str:
         form = "weighted sum" if self.weights is not None else (

@@ -69,7 +69,7 @@ _KIND_TRACTION, _KIND_COAST, _KIND_BRAKE = 0, 1, 2
 _J_PER_KWH = 3.6e6
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _full_step(m, v0, cell, kind):
     """Two-stage step over one cell at maximum traction, coasting or maximum braking.
 
@@ -94,7 +94,7 @@ def _full_step(m, v0, cell, kind):
     return u1, f, w0, v_half
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _share_above(v0, v1, v_cut):
     """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
     lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
@@ -105,67 +105,190 @@ def _share_above(v0, v1, v_cut):
     return (hi * hi - v_cut * v_cut) / (hi * hi - lo * lo)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _landing_force(m, v0, v1, cell):
     """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
 
     Returns (force, W0, feasible): feasible is False when the force exceeds what the train has.
+    The tolerance is relative (1e-8): the braking envelope is built with the maximum braking force
+    at an iterated mid-speed, and landing on it can need that force plus a rounding residue far
+    above 1e-9 N when the force depends on speed (power caps, no deceleration cap).
     """
     v_mid = 0.5 * (v0 + v1)
     w0 = davis_force(m, v_mid)
     f = m.effective_mass_kg * (v1 * v1 - v0 * v0) / (2.0 * m.dx_m) + w0 + m.line_force_n[cell]
     if f > 0.0:
-        feasible = f <= max_traction(m, v_mid, cell) + 1e-9
+        f_max = max_traction(m, v_mid, cell)
+        feasible = f <= f_max + 1e-9 + 1e-8 * f_max
     else:
-        feasible = -f <= max_braking(m, v_mid, cell) + 1e-9
+        f_max = max_braking(m, v_mid, cell)
+        feasible = -f <= f_max + 1e-9 + 1e-8 * f_max
     return f, w0, feasible
 
 
+# Slots of the running totals of a run (see ``new_totals``).
+_T_TIME, _T_TRAC, _T_BRAKE, _T_ELEC, _T_DAVIS, _T_LINE, _T_GRADE, _T_NEUTRAL = 0, 1, 2, 3, 4, 5, 6, 7
+_T_JERK, _T_PREV_ACC, _T_MAX_ACC, _T_PREV_REGIME, _T_CHANGES, _T_EXCESS = 8, 9, 10, 11, 12, 13
+N_TOTALS = 14
+TOTAL_TIME = _T_TIME  # the clock, for kernels that drive the train themselves (control)
+
+
 @njit(cache=True)
+def new_totals():
+    """Running totals of a run (time, works, comfort and limit figures) as a tuple.
+
+    A tuple, not an array: the kernels rebind it every cell and Numba keeps it in registers.
+    """
+    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300)
+
+
+@njit(cache=True, inline="always")
+def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
+    """Keep a step under the braking envelope and name its regime by the force applied.
+
+    Whatever a driver or controller asked for, the train lands on the envelope at the end of the
+    cell if it would rise above it. Returns (u1, force, W0, regime, clamped).
+    """
+    cap = m.envelope_ms[cell + 1]
+    clamped = u1 > cap * cap
+    if clamped:
+        fl, w0l, ok = _landing_force(m, v, cap, cell)
+        if ok:
+            u1, f, w0 = cap * cap, fl, w0l
+        else:  # cannot brake hard enough by a rounding margin: brake fully, record the excess
+            u1, f, w0, _ = _full_step(m, v, cell, _KIND_BRAKE)
+        if f < 0.0 and cap < m.limit_ms[cell + 1] - 1e-9:
+            regime = REGIME_BRAKE
+        elif f != 0.0:
+            regime = REGIME_CRUISE
+    if f == 0.0:
+        regime = REGIME_COAST
+    elif f > 0.0 and regime == REGIME_COAST:
+        regime = REGIME_CRUISE
+    return u1, f, w0, regime, clamped
+
+
+@njit(cache=True, inline="always")
+def complete_cell(m, totals, cell, v, u1, f, w0, regime):
+    """Finish one cell: standstill inside it, time, energy accounting, comfort.
+
+    Returns (v1, stopped, position reached, acceleration, updated totals). No arrays beyond the
+    model go in: array arguments of a per-cell function cost reference counting every cell.
+    """
+    n = m.position_m.shape[0]
+    dx = m.dx_m
+    # only a landing on the platform node ends at exactly zero speed without stopping short
+    stopped = u1 < 0.0 or (u1 == 0.0 and cell < n - 2)
+    a_cell = (u1 - v * v) / (2.0 * dx)  # before clamping: it sets the stopping distance
+    d = dx
+    if stopped:
+        d = -v * v / (2.0 * a_cell) if a_cell < 0.0 else 0.0
+        if d > dx:
+            d = dx
+    if u1 < 0.0:
+        u1 = 0.0
+    v1 = math.sqrt(u1)
+    (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
+     jerk, prev_acc, max_acc, prev_regime, changes, excess) = totals
+    time_s += 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
+    brake_n = -f if f < 0.0 else 0.0
+    if f > 0.0:
+        w_trac += f * d
+        if m.neutral[cell] != 0:
+            w_neutral += f * d
+    w_brake += brake_n * d
+    if brake_n > 0.0:
+        share = _share_above(v, v1, m.regen_min_speed_ms)
+        w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
+    w_davis += w0 * d
+    w_line += m.line_force_n[cell] * d
+    w_grade += m.grade_force_n[cell] * d
+    jerk += abs(a_cell - prev_acc)
+    if abs(a_cell) > max_acc:
+        max_acc = abs(a_cell)
+    if prev_regime >= 0.0 and regime != prev_regime:
+        changes += 1.0
+    if v1 - m.limit_ms[cell + 1] > excess:
+        excess = v1 - m.limit_ms[cell + 1]
+    x1 = m.position_m[cell] + d
+    totals = (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
+              jerk, a_cell, max_acc, float(regime), changes, excess)
+    return v1, stopped, x1, a_cell, totals
+
+
+@njit(cache=True)
+def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime):
+    """Write one cell into the trace arrays."""
+    tr_x[cell + 1] = x1
+    tr_v[cell + 1] = v1
+    tr_t[cell + 1] = t
+    tr_a[cell] = a_cell
+    tr_f[cell] = f
+    tr_r[cell] = regime
+
+
+@njit(cache=True)
+def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r):
+    """Close a run (back to rest) and write its ``OUT_*`` summary."""
+    length = m.position_m[m.position_m.shape[0] - 1]
+    jerk = totals[_T_JERK] + abs(totals[_T_PREV_ACC])
+    if record:
+        tr_a[count - 1] = 0.0
+        tr_f[count - 1] = 0.0
+        tr_r[count - 1] = REGIME_BRAKE if reached else REGIME_COAST
+    t = totals[_T_TIME]
+    out[OUT_TRACTION_KWH] = totals[_T_TRAC] / m.traction_efficiency / _J_PER_KWH
+    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[_T_ELEC] / _J_PER_KWH
+    out[OUT_AUX_KWH] = m.aux_power_w * t / _J_PER_KWH
+    out[OUT_NET_KWH] = out[OUT_TRACTION_KWH] + out[OUT_AUX_KWH] - out[OUT_REGEN_KWH]
+    out[OUT_RUNNING_TIME_S] = t
+    out[OUT_STOP_POSITION_M] = stop_pos
+    out[OUT_STOP_ERROR_M] = abs(length - stop_pos)
+    out[OUT_JERK_MS2] = jerk
+    out[OUT_REGIME_CHANGES] = totals[_T_CHANGES]
+    out[OUT_LIMIT_EXCESS_MS] = totals[_T_EXCESS] if totals[_T_EXCESS] > 0.0 else 0.0
+    out[OUT_TRACTION_WORK_J] = totals[_T_TRAC]
+    out[OUT_BRAKE_WORK_J] = totals[_T_BRAKE]
+    out[OUT_DAVIS_WORK_J] = totals[_T_DAVIS]
+    out[OUT_LINE_WORK_J] = totals[_T_LINE]
+    out[OUT_GRADE_WORK_J] = totals[_T_GRADE]
+    out[OUT_FINAL_SPEED_MS] = v
+    out[OUT_REACHED] = 1.0 if reached else 0.0
+    out[OUT_ELECTRIC_BRAKE_WORK_J] = totals[_T_ELEC]
+    out[OUT_MAX_ABS_ACCEL_MS2] = totals[_T_MAX_ACC]
+    out[OUT_NEUTRAL_TRACTION_J] = totals[_T_NEUTRAL]
+
+
+# No reference counting inside: the run allocates nothing, and NRT incref/decref pairs on the
+# model's arrays in every inlined helper call were half the cost of a cell (benchmarks/simulator.py).
+@njit(cache=True, _nrt=False)
 def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     """Simulate one run; write the summary into ``out`` and, if ``record``, the trace arrays.
 
     Returns the number of trace nodes written (nodes 0..count-1 are valid).
     """
     n = m.position_m.shape[0]
-    length = m.position_m[n - 1]
-    dx = m.dx_m
     n_rows = program.shape[0]
+    totals = new_totals()
     v = 0.0
-    t = 0.0
     row = 0
     hold_speed = -1.0
-    w_trac = 0.0
-    w_brake = 0.0
-    w_elec = 0.0
-    w_davis = 0.0
-    w_line = 0.0
-    w_grade = 0.0
-    w_neutral = 0.0
-    jerk = 0.0
-    prev_acc = 0.0
-    max_abs_acc = 0.0
-    prev_regime = -1
-    changes = 0
-    excess = -1e300
-    reached = 1.0
-    stop_pos = length
+    reached = True
+    stop_pos = m.position_m[n - 1]
     count = 1
     if record:
         tr_x[0] = 0.0
         tr_v[0] = 0.0
         tr_t[0] = 0.0
     for i in range(n - 1):
-        x_mid = m.position_m[i] + 0.5 * dx
+        x_mid = m.position_m[i] + 0.5 * m.dx_m
         while row < n_rows - 1 and x_mid > program[row, 0]:
             row += 1
             hold_speed = -1.0
         mode = int(program[row, 1])
         target = program[row, 2]
-        cap = m.envelope_ms[i + 1]
 
-        # 1. what the program asks for
-        landed = False
+        # what the program asks for
         if mode == MODE_HOLD:
             if hold_speed < 0.0:
                 hold_speed = v
@@ -175,16 +298,15 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
                 mode = MODE_TOWARD
                 target = hold_speed
         if mode == MODE_TOWARD:
+            landed = False
             if v < target:
                 u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
                 regime = REGIME_TRACTION
-                if u1 > target * target:
-                    landed = True
+                landed = u1 > target * target
             else:
                 u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
                 regime = REGIME_COAST
-                if u1 < target * target:
-                    landed = True
+                landed = u1 < target * target
             if landed:
                 fl, w0l, ok = _landing_force(m, v, target, i)
                 if ok:
@@ -200,94 +322,16 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
             u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
             regime = REGIME_COAST
 
-        # 2. never above the braking envelope (limits ahead, the platform)
-        if u1 > cap * cap:
-            fl, w0l, ok = _landing_force(m, v, cap, i)
-            if ok:
-                u1, f, w0 = cap * cap, fl, w0l
-            else:  # cannot brake hard enough by a rounding margin: brake fully, record the excess
-                u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)
-            if f < 0.0 and cap < m.limit_ms[i + 1] - 1e-9:
-                regime = REGIME_BRAKE
-            elif f != 0.0:
-                regime = REGIME_CRUISE
-        if f == 0.0:
-            regime = REGIME_COAST
-        elif f > 0.0 and regime == REGIME_COAST:
-            regime = REGIME_CRUISE
-
-        # 3. standstill inside the cell (before the platform) ends the run
-        # (only a landing on the platform node ends at exactly zero speed without stopping short)
-        stopped = u1 < 0.0 or (u1 == 0.0 and i < n - 2)
-        a_cell = (u1 - v * v) / (2.0 * dx)  # before clamping: it sets the stopping distance
-        d = dx
-        if stopped:
-            d = -v * v / (2.0 * a_cell) if a_cell < 0.0 else 0.0
-            if d > dx:
-                d = dx
-        if u1 < 0.0:
-            u1 = 0.0
-        v1 = math.sqrt(u1)
-        dt = 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
-        t += dt
-        brake_n = -f if f < 0.0 else 0.0
-        if f > 0.0:
-            w_trac += f * d
-            if m.neutral[i] != 0:
-                w_neutral += f * d
-        w_brake += brake_n * d
-        if brake_n > 0.0:
-            w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * _share_above(v, v1, m.regen_min_speed_ms)
-        w_davis += w0 * d
-        w_line += m.line_force_n[i] * d
-        w_grade += m.grade_force_n[i] * d
-        jerk += abs(a_cell - prev_acc)
-        prev_acc = a_cell
-        if abs(a_cell) > max_abs_acc:
-            max_abs_acc = abs(a_cell)
-        if prev_regime >= 0 and regime != prev_regime:
-            changes += 1
-        prev_regime = regime
-        if v1 - m.limit_ms[i + 1] > excess:
-            excess = v1 - m.limit_ms[i + 1]
+        u1, f, w0, regime, _ = clamp_to_envelope(m, v, i, u1, f, w0, regime)
+        v, stopped, x1, a_cell, totals = complete_cell(m, totals, i, v, u1, f, w0, regime)
         if record:
-            tr_x[i + 1] = m.position_m[i] + d
-            tr_v[i + 1] = v1
-            tr_t[i + 1] = t
-            tr_a[i] = a_cell
-            tr_f[i] = f
-            tr_r[i] = regime
+            record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[_T_TIME], a_cell, f, regime)
         count = i + 2
-        v = v1
         if stopped:
-            reached = 0.0
-            stop_pos = m.position_m[i] + d
+            reached = False
+            stop_pos = x1
             break
-    jerk += abs(prev_acc)  # back to rest
-    if record:
-        tr_a[count - 1] = 0.0
-        tr_f[count - 1] = 0.0
-        tr_r[count - 1] = REGIME_BRAKE if reached > 0.0 else REGIME_COAST
-    out[OUT_TRACTION_KWH] = w_trac / m.traction_efficiency / _J_PER_KWH
-    out[OUT_REGEN_KWH] = m.regen_efficiency * w_elec / _J_PER_KWH
-    out[OUT_AUX_KWH] = m.aux_power_w * t / _J_PER_KWH
-    out[OUT_NET_KWH] = out[OUT_TRACTION_KWH] + out[OUT_AUX_KWH] - out[OUT_REGEN_KWH]
-    out[OUT_RUNNING_TIME_S] = t
-    out[OUT_STOP_POSITION_M] = stop_pos
-    out[OUT_STOP_ERROR_M] = abs(length - stop_pos)
-    out[OUT_JERK_MS2] = jerk
-    out[OUT_REGIME_CHANGES] = changes
-    out[OUT_LIMIT_EXCESS_MS] = excess if excess > 0.0 else 0.0
-    out[OUT_TRACTION_WORK_J] = w_trac
-    out[OUT_BRAKE_WORK_J] = w_brake
-    out[OUT_DAVIS_WORK_J] = w_davis
-    out[OUT_LINE_WORK_J] = w_line
-    out[OUT_GRADE_WORK_J] = w_grade
-    out[OUT_FINAL_SPEED_MS] = v
-    out[OUT_REACHED] = reached
-    out[OUT_ELECTRIC_BRAKE_WORK_J] = w_elec
-    out[OUT_MAX_ABS_ACCEL_MS2] = max_abs_acc
-    out[OUT_NEUTRAL_TRACTION_J] = w_neutral
+    write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r)
     return count
 
 

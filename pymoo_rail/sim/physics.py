@@ -75,7 +75,7 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
     return model._replace(envelope_ms=braking_envelope(model))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def curve_force(v, breaks, coefs, max_n, max_w):
     """Piecewise polynomial force limit at speed v, capped by a force and a power."""
     k = 0
@@ -96,13 +96,13 @@ def curve_force(v, breaks, coefs, max_n, max_w):
     return f
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def davis_force(m, v):
     """Basic running resistance W0(v) in N."""
     return m.davis_a_n + (m.davis_b_nsm + m.davis_c_ns2m2 * v) * v
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def max_traction(m, v, cell):
     """Largest usable traction force in a cell: the curve, the acceleration cap, neutral sections."""
     if m.neutral[cell] != 0:
@@ -116,7 +116,7 @@ def max_traction(m, v, cell):
     return f
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def max_braking(m, v, cell):
     """Largest usable braking force in a cell: the curve and the deceleration cap."""
     f = curve_force(v, m.brake_breaks_ms, m.brake_coefs, m.brake_max_n, m.brake_max_w)
@@ -128,7 +128,7 @@ def max_braking(m, v, cell):
     return f
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def electric_braking_capped(m, v, brake_n):
     """The part of a braking force within the motors' regen force and power caps."""
     f = brake_n
@@ -139,7 +139,7 @@ def electric_braking_capped(m, v, brake_n):
     return f
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def electric_braking(m, v, brake_n):
     """The part of a braking force the motors take (and regenerate) at speed v; the rest is friction.
 

@@ -1,0 +1,205 @@
+"""Building blocks shared by the bee-colony algorithms (ABC and MOABC).
+
+The functions here are pure: random numbers come from the generator that is passed in (the
+algorithm's ``random_state``), never from global state. ``BeeColony`` is the cycle both
+algorithms run.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pymoo.core.algorithm import Algorithm
+from pymoo.util.display.column import Column
+
+
+def check_colony_size(pop_size: object, minimum: int) -> int:
+    """Validate the colony size and return the number of food sources ``SN``.
+
+    Parameters
+    ----------
+    pop_size
+        Colony size (employed plus onlooker bees). Must be an even integer
+        (employed bees = onlooker bees = food sources).
+    minimum
+        Smallest allowed colony size.
+
+    Returns
+    -------
+    int
+        ``pop_size // 2``, the number of food sources.
+
+    Raises
+    ------
+    ValueError
+        If ``pop_size`` is not an integer, is odd or is smaller than ``minimum``.
+    """
+    if isinstance(pop_size, bool) or not isinstance(pop_size, (int, np.integer)):
+        raise ValueError(f"pop_size must be an even integer >= {minimum}, got {pop_size!r}")
+    if pop_size < minimum:
+        raise ValueError(f"pop_size must be an even integer >= {minimum}, got {pop_size}")
+    if pop_size % 2 != 0:
+        raise ValueError(
+            f"pop_size must be even (colony = employed + onlooker bees, one employed bee per "
+            f"food source), got {pop_size}"
+        )
+    return int(pop_size) // 2
+
+
+def check_limit(limit: object) -> int | None:
+    """Validate the abandonment limit (``None`` means the default ``SN * D``)."""
+    if limit is None:
+        return None
+    if isinstance(limit, bool) or not isinstance(limit, (int, np.integer)) or limit < 0:
+        raise ValueError(f"limit must be None or an integer >= 0, got {limit!r}")
+    return int(limit)
+
+
+def check_bounds(problem) -> tuple[np.ndarray, np.ndarray]:
+    """Return the bounds ``(xl, xu)`` of a problem; bee colonies need finite bounds."""
+    if not problem.has_bounds():
+        raise ValueError("bee colony algorithms need a problem with finite bounds xl and xu")
+    xl, xu = problem.bounds()
+    xl = np.asarray(xl, dtype=float)
+    xu = np.asarray(xu, dtype=float)
+    if not (np.all(np.isfinite(xl)) and np.all(np.isfinite(xu))):
+        raise ValueError("bee colony algorithms need a problem with finite bounds xl and xu")
+    return xl, xu
+
+
+def one_variable_move(
+    X: np.ndarray,
+    partners: np.ndarray,
+    xl: np.ndarray,
+    xu: np.ndarray,
+    random_state: np.random.Generator,
+    centre_on_partner: bool = False,
+    scale: float = 1.0,
+) -> np.ndarray:
+    """Karaboga's neighbour move on one random variable per row, clamped to the bounds.
+
+    ``v_ij = x_ij + phi (x_ij - x_kj)`` (or ``x_kj + phi (x_ij - x_kj)`` when
+    ``centre_on_partner``), ``phi ~ scale * U[-1, 1]``, ``j`` uniform; all other variables
+    are copied from ``X``.
+
+    Parameters
+    ----------
+    X
+        Current positions, shape (n, n_var).
+    partners
+        Partner positions ``x_k``, shape (n, n_var).
+    xl, xu
+        Bounds used for clamping.
+    random_state
+        Generator for ``j`` and ``phi``.
+    centre_on_partner
+        Centre the move on the partner instead of on ``x_i``.
+    scale
+        Multiplies ``phi``.
+
+    Returns
+    -------
+    numpy.ndarray
+        New positions, shape (n, n_var).
+    """
+    n, n_var = X.shape
+    rows = np.arange(n)
+    j = random_state.integers(0, n_var, size=n)
+    phi = scale * random_state.uniform(-1.0, 1.0, size=n)
+    x_ij = X[rows, j]
+    x_kj = partners[rows, j]
+    centre = x_kj if centre_on_partner else x_ij
+    V = X.copy()
+    V[rows, j] = np.clip(centre + phi * (x_ij - x_kj), xl[j], xu[j])
+    return V
+
+
+def random_partners(n: int, random_state: np.random.Generator) -> np.ndarray:
+    """For each food source ``i`` in ``0..n-1`` draw a partner ``k != i`` uniformly."""
+    k = random_state.integers(0, n - 1, size=n)
+    # shift indices >= i up by one so k is uniform over the other n - 1 sources
+    return k + (k >= np.arange(n))
+
+
+def feasibility_first_better(
+    f_new: float, cv_new: float, f_old: float, cv_old: float
+) -> bool:
+    """Deb's feasibility-first comparison of two single-objective solutions.
+
+    A solution with smaller constraint violation wins while the old one is infeasible;
+    between feasible ones the strictly smaller objective wins. Ties (e.g. an offspring
+    equal to its parent) are not an improvement.
+    """
+    if cv_old > 0.0:
+        return cv_new < cv_old
+    return cv_new <= 0.0 and f_new < f_old
+
+
+def constraint_dominates(f_a: np.ndarray, cv_a: float, f_b: np.ndarray, cv_b: float) -> bool:
+    """Whether ``a`` constraint-dominates ``b`` (Deb): less violation first, then Pareto."""
+    if cv_a < cv_b:
+        return True
+    if cv_b < cv_a:
+        return False
+    return bool(np.all(f_a <= f_b) and np.any(f_a < f_b))
+
+
+def roulette(probabilities: np.ndarray, n: int, random_state: np.random.Generator) -> np.ndarray:
+    """Draw ``n`` indices with the given probabilities (with replacement)."""
+    return random_state.choice(len(probabilities), size=n, replace=True, p=probabilities)
+
+
+EMPLOYED, ONLOOKER, SCOUT = "employed", "onlooker", "scout"
+
+
+class BeeColony(Algorithm):
+    """The employed - onlooker - scout cycle as one pymoo iteration.
+
+    ``_advance`` returns False between the phases, so each phase is one ask/tell and nothing is
+    evaluated inside the algorithm. Subclasses provide ``_infill`` for the current ``_phase``,
+    ``_greedy(infills)`` (keep better candidates, count trials), ``_end_cycle(n_scouts)``, and
+    may override ``_observe(infills)`` to see every evaluated candidate (MOABC's archive).
+    Subclasses set ``trials`` (per source) and ``_limit``.
+    """
+
+    def _observe(self, infills) -> None:
+        """Called with every evaluated batch before it is used."""
+
+    def _advance(self, infills=None, **kwargs) -> bool:
+        if infills is None:
+            raise ValueError(f"{type(self).__name__} uses ask/tell: tell() needs the evaluated infills")
+        self._observe(infills)
+
+        if self._phase == SCOUT:
+            self.pop[self._scouts] = infills
+            self.trials[self._scouts] = 0
+            self._end_cycle(len(self._scouts))
+            return True
+
+        self._greedy(infills)
+
+        if self._phase == EMPLOYED:
+            self._phase = ONLOOKER
+            return False
+
+        self._scouts = np.flatnonzero(self.trials > self._limit)
+        if len(self._scouts) > 0:
+            self._phase = SCOUT
+            return False
+        self._end_cycle(0)
+        return True
+
+
+class ScoutColumn:
+    """Mixin for a pymoo output: adds the number of scouts sent in the last cycle."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.n_scouts = Column(name="n_scouts", width=8)
+
+    def initialize(self, algorithm) -> None:
+        super().initialize(algorithm)
+        self.columns += [self.n_scouts]
+
+    def update(self, algorithm) -> None:
+        super().update(algorithm)
+        self.n_scouts.set(algorithm.n_scouts)

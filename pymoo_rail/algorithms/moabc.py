@@ -1,0 +1,264 @@
+"""Multi-objective Artificial Bee Colony (MOABC) of seed 000, section 4.5.2.
+
+Pareto-dominance greedy choice, onlooker fitness ``dom(i) / N``, an external archive of
+non-dominated solutions truncated by crowding distance, and a neighbour search guided by
+a random archive member. Same ask/tell structure as :class:`pymoo_rail.algorithms.ABC`:
+one pymoo iteration is one full cycle.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pymoo.core.population import Population
+from pymoo.core.sampling import Sampling
+from pymoo.operators.sampling.rnd import FloatRandomSampling
+from pymoo.operators.survival.rank_and_crowding.metrics import calc_crowding_distance
+from pymoo.util.display.multi import MultiObjectiveOutput
+from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+from pymoo_rail.algorithms._bees import (
+    EMPLOYED,
+    ONLOOKER,
+    SCOUT,
+    BeeColony,
+    ScoutColumn,
+    check_bounds,
+    check_colony_size,
+    check_limit,
+    constraint_dominates,
+    one_variable_move,
+    roulette,
+)
+
+MOVES = ("centred", "canonical", "literal")
+
+
+class MOABCOutput(ScoutColumn, MultiObjectiveOutput):
+    """Verbose output of :class:`MOABC`: pymoo's multi-objective columns plus scouts."""
+
+
+def domination_counts(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
+    """``dom(i)``: how many members of the set solution ``i`` constraint-dominates."""
+    n = len(F)
+    less_eq = np.all(F[:, None, :] <= F[None, :, :], axis=2)
+    less = np.any(F[:, None, :] < F[None, :, :], axis=2)
+    pareto = less_eq & less & (CV[:, None] == CV[None, :])
+    dominates = (CV[:, None] < CV[None, :]) | pareto
+    dominates[np.arange(n), np.arange(n)] = False
+    return dominates.sum(axis=1)
+
+
+def dominance_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
+    """Onlooker probabilities ``P_i = fit_i / sum(fit)`` with ``fit_i = dom(i) / N``.
+
+    Seed 000, eq. 4-25 with eq. 3-5. When no food source dominates another (all mutually
+    non-dominated, usual late in a run) every ``fit_i`` is 0 and ``P`` is uniform.
+    """
+    fit = domination_counts(F, CV) / len(F)
+    total = fit.sum()
+    if total == 0.0:
+        return np.full(len(F), 1.0 / len(F))
+    return fit / total
+
+
+def nondominated(pop: Population) -> Population:
+    """Constraint-non-dominated members of ``pop``, without duplicate ``X``, in order.
+
+    With at least one feasible member these are the feasible Pareto-optimal ones;
+    otherwise the least-violating ones (ties broken by Pareto dominance).
+    """
+    if len(pop) == 0:
+        return pop
+    _, first = np.unique(pop.get("X"), axis=0, return_index=True)
+    pop = pop[np.sort(first)]
+    CV = pop.get("CV")[:, 0]
+    pop = pop[CV == CV.min()]
+    front = NonDominatedSorting().do(pop.get("F"), only_non_dominated_front=True)
+    return pop[np.sort(front)]
+
+
+def truncate_by_crowding(pop: Population, max_size: int) -> Population:
+    """Remove the most crowded member, one at a time, until ``len(pop) <= max_size``.
+
+    Crowding distance as in NSGA-II (seed 000, eq. 4-26), recomputed after every removal;
+    boundary points have infinite distance. Ties go to the lowest index, so the result is
+    deterministic.
+    """
+    while len(pop) > max_size:
+        cd = calc_crowding_distance(pop.get("F"))
+        keep = np.ones(len(pop), dtype=bool)
+        keep[int(np.argmin(cd))] = False
+        pop = pop[keep]
+    return pop
+
+
+class MOABC(BeeColony):
+    """Multi-objective Artificial Bee Colony (seed 000, section 4.5.2).
+
+    Parameters
+    ----------
+    pop_size : int
+        Colony size (employed plus onlooker bees), even and at least 2; there are
+        ``SN = pop_size // 2`` food sources. The initial sample has ``pop_size`` points;
+        the ``SN`` with the largest ``dom(i)`` become food sources (seed 000, 4.5.3 step 3)
+        and its non-dominated points start the archive.
+    archive_size : int
+        Maximum size of the external archive.
+    w : float
+        Scale factor ``w_1`` of eq. 4-27 (``"literal"``); scales ``phi`` for the other
+        moves.
+    move : {"centred", "canonical", "literal"}
+        Neighbour search, always guided by a random archive member ``x_k``:
+
+        * ``"centred"`` (default): one random variable ``j``,
+          ``v_j = x_kj + w phi (x_ij - x_kj)``, ``phi ~ U[-1, 1]``.
+        * ``"canonical"``: Karaboga's move with the archive member as partner,
+          ``v_j = x_ij + w phi (x_ij - x_kj)``.
+        * ``"literal"``: eq. 4-27 read literally, all variables,
+          ``v = x_i + w r (x_i - x_k)``, ``r ~ U[0, 1]``.
+
+        The literal move pushes ``x_i`` away from the archive and does not converge
+        (IGD around 2 on ZDT1); the canonical move converges; centring on the archive
+        member pulls the changed variable into the neighbourhood of the current front
+        and converges fastest (see ``benchmarks/reports/moabc_zdt.md``).
+    limit : int, optional
+        Trial limit before a food source is abandoned (scout). Default ``SN * n_var``.
+    sampling : pymoo Sampling
+        Initial colony and scouts.
+    output : pymoo Output
+        Verbose output.
+    **kwargs
+        Passed on to :class:`pymoo.core.algorithm.Algorithm`.
+
+    Notes
+    -----
+    * Greedy choice: a candidate replaces its food source only if it constraint-dominates
+      it (less violation, or equal violation and Pareto-dominance). Otherwise the source
+      stays and its trial counter grows by one (also when the two are mutually
+      non-dominated; the candidate still reaches the archive).
+    * Onlookers choose food sources by roulette on ``fit_i = dom(i) / N`` where ``dom(i)``
+      counts the food sources that ``i`` constraint-dominates and ``N = SN``; see
+      :func:`dominance_probabilities`.
+    * The archive (attribute ``pareto_archive``) receives every evaluated candidate, keeps
+      the constraint-non-dominated ones and, above ``archive_size``, drops the most crowded
+      point one at a time (:func:`truncate_by_crowding`). ``opt``, and therefore
+      ``res.X``/``res.F``, is this archive; ``pop`` holds the current food sources.
+    """
+
+    def __init__(
+        self,
+        pop_size: int = 100,
+        archive_size: int = 100,
+        w: float = 1.0,
+        move: str = "centred",
+        limit: int | None = None,
+        sampling: Sampling = FloatRandomSampling(),
+        output=MOABCOutput(),
+        **kwargs,
+    ) -> None:
+        super().__init__(output=output, **kwargs)
+        self.n_sources = check_colony_size(pop_size, minimum=2)
+        self.pop_size = int(pop_size)
+        if (
+            isinstance(archive_size, bool)
+            or not isinstance(archive_size, (int, np.integer))
+            or archive_size < 1
+        ):
+            raise ValueError(f"archive_size must be an integer >= 1, got {archive_size!r}")
+        self.archive_size = int(archive_size)
+        if move not in MOVES:
+            raise ValueError(f"move must be one of {MOVES}, got {move!r}")
+        self.move = move
+        if not np.isfinite(w) or w <= 0:
+            raise ValueError(f"w must be a positive finite number, got {w!r}")
+        self.w = float(w)
+        self.limit = check_limit(limit)
+        self.sampling = sampling
+
+        self.pareto_archive: Population | None = None
+        self.trials: np.ndarray | None = None
+        self.n_scouts = 0
+        self._phase = EMPLOYED
+        self._parents: np.ndarray | None = None
+        self._scouts: np.ndarray | None = None
+        self._xl: np.ndarray | None = None
+        self._xu: np.ndarray | None = None
+        self._limit: int | None = None
+
+    def _setup(self, problem, **kwargs) -> None:
+        self._xl, self._xu = check_bounds(problem)
+        self._limit = self.limit if self.limit is not None else self.n_sources * problem.n_var
+
+    # ------------------------------------------------------------------ initialisation
+    def _initialize_infill(self) -> Population:
+        return self.sampling.do(self.problem, self.pop_size, random_state=self.random_state)
+
+    def _initialize_advance(self, infills=None, **kwargs) -> None:
+        dom = domination_counts(infills.get("F"), infills.get("CV")[:, 0])
+        best = np.argsort(-dom, kind="stable")[: self.n_sources]
+        self.pop = infills[np.sort(best)]
+        self.pareto_archive = Population.empty()
+        self._update_archive(infills)
+        self.trials = np.zeros(self.n_sources, dtype=int)
+        self.n_scouts = 0
+        self._phase = EMPLOYED
+
+    # ------------------------------------------------------------------ one cycle
+    def _infill(self) -> Population:
+        if self._phase == SCOUT:
+            self._parents = self._scouts
+            return self.sampling.do(
+                self.problem, len(self._scouts), random_state=self.random_state
+            )
+        if self._phase == EMPLOYED:
+            self._parents = np.arange(self.n_sources)
+        else:
+            P = dominance_probabilities(self.pop.get("F"), self.pop.get("CV")[:, 0])
+            self._parents = roulette(P, self.n_sources, self.random_state)
+
+        X = self.pop.get("X")[self._parents]
+        guides = self.random_state.integers(0, len(self.pareto_archive), size=len(X))
+        X_k = self.pareto_archive.get("X")[guides]
+        return Population.new(X=self._move(X, X_k))
+
+    def _move(self, X: np.ndarray, X_k: np.ndarray) -> np.ndarray:
+        if self.move == "literal":
+            r = self.random_state.random((len(X), 1))
+            return np.clip(X + self.w * r * (X - X_k), self._xl, self._xu)
+        return one_variable_move(
+            X,
+            X_k,
+            self._xl,
+            self._xu,
+            self.random_state,
+            centre_on_partner=self.move == "centred",
+            scale=self.w,
+        )
+
+    def _observe(self, infills: Population) -> None:
+        self._update_archive(infills)  # every evaluated candidate may enter the archive
+
+    def _greedy(self, infills: Population) -> None:
+        """Replace a source by a candidate that constraint-dominates it; count trials."""
+        off_F, off_CV = infills.get("F"), infills.get("CV")[:, 0]
+        pop_F, pop_CV = self.pop.get("F"), self.pop.get("CV")[:, 0]
+        for c, i in enumerate(self._parents):
+            if constraint_dominates(off_F[c], off_CV[c], pop_F[i], pop_CV[i]):
+                self.pop[i] = infills[c]
+                pop_F[i], pop_CV[i] = off_F[c], off_CV[c]
+                self.trials[i] = 0
+            else:
+                self.trials[i] += 1
+
+    def _update_archive(self, infills: Population) -> None:
+        merged = Population.merge(self.pareto_archive, infills)
+        self.pareto_archive = truncate_by_crowding(nondominated(merged), self.archive_size)
+
+    def _end_cycle(self, n_scouts: int) -> None:
+        self.n_scouts = n_scouts
+        self._phase = EMPLOYED
+        self._parents = None
+        self._scouts = None
+
+    def _set_optimum(self) -> None:
+        self.opt = self.pareto_archive

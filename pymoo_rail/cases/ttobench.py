@@ -1,0 +1,671 @@
+"""TTOBench import and export: JSON tracks and trains to :class:`~pymoo_rail.model.Case` and back.
+
+TTOBench (Kouzoupis, Pendharkar and Corman, Operations Research Forum 4, 67, 2023; BSD 2-Clause)
+is the open benchmark library for train trajectory optimisation. A *track* file holds the stops,
+the speed limits and the gradients of a whole line as change-point lists; a *train* file holds
+scalar parameters, each as ``{"unit": ..., "value": ...}``. This module reads both into a
+:class:`Case` for one run between two stops, and writes a case back as a pair of files.
+
+>>> from pymoo_rail.cases.ttobench import (BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK,
+...                                        from_ttobench)
+>>> case = from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, "Tongjinan Rd", "Jinghai Rd", 150.0,
+...                      stop_names=YIZHUANG_STOP_NAMES)
+>>> case.line.length_m
+2265.0
+
+Mapping decisions (the full table is in ``docs/ttobench.md``):
+
+- Units: every value is converted by its stated unit; a missing or unknown unit is a
+  :class:`CaseError` naming the field. Efficiencies and ``rho`` in ``"%"`` are divided by 100
+  (a value below 1 with unit ``"%"`` is refused as ambiguous: it is almost certainly a fraction).
+- Davis resistance ``r0 + r1 v + r2 v^2`` is stored in kN with v in km/h, whatever the file's units.
+- Traction is ``min(max traction force, max traction power / v)``.
+- Braking: the model has one braking curve plus regen caps on its electric share. TTOBench's
+  total braking is ``max pn braking force + min(max reg braking force, max reg braking power / v)``
+  and the regen caps are the electric part. With no pneumatic force that is a force-plus-power
+  curve, exactly; with a pneumatic force and a reg power cap that binds below the maximum speed it
+  is a table with nodes 1 % apart in speed (linear interpolation of the hyperbola; relative error
+  below 2e-5).
+- Train length: TTOBench's benchmark formulations treat the train as a point mass and the train
+  files have an optional ``length``. ``train_length_m=None`` uses that length when the file has one
+  (limits hold over the whole train and gradients are averaged over it, seed 000 eq. 4-14), and a
+  point mass otherwise; ``0`` forces a point mass. The model needs a positive length, so a point
+  mass is a train of :data:`POINT_MASS_LENGTH_M` (1 mm) with ``gradient_model = "point_mass"``.
+- Efficiencies absent (TTOBench allows omitting both) give traction efficiency 1 and no regen,
+  so net energy is the traction work at the wheel.
+- Not represented (a :class:`CaseError` if present and not trivial): track ``curvatures`` with a
+  finite radius and ``tunnels`` (TTOBench's tunnel drag depends on cross-section and speed; the
+  model's tunnel term does not). Informational train fields (``num seats``, ``num coaches``,
+  ``tunnel resistance``, ``ETCS braking data``) are accepted and not used.
+
+The TTOBench files shipped in ``pymoo_rail/cases/data/`` (Yizhuang line and Beijing subway train)
+are copies under the BSD 2-Clause license; the notice is in ``data/TTOBENCH_LICENSE``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+
+from pymoo_rail.model import Case, CaseError, DavisResistance, ForceCurve, Line, Train
+from pymoo_rail.model.curves import KMH_PER_MS
+
+DATA_DIR = Path(__file__).resolve().parent / "data"
+YIZHUANG_TRACK = DATA_DIR / "CN_Songjiazhuang_Yizhuang.json"
+BEIJING_SUBWAY_TRAIN = DATA_DIR / "CN_Beijing_Subway.json"
+TTOBENCH_LICENSE = DATA_DIR / "TTOBENCH_LICENSE"
+TTOBENCH_NOTICE = "TTOBench data, BSD 2-Clause License, Copyright (c) 2022, Dimitris Kouzoupis"
+
+# TTOBench stores positions only. Station names of the Beijing Subway Yizhuang line in the order of
+# the stops in CN_Songjiazhuang_Yizhuang.json (public line map, not part of TTOBench). Stops 9 -> 10
+# are seed 000's Tongjinan Rd -> Jinghai Rd run (2265 m in both sources).
+YIZHUANG_STOP_NAMES = (
+    "Songjiazhuang", "Xiaocun", "Xiaohongmen", "Jiugong", "Yizhuangqiao", "Yizhuang Culture Park",
+    "Wanyuan St", "Rongjing East St", "Rongchang East St", "Tongjinan Rd", "Jinghai Rd", "Ciqu South",
+    "Ciqu", "Yizhuang Railway Station",
+)
+
+POINT_MASS_LENGTH_M = 0.001
+LIBRARY_VERSION = "TTOBench v1.3"
+# Relative spacing of the speed nodes of a tabulated braking curve (pneumatic + power-capped regen).
+_BRAKE_TABLE_RATIO = 1.01
+# Tolerance (relative to the largest braking force) of the export check on the braking curve.
+_BRAKE_CHECK_RTOL = 1e-4
+
+Source = Union[str, Path, Mapping]
+StopRef = Union[int, float, str]
+
+# Each accepted unit as (multiplier, divisor) to the unit used inside the case (t, km/h, kW, kN, m,
+# fractions); a divisor keeps exact decimals exact (70 % -> 0.7, not 0.7000000000000001).
+_LENGTH = {"m": (1.0, 1.0), "km": (1000.0, 1.0)}
+_MASS_T = {"kg": (1.0, 1000.0), "t": (1.0, 1.0)}
+_SPEED_KMH = {"km/h": (1.0, 1.0), "m/s": (KMH_PER_MS, 1.0)}
+_POWER_KW = {"W": (1.0, 1000.0), "kW": (1.0, 1.0), "MW": (1000.0, 1.0)}
+_FORCE_KN = {"N": (1.0, 1000.0), "kN": (1.0, 1.0)}
+_ACCEL = {"m/s^2": (1.0, 1.0)}
+_FRACTION = {"-": (1.0, 1.0), "%": (1.0, 100.0)}
+_R1_KN_PER_KMH = {"N/(m/s)": (1.0, 1000.0 * KMH_PER_MS), "kN/(m/s)": (1.0, KMH_PER_MS), "kN/(km/h)": (1.0, 1.0)}
+_R2_KN_PER_KMH2 = {"N/(m/s)^2": (1.0, 1000.0 * KMH_PER_MS**2), "kN/(m/s)^2": (1.0, KMH_PER_MS**2),
+                   "kN/(km/h)^2": (1.0, 1.0)}
+_SLOPE_PERMILLE = {"permil": (1.0, 1.0), "permille": (1.0, 1.0)}
+
+_TRAIN_REQUIRED = ("metadata", "mass", "max speed", "max traction power", "max reg braking power",
+                   "max traction force", "max reg braking force", "rolling resistance r0",
+                   "rolling resistance r1", "rolling resistance r2")
+_TRAIN_USED = {"rho", "length", "max pn braking force", "max acceleration", "max deceleration",
+               "efficiency traction", "efficiency reg brake"}
+_TRAIN_INFORMATIONAL = {"num seats", "num coaches", "tunnel resistance", "ETCS braking data"}
+_TRACK_REQUIRED = ("metadata", "stops", "speed limits")
+_TRACK_OPTIONAL = {"altitude", "gradients", "curvatures", "tunnels"}
+
+
+# ----------------------------------------------------------------------------------------- reading
+
+
+def _load(source: Source, what: str) -> tuple[dict, str]:
+    """The parsed JSON object and a label for error messages."""
+    if isinstance(source, Mapping):
+        return dict(source), f"<{what} dict>"
+    path = Path(source)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise CaseError("<file>", str(path), f"cannot read the TTOBench {what} file: {err.strerror}",
+                        str(path)) from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise CaseError("<file>", str(path), f"is not valid JSON: {err}", str(path)) from None
+    if not isinstance(data, dict):
+        raise CaseError("<file>", str(path), "a TTOBench file must hold a JSON object", str(path))
+    return data, str(path)
+
+
+def _number(field: str, value: Any, source: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise CaseError(field, value, "must be a finite number", source)
+    return float(value)
+
+
+def _unit_factor(field: str, unit: Any, units: Mapping[str, tuple[float, float]],
+                 source: str) -> tuple[float, float]:
+    if unit is None:
+        raise CaseError(field, None, f"is required: TTOBench values carry their unit (one of {', '.join(units)})",
+                        source)
+    if unit not in units:
+        raise CaseError(field, unit, f"unknown unit (known: {', '.join(units)})", source)
+    return units[unit]
+
+
+def _scalar(data: Mapping, key: str, units: Mapping[str, tuple[float, float]], source: str, *,
+            default: float | None = None) -> float | None:
+    """A ``{"unit", "value"}`` entry converted to the case's unit; ``default`` if absent."""
+    if key not in data:
+        return default
+    entry = data[key]
+    if not isinstance(entry, Mapping):
+        raise CaseError(key, entry, 'must be an object {"unit": ..., "value": ...}', source)
+    extra = sorted(set(entry) - {"unit", "value"})
+    if extra:
+        raise CaseError(f"{key}.{extra[0]}", entry[extra[0]], 'unknown key (expected "unit" and "value")', source)
+    factor = _unit_factor(f"{key}.unit", entry.get("unit"), units, source)
+    if "value" not in entry:
+        raise CaseError(f"{key}.value", None, "is required", source)
+    return _convert(_number(f"{key}.value", entry["value"], source), factor)
+
+
+def _fraction(data: Mapping, key: str, source: str, *, default: float | None = None) -> float | None:
+    """A dimensionless entry in ``"-"`` or ``"%"``; a percentage below 1 is ambiguous and refused."""
+    value = _scalar(data, key, _FRACTION, source, default=default)
+    if key in data and data[key].get("unit") == "%" and 0.0 < data[key]["value"] < 1.0 and key != "rho":
+        raise CaseError(f"{key}.value", data[key]["value"],
+                        "is below 1 % with unit '%': a fraction written as a percentage? "
+                        "Write unit '-' for a fraction or the value in percent", source)
+    return value
+
+
+def _convert(value: float, factor: tuple[float, float]) -> float:
+    mul, div = factor
+    return value * mul / div
+
+
+def _check_keys(data: Mapping, required: Sequence[str], allowed: set[str], what: str, source: str) -> None:
+    for key in required:
+        if key not in data:
+            raise CaseError(key, None, f"is required in a TTOBench {what} file", source)
+    unknown = sorted(set(data) - set(required) - allowed)
+    if unknown:
+        known = ", ".join(sorted(set(required) | allowed))
+        raise CaseError(unknown[0], data[unknown[0]], f"unknown field of a TTOBench {what} file (known: {known})",
+                        source)
+    meta = data["metadata"]
+    if not isinstance(meta, Mapping) or "id" not in meta:
+        raise CaseError("metadata.id", None, "is required", source)
+    if not isinstance(meta["id"], str) or not meta["id"]:
+        raise CaseError("metadata.id", meta["id"], "must be a non-empty string", source)
+
+
+def _change_points(data: Mapping, key: str, value_key: str, value_units: Mapping[str, tuple[float, float]],
+                   length_m: float, source: str) -> tuple[tuple[float, float], ...]:
+    """``[[position, value], ...]`` in m and the case's unit; sorted, from 0, inside the track."""
+    entry = data[key]
+    if not isinstance(entry, Mapping):
+        raise CaseError(key, entry, 'must be an object {"units": {...}, "values": [...]}', source)
+    units = entry.get("units")
+    if not isinstance(units, Mapping):
+        raise CaseError(f"{key}.units", units, f'is required: an object with "position" and "{value_key}"', source)
+    pos_factor = _unit_factor(f"{key}.units.position", units.get("position"), _LENGTH, source)
+    val_factor = _unit_factor(f"{key}.units.{value_key}", units.get(value_key), value_units, source)
+    values = entry.get("values")
+    if not isinstance(values, list) or not values:
+        raise CaseError(f"{key}.values", values, "must be a non-empty list of [position, value] pairs", source)
+    points: list[tuple[float, float]] = []
+    for k, pair in enumerate(values):
+        field = f"{key}.values[{k}]"
+        if not isinstance(pair, (list, tuple)) or len(pair) != 2:
+            raise CaseError(field, pair, "must be a [position, value] pair", source)
+        pos = _convert(_number(field, pair[0], source), pos_factor)
+        val = _convert(_number(field, pair[1], source), val_factor)
+        if k == 0 and pos != 0.0:
+            raise CaseError(field, list(pair), "the first change point must be at position 0", source)
+        if points and pos <= points[-1][0]:
+            raise CaseError(field, list(pair), f"positions must be sorted and strictly increasing "
+                                               f"(the previous change point is at {points[-1][0]} m)", source)
+        if pos >= length_m:
+            raise CaseError(field, list(pair), f"must start before the end of the track ({length_m} m)", source)
+        points.append((pos, val))
+    return tuple(points)
+
+
+@dataclass(frozen=True)
+class TTOBenchTrack:
+    """A TTOBench track in the case's units: positions in m, limits in km/h, gradients in permille.
+
+    ``speed_limits`` and ``gradients`` are change points ``(position_m, value)``: each value holds
+    from its position to the next change point (the last one to the end of the track).
+    """
+
+    id: str
+    stops_m: tuple[float, ...]
+    speed_limits: tuple[tuple[float, float], ...]
+    gradients: tuple[tuple[float, float], ...]
+    altitude_m: float = 0.0
+    metadata: Mapping[str, Any] = field(default_factory=dict, compare=False)
+
+    @property
+    def length_m(self) -> float:
+        return self.stops_m[-1]
+
+    def line(self, gradient_model: str = "point_mass") -> Line:
+        """The whole track as one :class:`Line` (stop 0 to the last stop)."""
+        return Line(length_m=self.length_m, gradients=_rows(self.gradients, self.length_m),
+                    speed_limits=_rows(self.speed_limits, self.length_m), gradient_model=gradient_model)
+
+    def stop_index(self, stop: StopRef, stop_names: Sequence[str] | None = None) -> int:
+        """Index of a stop given by index (int), name (str, needs ``stop_names``) or position (float, m).
+
+        Negative indices count from the last stop. A position must match a stop within 0.5 m.
+        """
+        n = len(self.stops_m)
+        if isinstance(stop, bool):
+            raise CaseError("stop", stop, "give a stop index (int), name (str) or position in m (float)")
+        if isinstance(stop, (int, np.integer)):
+            index = int(stop) + n if stop < 0 else int(stop)
+            if not 0 <= index < n:
+                raise CaseError("stop", stop, f"index out of range: the track has {n} stops "
+                                              "(pass a float to give a position in m)")
+            return index
+        if isinstance(stop, str):
+            if stop_names is None:
+                raise CaseError("stop", stop, "TTOBench stops have no names: pass stop_names=[...] "
+                                              "(e.g. YIZHUANG_STOP_NAMES) or an index or position")
+            if len(stop_names) != n:
+                raise CaseError("stop_names", len(stop_names), f"needs one name per stop ({n})")
+            matches = [k for k, name in enumerate(stop_names) if name.casefold() == stop.casefold()]
+            if not matches:
+                raise CaseError("stop", stop, f"no such stop (stops: {', '.join(stop_names)})")
+            return matches[0]
+        if isinstance(stop, (float, np.floating)):
+            distances = np.abs(np.asarray(self.stops_m) - float(stop))
+            index = int(np.argmin(distances))
+            if distances[index] > 0.5:
+                raise CaseError("stop", stop, f"no stop at this position (stops at {list(self.stops_m)} m)")
+            return index
+        raise CaseError("stop", stop, "give a stop index (int), name (str) or position in m (float)")
+
+
+def _rows(points: Sequence[tuple[float, float]], length_m: float) -> tuple[tuple[float, float, float], ...]:
+    """Change points to ``(start_m, end_m, value)`` rows covering [0, length]."""
+    ends = [p for p, _ in points[1:]] + [length_m]
+    return tuple((p, e, v) for (p, v), e in zip(points, ends))
+
+
+def _change_points_of(rows: Sequence[Sequence[float]]) -> list[list[float]]:
+    """Rows back to change points, merging neighbours with the same value (TTOBench's rule)."""
+    points: list[list[float]] = []
+    for start, _end, value in rows:
+        if not points or value != points[-1][1]:
+            points.append([float(start), float(value)])
+    return points
+
+
+def read_track(source: Source) -> TTOBenchTrack:
+    """Read a TTOBench track file (or its parsed JSON object)."""
+    data, label = _load(source, "track")
+    _check_keys(data, _TRACK_REQUIRED, _TRACK_OPTIONAL, "track", label)
+    stops = data["stops"]
+    if not isinstance(stops, Mapping):
+        raise CaseError("stops", stops, 'must be an object {"unit": ..., "values": [...]}', label)
+    factor = _unit_factor("stops.unit", stops.get("unit"), _LENGTH, label)
+    values = stops.get("values")
+    if not isinstance(values, list) or len(values) < 2:
+        raise CaseError("stops.values", values, "needs at least two stop positions", label)
+    stops_m = []
+    for k, v in enumerate(values):
+        x = _convert(_number(f"stops.values[{k}]", v, label), factor)
+        if k == 0 and x != 0.0:
+            raise CaseError("stops.values[0]", v, "the first stop must be at position 0", label)
+        if stops_m and x <= stops_m[-1]:
+            raise CaseError(f"stops.values[{k}]", v, f"stops must be sorted and strictly increasing "
+                                                     f"(the previous stop is at {stops_m[-1]} m)", label)
+        stops_m.append(x)
+    length = stops_m[-1]
+    limits = _change_points(data, "speed limits", "velocity", _SPEED_KMH, length, label)
+    for k, (_, v) in enumerate(limits):
+        if v <= 0:
+            raise CaseError(f"speed limits.values[{k}]", v, "a speed limit must be > 0", label)
+    if "gradients" in data:
+        gradients = _change_points(data, "gradients", "slope", _SLOPE_PERMILLE, length, label)
+    else:  # TTOBench: the field may be omitted for level tracks
+        gradients = ((0.0, 0.0),)
+    if "curvatures" in data:
+        _refuse_curvatures(data["curvatures"], label)
+    if "tunnels" in data and (not isinstance(data["tunnels"], Mapping) or data["tunnels"].get("values")):
+        raise CaseError("tunnels", data["tunnels"], "is not represented: TTOBench tunnel drag depends on the "
+                                                    "cross-section and the speed, the model's tunnel term does not",
+                        label)
+    altitude = _scalar(data, "altitude", _LENGTH, label, default=0.0)
+    return TTOBenchTrack(id=data["metadata"]["id"], stops_m=tuple(stops_m), speed_limits=limits,
+                         gradients=gradients, altitude_m=altitude, metadata=dict(data["metadata"]))
+
+
+def _refuse_curvatures(entry: Any, source: str) -> None:
+    values = entry.get("values", []) if isinstance(entry, Mapping) else entry
+    for k, row in enumerate(values or []):
+        radii = row[1:] if isinstance(row, (list, tuple)) else [row]
+        if any(not (isinstance(r, str) and r.lower() in ("infinity", "inf")) and
+               not (isinstance(r, (int, float)) and math.isinf(r)) for r in radii):
+            raise CaseError(f"curvatures.values[{k}]", row,
+                            "curves are not represented: TTOBench gives no curve-resistance model", source)
+
+
+@dataclass(frozen=True)
+class TTOBenchTrain:
+    """A TTOBench train file converted to a :class:`Train`, with what the model does not store."""
+
+    id: str
+    train: Train
+    length_m: float | None
+    metadata: Mapping[str, Any] = field(default_factory=dict, compare=False)
+
+
+def braking_curve(reg_force_kn: float, reg_power_kw: float, pn_force_kn: float, max_speed_kmh: float) -> ForceCurve:
+    """The total braking limit ``F_pn + min(F_reg, P_reg / v)`` as a :class:`ForceCurve`.
+
+    Exact (a force and a power cap) when there is no pneumatic part, or when the regen power cap
+    does not bind below ``max_speed_kmh``; otherwise a table with speed nodes 1 % apart from the
+    corner speed up, whose linear interpolation of the hyperbola is within 2e-5 relative.
+    """
+    corner_kmh = reg_power_kw / reg_force_kn * KMH_PER_MS
+    if pn_force_kn == 0.0:
+        return ForceCurve(max_force_kn=reg_force_kn, max_power_kw=reg_power_kw)
+    if corner_kmh >= max_speed_kmh:
+        return ForceCurve(max_force_kn=reg_force_kn + pn_force_kn)
+    speeds = [0.0, corner_kmh]
+    while speeds[-1] < max_speed_kmh:
+        speeds.append(min(speeds[-1] * _BRAKE_TABLE_RATIO, max_speed_kmh))
+    table = [(v, pn_force_kn + min(reg_force_kn, reg_power_kw * KMH_PER_MS / v) if v > 0 else
+              pn_force_kn + reg_force_kn) for v in speeds]
+    return ForceCurve(table=tuple(table))
+
+
+def read_train(source: Source, *, train_length_m: float | None = None) -> TTOBenchTrain:
+    """Read a TTOBench train file (or its parsed JSON object).
+
+    ``train_length_m``: ``None`` takes the file's ``length`` if any, else a point mass; ``0`` forces
+    a point mass; a positive value sets the length (limits over the whole train, averaged gradients).
+    """
+    data, label = _load(source, "train")
+    _check_keys(data, _TRAIN_REQUIRED, _TRAIN_USED | _TRAIN_INFORMATIONAL, "train", label)
+    mass_t = _scalar(data, "mass", _MASS_T, label)
+    rho = _fraction(data, "rho", label, default=0.0)
+    vmax = _scalar(data, "max speed", _SPEED_KMH, label)
+    trac_p = _scalar(data, "max traction power", _POWER_KW, label)
+    trac_f = _scalar(data, "max traction force", _FORCE_KN, label)
+    reg_p = _scalar(data, "max reg braking power", _POWER_KW, label)
+    reg_f = _scalar(data, "max reg braking force", _FORCE_KN, label)
+    pn_f = _scalar(data, "max pn braking force", _FORCE_KN, label, default=0.0)
+    accel = _scalar(data, "max acceleration", _ACCEL, label)
+    decel = _scalar(data, "max deceleration", _ACCEL, label)
+    r0 = _scalar(data, "rolling resistance r0", _FORCE_KN, label)
+    r1 = _scalar(data, "rolling resistance r1", _R1_KN_PER_KMH, label)
+    r2 = _scalar(data, "rolling resistance r2", _R2_KN_PER_KMH2, label)
+    has_eta = ("efficiency traction" in data, "efficiency reg brake" in data)
+    if any(has_eta) and not all(has_eta):
+        missing = "efficiency reg brake" if has_eta[0] else "efficiency traction"
+        raise CaseError(missing, None, "TTOBench gives both efficiencies or neither", label)
+    eta_t = _fraction(data, "efficiency traction", label, default=1.0)
+    eta_r = _fraction(data, "efficiency reg brake", label, default=0.0)
+    for key, value in (("mass", mass_t), ("max speed", vmax), ("max traction power", trac_p),
+                       ("max traction force", trac_f), ("max reg braking power", reg_p),
+                       ("max reg braking force", reg_f)):
+        if value <= 0:
+            raise CaseError(f"{key}.value", data[key]["value"], "must be > 0", label)
+    if pn_f < 0:
+        raise CaseError("max pn braking force.value", data["max pn braking force"]["value"], "must be >= 0", label)
+    file_length = _scalar(data, "length", _LENGTH, label)
+    if train_length_m is None:
+        length = file_length
+    else:
+        length = _number("train_length_m", train_length_m, "from_ttobench")
+        if length < 0:
+            raise CaseError("train_length_m", train_length_m, "must be >= 0 (0 = point mass)", "from_ttobench")
+        length = length or None
+    try:
+        train = Train(
+            name=data["metadata"]["id"], mass_t=mass_t, rotary_factor=rho,
+            length_m=length if length else POINT_MASS_LENGTH_M, max_speed_kmh=vmax,
+            max_accel_ms2=accel, max_decel_ms2=decel, traction_efficiency=eta_t, regen_efficiency=eta_r,
+            resistance=DavisResistance(r0, r1, r2, unit="kN", speed_unit="kmh"),
+            traction=ForceCurve(max_force_kn=trac_f, max_power_kw=trac_p),
+            braking=braking_curve(reg_f, reg_p, pn_f, vmax),
+            regen_max_force_kn=reg_f, regen_max_power_kw=reg_p,
+        )
+    except CaseError as err:  # name the TTOBench field behind the model's field
+        raise CaseError(_TTOBENCH_FIELD.get(err.field, err.field), err.value, err.reason, label) from None
+    return TTOBenchTrain(id=data["metadata"]["id"], train=train, length_m=length, metadata=dict(data["metadata"]))
+
+
+_TTOBENCH_FIELD = {
+    "train.rotary_factor": "rho", "train.traction_efficiency": "efficiency traction",
+    "train.regen_efficiency": "efficiency reg brake", "resistance.a": "rolling resistance r0",
+    "resistance.b": "rolling resistance r1", "resistance.c": "rolling resistance r2",
+    "train.max_accel_ms2": "max acceleration", "train.max_decel_ms2": "max deceleration",
+}
+
+
+def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to_stop: StopRef,
+                  planned_time_s: float, *, dwell_s: float = 0.0, stop_names: Sequence[str] | None = None,
+                  train_length_m: float | None = None, name: str | None = None) -> Case:
+    """The run of a TTOBench train between two stops of a TTOBench track, as a :class:`Case`.
+
+    Parameters
+    ----------
+    track_path, train_path : str, Path or dict
+        TTOBench JSON files (or their parsed objects).
+    from_stop, to_stop : int, str or float
+        Departure and arrival stop: an index into the track's stops (int, negative counts from the
+        end), a name (str, with ``stop_names``), or a position in m (float, within 0.5 m of a stop).
+        Stops in between are passed without stopping.
+    planned_time_s : float
+        Planned running time (TTOBench tracks carry none).
+    dwell_s : float
+        Dwell at the arrival stop.
+    stop_names : sequence of str, optional
+        One name per stop of the track (e.g. :data:`YIZHUANG_STOP_NAMES`).
+    train_length_m : float, optional
+        ``None``: the train file's ``length`` if it has one, else a point mass (TTOBench's own
+        convention). ``0``: a point mass. ``> 0``: this length, with limits over the whole train and
+        gradients averaged over it.
+    name : str, optional
+        Case name (default ``"<track id>[<i>-<j>]"``).
+    """
+    track = read_track(track_path)
+    tt_train = read_train(train_path, train_length_m=train_length_m)
+    i = track.stop_index(from_stop, stop_names)
+    j = track.stop_index(to_stop, stop_names)
+    if j <= i:
+        raise CaseError("to_stop", to_stop, f"must lie after from_stop {from_stop!r} (stop {i} at "
+                                            f"{track.stops_m[i]} m) in the track's direction")
+    point_mass = tt_train.length_m is None
+    line = track.line("point_mass" if point_mass else "train_length").slice(track.stops_m[i], track.stops_m[j])
+    stop_label = (lambda k: f"{stop_names[k]} (stop {k}, {track.stops_m[k]:g} m)") if stop_names else \
+        (lambda k: f"stop {k} at {track.stops_m[k]:g} m")
+    model = "point mass" if point_mass else f"train of {tt_train.length_m:g} m (limits over its length)"
+    source = (f"TTOBench track {track.id} ({track.metadata.get('library version', '?')}), "
+              f"{stop_label(i)} -> {stop_label(j)}; TTOBench train {tt_train.id} "
+              f"({tt_train.metadata.get('library version', '?')}); {model}; converted by "
+              f"pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
+    return Case(name=name or f"{track.id}[{i}-{j}]", train=tt_train.train, line=line,
+                planned_time_s=planned_time_s, dwell_s=dwell_s, source=source,
+                description=f"{track.id} {stop_label(i)} -> {stop_label(j)}, {line.length_m:g} m, "
+                            f"train {tt_train.id}")
+
+
+# ----------------------------------------------------------------------------------------- writing
+
+
+def _entry(unit: str, value: float) -> dict:
+    return {"unit": unit, "value": float(value)}
+
+
+def _ttobench_braking(train: Train) -> tuple[float, float, float]:
+    """(reg force kN, reg power kW, pneumatic force kN) equal to the train's braking and regen split.
+
+    Raises :class:`CaseError` when the model's braking curve or its electric share is not of the
+    TTOBench form ``F_pn + min(F_reg, P_reg / v)`` with electric part ``min(F_reg, P_reg / v)``.
+    """
+    vmax = train.max_speed_kmh
+    speeds = np.linspace(0.0, vmax, int(math.ceil(vmax / 0.25)) + 1)
+    if train.braking.table is not None:
+        speeds = np.union1d(speeds, [v for v, _ in train.braking.table if v <= vmax])
+    total = train.braking.force_kn(speeds)
+    electric = total.copy()
+    if train.regen_max_force_kn is not None:
+        electric = np.minimum(electric, train.regen_max_force_kn)
+    if train.regen_max_power_kw is not None:
+        with np.errstate(divide="ignore"):
+            electric = np.minimum(electric, np.where(speeds > 0, train.regen_max_power_kw * KMH_PER_MS
+                                                     / np.maximum(speeds, 1e-300), np.inf))
+    reg_f = float(electric[0])
+    # The power cap as given when there is one (exact round trip); else F v_max, which never binds.
+    caps = [p for p in (train.braking.max_power_kw, train.regen_max_power_kw) if p is not None]
+    reg_p = float(min(caps)) if caps else reg_f * vmax / KMH_PER_MS
+    pn_f = float(total[0] - reg_f)
+    if reg_f <= 0 or reg_p <= 0:
+        raise CaseError("train.braking", train.braking, "TTOBench needs a positive regenerative braking force")
+    with np.errstate(divide="ignore"):
+        ttob_electric = np.minimum(reg_f, np.where(speeds > 0, reg_p * KMH_PER_MS / np.maximum(speeds, 1e-300),
+                                                   np.inf))
+    tol = _BRAKE_CHECK_RTOL * float(np.max(total))
+    worst_total = float(np.max(np.abs(pn_f + ttob_electric - total)))
+    worst_electric = float(np.max(np.abs(ttob_electric - electric)))
+    if worst_total > tol:
+        k = int(np.argmax(np.abs(pn_f + ttob_electric - total)))
+        raise CaseError("train.braking", f"{total[k]:.3f} kN at {speeds[k]:.2f} km/h",
+                        f"is not of the TTOBench form pneumatic + min(F_reg, P_reg / v) "
+                        f"(off by {worst_total:.3f} kN with F_reg = {reg_f:g} kN, P_reg = {reg_p:g} kW, "
+                        f"F_pn = {pn_f:g} kN)")
+    if worst_electric > tol:
+        raise CaseError("train.regen_max_force_kn|regen_max_power_kw",
+                        (train.regen_max_force_kn, train.regen_max_power_kw),
+                        f"the electric share of braking is not min(F_reg, P_reg / v) (off by {worst_electric:.3f} kN)")
+    return reg_f, reg_p, max(pn_f, 0.0)
+
+
+def train_to_json(train: Train, train_id: str, *, metadata: Mapping[str, Any] | None = None) -> dict:
+    """A TTOBench train object (units: kg, %, km/h, kW, kN, m/s^2, kN/(km/h)^k) for a :class:`Train`."""
+    if train.traction.max_force_kn is None:
+        form = "segments" if train.traction.segments is not None else "table"
+        raise CaseError(f"train.traction.{form}", getattr(train.traction, form),
+                        "TTOBench trains give traction as a force cap and a power cap only")
+    if train.regen_min_speed_kmh > 0:
+        raise CaseError("train.regen_min_speed_kmh", train.regen_min_speed_kmh, "TTOBench has no regen cut-off speed")
+    if train.aux_power_kw > 0:
+        raise CaseError("train.aux_power_kw", train.aux_power_kw, "TTOBench has no auxiliary power")
+    trac_f = train.traction.max_force_kn
+    # No power cap: F <= F_max equals min(F_max, F_max v_max / v) at every speed the train can run.
+    trac_p = train.traction.max_power_kw if train.traction.max_power_kw is not None else \
+        trac_f * train.max_speed_kmh / KMH_PER_MS
+    reg_f, reg_p, pn_f = _ttobench_braking(train)
+    r = train.resistance
+    a, b, c = r.a, r.b, r.c
+    if r.unit == "N/kN":
+        a, b, c = (x * train.weight_kn / 1000.0 for x in (a, b, c))
+    if r.speed_unit == "ms":
+        b, c = b / KMH_PER_MS, c / KMH_PER_MS**2
+    meta = {"id": train_id, "library version": LIBRARY_VERSION, "created by": "pymoo-rail (to_ttobench)"}
+    meta.update(metadata or {})
+    out: dict[str, Any] = {"metadata": meta}
+    if train.length_m > POINT_MASS_LENGTH_M:
+        out["length"] = _entry("m", train.length_m)
+    out.update({
+        "mass": _entry("kg", train.mass_t * 1000.0),
+        "rho": _entry("%", train.rotary_factor * 100.0),
+        "max traction power": _entry("kW", trac_p),
+        "max reg braking power": _entry("kW", reg_p),
+        "max traction force": _entry("kN", trac_f),
+        "max reg braking force": _entry("kN", reg_f),
+        "max pn braking force": _entry("kN", pn_f),
+    })
+    if train.max_accel_ms2 is not None:
+        out["max acceleration"] = _entry("m/s^2", train.max_accel_ms2)
+    if train.max_decel_ms2 is not None:
+        out["max deceleration"] = _entry("m/s^2", train.max_decel_ms2)
+    out.update({
+        "max speed": _entry("km/h", train.max_speed_kmh),
+        "rolling resistance r0": _entry("kN", a),
+        "rolling resistance r1": _entry("kN/(km/h)", b),
+        "rolling resistance r2": _entry("kN/(km/h)^2", c),
+    })
+    if not (train.traction_efficiency == 1.0 and train.regen_efficiency == 0.0):  # absent = (1, 0) on import
+        out["efficiency traction"] = _entry("%", train.traction_efficiency * 100.0)
+        out["efficiency reg brake"] = _entry("%", train.regen_efficiency * 100.0)
+    return out
+
+
+def track_to_json(lines: Sequence[Line], track_id: str, *, altitude_m: float = 0.0,
+                  metadata: Mapping[str, Any] | None = None) -> dict:
+    """A TTOBench track object for consecutive stop-to-stop lines (one stop between each pair)."""
+    gradients: list[list[float]] = []
+    limits: list[list[float]] = []
+    stops = [0.0]
+    for k, line in enumerate(lines):
+        for name in ("curves", "tunnels", "neutral_sections"):
+            if getattr(line, name):
+                raise CaseError(f"line.{name}", getattr(line, name), "is not represented in TTOBench tracks")
+        offset = stops[-1]
+        gradients += [[s + offset, e + offset, v] for s, e, v in line.gradients]
+        limits += [[s + offset, e + offset, v] for s, e, v in line.speed_limits]
+        stops.append(offset + line.length_m)
+    meta = {"id": track_id, "library version": LIBRARY_VERSION, "created by": "pymoo-rail (to_ttobench)"}
+    meta.update(metadata or {})
+    return {
+        "metadata": meta,
+        "altitude": _entry("m", altitude_m),
+        "stops": {"unit": "m", "values": stops},
+        "speed limits": {"units": {"position": "m", "velocity": "km/h"}, "values": _change_points_of(limits)},
+        "gradients": {"units": {"position": "m", "slope": "permil"}, "values": _change_points_of(gradients)},
+    }
+
+
+def ttobench_id(text: str) -> str:
+    """A TTOBench id from any text (ids hold letters, numbers and underscores only)."""
+    return re.sub(r"[^A-Za-z0-9_]+", "_", text).strip("_") or "track"
+
+
+def to_ttobench(case: Case, out_dir: str | Path, *, track_id: str | None = None, train_id: str | None = None,
+                altitude_m: float = 0.0, license_text: str | None = None) -> tuple[Path, Path]:
+    """Write a case as a TTOBench track (two stops, or one per leg) and a TTOBench train.
+
+    Returns ``(track_path, train_path)``, files named ``<id>.json``. Raises :class:`CaseError`
+    naming the field for what TTOBench cannot hold: traction as polynomials or tables, a braking
+    curve not of the form ``pneumatic + min(F_reg, P_reg / v)``, a regen cut-off speed, auxiliary
+    power, curves, tunnels, neutral sections, or averaged gradients on a point-mass train.
+
+    ``altitude_m`` is the altitude of the first stop (the case does not store it). ``license_text``
+    goes into the metadata; by default the TTOBench notice is carried when the case came from
+    TTOBench data (its ``source`` says so).
+    """
+    train = case.train
+    whole_train = train.length_m > POINT_MASS_LENGTH_M
+    if whole_train and case.line.gradient_model != "train_length":
+        raise CaseError("line.gradient_model", case.line.gradient_model,
+                        "TTOBench has no flag for it: a train with a length is written with gradients averaged "
+                        "over it ('train_length'); use a point mass (train length 0.001 m) for 'point_mass'")
+    lines = [case.leg(k).line for k in range(len(case.legs))] if case.legs else [case.line]
+    if license_text is None and "TTOBench" in case.source:
+        license_text = TTOBENCH_NOTICE
+    meta = {"description": case.description or case.name}
+    if license_text:
+        meta["license"] = license_text
+    track_id = track_id or ttobench_id(case.name)
+    train_id = train_id or ttobench_id(train.name or f"{case.name}_train")
+    track = track_to_json(lines, track_id, altitude_m=altitude_m, metadata=meta)
+    train_json = train_to_json(train, train_id, metadata={"license": license_text} if license_text else None)
+    return write_pair(out_dir, track, train_json)
+
+
+def write_pair(out_dir: str | Path, track: Mapping, train: Mapping) -> tuple[Path, Path]:
+    """Write a track and a train object as ``<id>.json`` files in ``out_dir``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for obj in (track, train):
+        path = out / f"{obj['metadata']['id']}.json"
+        path.write_text(json.dumps(obj, indent=2) + "\n", encoding="utf-8")
+        paths.append(path)
+    return paths[0], paths[1]
+
+
+__all__ = ["from_ttobench", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
+           "track_to_json", "train_to_json", "write_pair", "ttobench_id", "braking_curve", "YIZHUANG_TRACK",
+           "BEIJING_SUBWAY_TRAIN", "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M", "TTOBENCH_LICENSE",
+           "TTOBENCH_NOTICE", "DATA_DIR"]

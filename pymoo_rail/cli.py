@@ -1,0 +1,606 @@
+"""The ``pymoo-rail`` command: cases, optimisation, the exact reference, studies and plots.
+
+Every subcommand is a thin layer over the library (``pymoo_rail.cases``, ``.problems``,
+``.experiments``, ``.plotting``, ``.optimal``); heavy modules are imported when a subcommand
+runs, so ``pymoo-rail --help`` answers at once. Bad arguments (unknown case, algorithm or
+objective, impossible values) end with exit code 2 and a message naming the argument and the
+value; other failures with exit code 1 and a one-line message (``--debug`` shows the traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import textwrap
+from pathlib import Path
+from typing import Sequence
+
+OBJECTIVE_NAMES = ("energy", "running_time", "time_error", "jerk", "stop_error")
+OBJECTIVE_COLUMNS = {"energy": "energy_kwh", "running_time": "running_time_s", "time_error": "time_error_s",
+                     "jerk": "jerk_ms2", "stop_error": "stop_error_m"}
+
+
+class UsageError(Exception):
+    """A bad argument value found after parsing: reported as ``argument NAME: message``, exit 2."""
+
+    def __init__(self, argument: str, message: str):
+        self.argument = argument
+        super().__init__(message)
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    pass
+
+
+MAIN_EPILOG = """\
+examples:
+  pymoo-rail cases                                  list the built-in cases
+  pymoo-rail cases yizhuang                         describe one case
+  pymoo-rail optimize yizhuang --out out/           NSGA-II on energy and time error (about 10 s)
+  pymoo-rail optimize yizhuang --algorithm moabc --pop-size 40 --n-gen 100 --seed 3 --out out/moabc
+  pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
+  pymoo-rail reference yizhuang --out out/ref       the exact minimum-energy front
+  pymoo-rail study examples/study_zdt.toml --workers 2 --out out/zdt
+  pymoo-rail plot study out/zdt                     redraw the tables and figures of a study
+  pymoo-rail plot trajectory out/trajectory.csv --case yizhuang
+
+Run 'pymoo-rail COMMAND --help' for the options of a command.
+"""
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid integer: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive finite number, got {text}")
+    return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid integer: {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="pymoo-rail",
+        description="Energy-efficient train driving with pymoo: optimise recommended speed profiles of "
+                    "built-in or your own cases, compute the exact minimum-energy reference, run algorithm "
+                    "studies (many problems x algorithms x seeds) on this machine or a Dask cluster, and "
+                    "draw the figures.",
+        epilog=MAIN_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", title="commands")
+
+    p = sub.add_parser("cases", help="list the built-in cases, or describe one", formatter_class=_Formatter,
+                       description="List the built-in cases (length, planned time, train, source), or describe "
+                                   "one case (built-in name or path of a .toml case file) in full.",
+                       epilog="examples:\n  pymoo-rail cases\n  pymoo-rail cases wuguang-crh3\n"
+                              "  pymoo-rail cases my_line.toml")
+    p.add_argument("case", nargs="?", metavar="CASE", help="a case to describe (name or .toml path)")
+
+    p = sub.add_parser(
+        "optimize", aliases=["optimise"], help="optimise the speed profile of a case", formatter_class=_Formatter,
+        description=textwrap.dedent("""\
+            Optimise the recommended speed profile of one case and write into --out:
+              front.csv        every front member: objectives, running time, energy, stop error,
+                               constraint violation and decision vector
+              trajectory.csv   the chosen run (the least energy within --time-tolerance, default 1 s,
+                               of the planned time; else the member closest to it; for a single
+                               objective the best one), one row per grid node
+              front.png        the front in objective space, the chosen member circled
+              profile.png      speed against distance over the line (limits, gradients, regimes)
+              speed_time.png   speed against time with the planned time"""),
+        epilog=textwrap.dedent("""\
+            objectives: energy (net kWh), running_time (s), time_error (|T - T_plan|, s),
+                        jerk (comfort, m/s^2), stop_error (m)
+            algorithms: nsga2, moabc, grnsga2, sms-emoa, moead, nsga3 (several objectives);
+                        abc, de, ga, pso (one objective, e.g. with --time-tolerance)
+
+            examples:
+              pymoo-rail optimize yizhuang --out out/
+              pymoo-rail optimize yizhuang --algorithm grnsga2 --pop-size 60 --n-gen 80 --out out/gr
+              pymoo-rail optimize metro-a --objectives energy jerk stop_error time_error --out out/m4
+              pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc"""))
+    p.add_argument("case", metavar="CASE", help="built-in case name (see 'pymoo-rail cases') or a .toml case file")
+    p.add_argument("--algorithm", "-a", default="nsga2", metavar="NAME", help="optimisation algorithm")
+    p.add_argument("--pop-size", "-p", type=_positive_int, default=40, metavar="N", help="population size")
+    p.add_argument("--n-gen", "-g", type=_positive_int, default=50, metavar="N", help="number of generations")
+    p.add_argument("--objectives", "-o", nargs="+", default=["energy", "time_error"], metavar="NAME",
+                   help="objectives to minimise")
+    p.add_argument("--seed", "-s", type=_seed, default=1, help="random seed (same seed, same result)")
+    p.add_argument("--encoding", default="speed_codes", choices=["speed_codes", "switching_points"],
+                   help="decision variables: a speed code per section, or regime switching positions")
+    p.add_argument("--partition", default="gradient_limit", choices=["gradient_limit", "equal"],
+                   help="sections of the speed-code encoding")
+    p.add_argument("--n-sections", type=_positive_int, default=None, metavar="N",
+                   help="number of equal sections (with --partition equal)")
+    p.add_argument("--time-tolerance", type=_positive_float, default=None, metavar="S",
+                   help="constraint |T - T_plan| <= S seconds (the single-objective form of seed 000)")
+    p.add_argument("--weights", type=float, nargs="+", default=None, metavar="W",
+                   help="one weight per objective: minimise the weighted sum (seed 002)")
+    p.add_argument("--out", default="out", metavar="DIR", help="output directory")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+
+    p = sub.add_parser(
+        "reference", help="the exact minimum-energy front of a case", formatter_class=_Formatter,
+        description="Compute the exact minimum-energy run for a range of running times (dynamic programming, "
+                    "pymoo_rail.optimal) and write optimal_front.csv / .png and the optimal run at the planned "
+                    "time (optimal_trajectory.csv, optimal_profile.png).",
+        epilog="examples:\n  pymoo-rail reference yizhuang --out out/ref\n"
+               "  pymoo-rail reference yizhuang --times 140 150 160 170 --out out/ref")
+    p.add_argument("case", metavar="CASE", help="built-in case name or a .toml case file")
+    p.add_argument("--times", type=_positive_float, nargs="+", default=None, metavar="S",
+                   help="running times (s); default: --n-points from the minimum time to 1.3 x planned")
+    p.add_argument("--n-points", type=_positive_int, default=8, metavar="N", help="number of running times")
+    p.add_argument("--out", default="out", metavar="DIR", help="output directory")
+
+    p = sub.add_parser(
+        "study", help="run a study file (problems x algorithms x seeds)", formatter_class=_Formatter,
+        description="Run every run of a study file not yet stored in --out (an interrupted study resumes "
+                    "where it stopped), then write the statistics tables (--out/tables: summary, mean (std) "
+                    "per indicator, Wilcoxon rank-sum tests against the baseline) and the figures "
+                    "(--out/figures). Same seeds, same results on the local pool and on Dask.",
+        epilog=textwrap.dedent("""\
+            examples:
+              pymoo-rail study examples/study_zdt.toml --workers 2 --out out/zdt
+              pymoo-rail study examples/study_zdt.toml --scheduler local --workers 4 --out out/zdt
+              pymoo-rail study examples/study_zdt.toml --scheduler tcp://10.0.0.5:8786 --out out/zdt
+
+            See docs/experiments.md for the study file format."""))
+    p.add_argument("file", metavar="FILE", help="study file (.toml)")
+    p.add_argument("--workers", "-w", type=_positive_int, default=None, metavar="N",
+                   help="worker processes (default: all CPUs; 1 runs in this process)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on Dask: 'local' for a LocalCluster of --workers processes, or the address "
+                        "of a running scheduler (tcp://host:8786)")
+    p.add_argument("--out", default=None, metavar="DIR", help="study directory (default: out/<study name>)")
+    p.add_argument("--baseline", default=None, metavar="ALGORITHM",
+                   help="algorithm the others are tested against (default: the file's baseline)")
+    p.add_argument("--no-plots", action="store_true", help="write the tables only")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+
+    p = sub.add_parser("plot", help="redraw figures from stored results or CSV files", formatter_class=_Formatter,
+                       description="Redraw figures without recomputing anything.",
+                       epilog=textwrap.dedent("""\
+                           examples:
+                             pymoo-rail plot study out/zdt
+                             pymoo-rail plot front out/front.csv
+                             pymoo-rail plot front out/front.csv --x running_time_s --y energy_kwh \\
+                                 --reference out/ref/optimal_front.csv
+                             pymoo-rail plot trajectory out/trajectory.csv --case yizhuang"""))
+    plot_sub = p.add_subparsers(dest="what", metavar="WHAT", title="what to plot")
+    q = plot_sub.add_parser("study", help="tables and figures of a study directory", formatter_class=_Formatter)
+    q.add_argument("directory", metavar="DIR", help="study directory written by 'pymoo-rail study'")
+    q.add_argument("--out", default=None, metavar="DIR", help="where to write (default: DIR)")
+    q.add_argument("--baseline", default=None, metavar="ALGORITHM", help="baseline of the rank-sum tests")
+    q = plot_sub.add_parser("front", help="a front from front.csv", formatter_class=_Formatter)
+    q.add_argument("csv", metavar="CSV", help="front.csv written by 'pymoo-rail optimize'")
+    q.add_argument("--x", default=None, metavar="COLUMN", help="column on the x axis (default: first objective)")
+    q.add_argument("--y", default=None, metavar="COLUMN", help="column on the y axis (default: second objective)")
+    q.add_argument("--reference", default=None, metavar="CSV",
+                   help="a reference front to draw as a line (optimal_front.csv, same column names)")
+    q.add_argument("--out", default=None, metavar="PNG", help="image file (default: next to the CSV)")
+    q = plot_sub.add_parser("trajectory", help="a speed profile from trajectory.csv", formatter_class=_Formatter)
+    q.add_argument("csv", metavar="CSV", help="trajectory.csv written by 'pymoo-rail optimize'")
+    q.add_argument("--case", default=None, metavar="CASE",
+                   help="the case, to draw the line (limits, gradients, neutral sections)")
+    q.add_argument("--out", default=None, metavar="PNG", help="image file (default: next to the CSV)")
+    return parser
+
+
+# ------------------------------------------------------------------------------ helpers
+
+
+def _load_case(argument: str, value: str):
+    from pymoo_rail.cases import list_cases, load_case
+    from pymoo_rail.model import CaseError
+
+    try:
+        return load_case(value)
+    except CaseError as err:
+        if Path(value).suffix == ".toml" or Path(value).exists():
+            raise UsageError(argument, str(err)) from None
+        raise UsageError(argument, f"unknown case {value!r} (built-in: {', '.join(list_cases())}; "
+                                   "or give the path of a .toml case file)") from None
+
+
+def _out_dir(value: str) -> Path:
+    path = Path(value)
+    if path.exists() and not path.is_dir():
+        raise UsageError("--out", f"{value!r} exists and is not a directory")
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def _say(text: str) -> None:
+    print(text, flush=True)
+
+
+# ------------------------------------------------------------------------------ commands
+
+
+def cmd_cases(args) -> int:
+    from pymoo_rail.cases import list_cases, load_case
+
+    if args.case is None:
+        rows = []
+        for name in list_cases():
+            case = load_case(name)
+            source = " ".join(case.source.split())
+            rows.append((name, f"{case.line.length_m:,.0f} m", f"{case.planned_time_s:g} s",
+                         case.train.name or f"{case.train.mass_t:g} t", source[:60] + ("..." if len(source) > 60 else "")))
+        widths = [max(len(r[i]) for r in rows + [("case", "length", "planned", "train", "source")]) for i in range(5)]
+        header = ("case", "length", "planned", "train", "source")
+        for row in [header] + rows:
+            _say("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
+        _say("\n'pymoo-rail cases NAME' describes one case.")
+        return 0
+    case = _load_case("CASE", args.case)
+    line, train = case.line, case.train
+    wrap = lambda text: textwrap.fill(" ".join(text.split()), 96, initial_indent="  ", subsequent_indent="  ")  # noqa: E731
+    _say(f"{case.name}")
+    if case.description:
+        _say(wrap(case.description))
+    _say(f"run:    {line.length_m:,.1f} m in {case.planned_time_s:g} s planned"
+         + (f" (+{case.time_margin_s:g} s margin)" if case.time_margin_s else "")
+         + (f", dwell {case.dwell_s:g} s" if case.dwell_s else "")
+         + (f", {len(case.legs)} legs" if case.legs else ""))
+    _say(f"train:  {train.name or '-'}: {train.mass_t:g} t, {train.length_m:g} m, max {train.max_speed_kmh:g} km/h")
+    limits = ", ".join(f"{a:g}-{b:g} m: {v:g} km/h" for a, b, v in line.speed_limits)
+    _say(f"limits: {limits}")
+    grads = ", ".join(f"{a:g}-{b:g} m: {g:+g}" for a, b, g in line.gradients)
+    _say(textwrap.fill(f"gradients (permille): {grads}", 96, subsequent_indent="  "))
+    if line.neutral_sections:
+        _say("neutral sections: " + ", ".join(f"{a:g}-{b:g} m" for a, b in line.neutral_sections))
+    _say("source:")
+    _say(wrap(case.source))
+    return 0
+
+
+def _objectives(values: Sequence[str]) -> tuple[str, ...]:
+    try:
+        from pymoo_rail.problems import OBJECTIVES
+    except ImportError:
+        OBJECTIVES = OBJECTIVE_NAMES
+    for name in values:
+        if name not in OBJECTIVES:
+            raise UsageError("--objectives", f"unknown objective {name!r} (choose from {', '.join(OBJECTIVES)})")
+    if len(set(values)) != len(values):
+        raise UsageError("--objectives", f"{' '.join(values)}: an objective is repeated")
+    return tuple(values)
+
+
+class _Progress:
+    """pymoo callback that advances a tqdm bar by one per generation."""
+
+    def __init__(self, bar):
+        self.bar = bar
+
+    def __call__(self, algorithm) -> None:
+        self.bar.update(1)
+
+
+def choose_member(F: "np.ndarray", CV: "np.ndarray", running_time_s: "np.ndarray", energy_kwh: "np.ndarray",
+                  planned_time_s: float, window_s: float = 1.0) -> int:
+    """Index of the front member to show.
+
+    One objective: the best. Several: the least energy among the members within ``window_s`` of
+    the planned time (what an operator would pick: punctual, then frugal); if none is that close,
+    the one closest to the planned time (ties: least energy). Feasible members first.
+    """
+    import numpy as np
+
+    candidates = np.flatnonzero(CV <= 0)
+    if len(candidates) == 0:
+        candidates = np.array([int(np.argmin(CV))])
+    if F.shape[1] == 1:
+        return int(candidates[np.argmin(F[candidates, 0])])
+    error = np.abs(running_time_s[candidates] - planned_time_s)
+    punctual = candidates[error <= window_s]
+    if len(punctual):
+        return int(punctual[np.argmin(energy_kwh[punctual])])
+    order = np.lexsort((energy_kwh[candidates], error))
+    return int(candidates[order[0]])
+
+
+def cmd_optimize(args) -> int:
+    import numpy as np
+    import pandas as pd
+    from pymoo.optimize import minimize
+    from tqdm import tqdm
+
+    from pymoo_rail.experiments.registry import algorithm_names, build_algorithm, canonical_name, ALGORITHMS
+    from pymoo_rail.experiments.spec import AlgorithmSpec, StudyError
+    from pymoo_rail.plotting import plot_front, plot_speed_profile, plot_speed_time, save_figure
+    from pymoo_rail.problems import SpeedProfileProblem
+
+    case = _load_case("CASE", args.case)
+    objectives = _objectives(args.objectives)
+    if canonical_name(args.algorithm) not in ALGORITHMS:
+        raise UsageError("--algorithm", f"unknown algorithm {args.algorithm!r} (choose from "
+                                        f"{', '.join(algorithm_names())})")
+    if args.weights is not None and len(args.weights) != len(objectives):
+        raise UsageError("--weights", f"{len(args.weights)} weights for {len(objectives)} objectives "
+                                      f"({' '.join(objectives)}): give one weight per objective")
+    if args.n_sections is not None and args.partition != "equal":
+        raise UsageError("--n-sections", "only applies with --partition equal")
+    out = _out_dir(args.out)
+
+    kwargs = {"objectives": objectives, "encoding": args.encoding, "partition": args.partition,
+              "time_tolerance_s": args.time_tolerance}
+    if args.n_sections is not None:
+        kwargs["n_sections"] = args.n_sections
+    if args.weights is not None:
+        kwargs["weights"] = args.weights
+    try:
+        problem = SpeedProfileProblem(case, **kwargs)
+    except ValueError as err:  # e.g. a planned time below the minimum running time
+        raise UsageError("CASE" if "planned_time" in str(err) else "--objectives", str(err)) from None
+    try:
+        algorithm = build_algorithm(AlgorithmSpec(args.algorithm, {"pop_size": args.pop_size}), problem)
+    except StudyError as err:
+        raise UsageError("--algorithm", f"{args.algorithm!r}: {err.reason}") from None
+    except ValueError as err:
+        raise UsageError("--pop-size", f"{args.pop_size} with {args.algorithm}: {err}") from None
+
+    _say(f"{problem.describe()}\n{args.algorithm}, population {args.pop_size}, {args.n_gen} generations, "
+         f"seed {args.seed}")
+    with tqdm(total=args.n_gen, desc=f"optimize {case.name}", unit="gen", disable=args.quiet) as bar:
+        res = minimize(problem, algorithm, ("n_gen", args.n_gen), seed=args.seed, verbose=False,
+                       callback=_Progress(bar))
+
+    opt = res.algorithm.opt
+    X = np.asarray(opt.get("X"), dtype=float)
+    F = np.asarray(opt.get("F"), dtype=float)
+    CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1)
+    X, index = np.unique(X, axis=0, return_index=True)  # a front may hold copies of one solution
+    F, CV = F[index], CV[index]
+    trajectories = [problem.trajectory(x) for x in X]
+    running = np.array([t.running_time_s for t in trajectories])
+    energy = np.array([t.energy.net_kwh for t in trajectories])
+    order = np.lexsort((energy, running))
+    X, F, CV, running, energy = X[order], F[order], CV[order], running[order], energy[order]
+    trajectories = [trajectories[i] for i in order]
+
+    unit = "kmh" if args.encoding == "speed_codes" else "m"
+    objective_cols = ([f"f_{name}" for name in objectives] if problem.n_obj == len(objectives)
+                      else ["f_weighted_sum"])
+    front = pd.DataFrame(F, columns=objective_cols)
+    front["running_time_s"] = running
+    front["energy_kwh"] = energy
+    front["stop_error_m"] = [t.stop_error_m for t in trajectories]
+    front["jerk_ms2"] = [t.jerk_ms2 for t in trajectories]
+    front["feasible"] = CV <= 0
+    front["cv"] = CV
+    for j in range(X.shape[1]):
+        front[f"x{j}_{unit}"] = X[:, j]
+    chosen = choose_member(F, CV, running, energy, case.planned_time_s,
+                           args.time_tolerance if args.time_tolerance is not None else 1.0)
+    front.insert(0, "chosen", np.arange(len(front)) == chosen)
+    trajectory = trajectories[chosen]
+
+    written = [out / "front.csv", out / "trajectory.csv"]
+    front.to_csv(written[0], index=False)
+    trajectory.to_frame().to_csv(written[1], index=False)
+    label = f"{args.algorithm}, seed {args.seed}"
+    if F.shape[1] >= 2 and F.shape[1] <= 3:
+        written.append(save_figure(plot_front(F, objectives, highlight=F[chosen], label=label,
+                                              title=f"{case.name}: front after {res.algorithm.evaluator.n_eval} "
+                                                    "evaluations"), out / "front.png"))
+    written.append(save_figure(plot_speed_profile(trajectory, case, label=args.algorithm), out / "profile.png"))
+    written.append(save_figure(plot_speed_time(trajectory, case), out / "speed_time.png"))
+
+    n_feasible = int((CV <= 0).sum())
+    _say(f"front: {len(front)} solutions ({n_feasible} feasible), {res.algorithm.evaluator.n_eval} evaluations")
+    _say(f"chosen: running time {trajectory.running_time_s:.2f} s (planned {case.planned_time_s:g} s), "
+         f"energy {trajectory.energy.net_kwh:.3f} kWh, stop error {trajectory.stop_error_m:.3f} m"
+         + ("" if CV[chosen] <= 0 else "  [INFEASIBLE: no feasible solution found]"))
+    for path in written:
+        _say(f"wrote {path}")
+    return 0
+
+
+def _default_times(case, n_points: int):
+    import numpy as np
+
+    from pymoo_rail.optimal import min_running_time
+
+    t_min = float(min_running_time(case))
+    upper = max(1.3 * case.planned_time_s, 1.1 * t_min)
+    return np.linspace(1.01 * t_min, upper, n_points)
+
+
+def cmd_reference(args) -> int:
+    case = _load_case("CASE", args.case)
+    try:
+        from pymoo_rail.optimal import optimal_front, optimal_profile
+    except ImportError as err:
+        raise RuntimeError("'pymoo-rail reference' needs the exact reference solver pymoo_rail.optimal "
+                           f"(optimal_front, optimal_profile), which this installation lacks: {err}") from None
+    import numpy as np
+
+    from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
+
+    out = _out_dir(args.out)
+    times = np.asarray(args.times, dtype=float) if args.times is not None else _default_times(case, args.n_points)
+    _say(f"{case.name}: exact minimum-energy runs for {len(times)} running times "
+         f"({times.min():.1f}-{times.max():.1f} s)")
+    front = optimal_front(case, times)
+    front.to_csv(out / "optimal_front.csv", index=False)
+    points = front[["running_time_s", "energy_kwh"]].to_numpy(float)
+    written = [out / "optimal_front.csv",
+               save_figure(plot_fronts({"optimal": points}, ["running_time", "energy"], reference=points,
+                                       reference_label="optimal front", title=f"{case.name}: minimum energy "
+                                                                               "against running time"),
+                           out / "optimal_front.png")]
+    trajectory = optimal_profile(case, case.planned_time_s)
+    trajectory.to_frame().to_csv(out / "optimal_trajectory.csv", index=False)
+    written.append(out / "optimal_trajectory.csv")
+    written.append(save_figure(plot_speed_profile(trajectory, case, label="optimal"), out / "optimal_profile.png"))
+    _say(f"at the planned {case.planned_time_s:g} s: {trajectory.energy.net_kwh:.3f} kWh "
+         f"(running time {trajectory.running_time_s:.2f} s)")
+    for path in written:
+        _say(f"wrote {path}")
+    return 0
+
+
+def _study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool) -> list[Path]:
+    from pymoo_rail.experiments import load_results
+    from pymoo_rail.experiments.stats import write_tables
+    from pymoo_rail.plotting import plot_study
+
+    results = load_results(directory)
+    if results.empty:
+        raise RuntimeError(f"no stored runs in {directory}")
+    algorithms = sorted(results["algorithm"].unique())
+    if baseline is not None and baseline not in algorithms:
+        raise UsageError("--baseline", f"unknown algorithm {baseline!r} (the study has {', '.join(algorithms)})")
+    written = write_tables(results, out / "tables", baseline=baseline)
+    if plots:
+        written += plot_study(results, out / "figures")
+    return written
+
+
+def cmd_study(args) -> int:
+    from pymoo_rail.experiments import read_study, run_study
+    from pymoo_rail.experiments.spec import StudyError
+
+    try:
+        study = read_study(args.file)
+    except StudyError as err:
+        raise UsageError("FILE", str(err)) from None
+    baseline = args.baseline or study.baseline
+    if baseline is not None and baseline not in {a.display for a in study.algorithms}:
+        raise UsageError("--baseline", f"unknown algorithm {baseline!r} (the study has "
+                                       f"{', '.join(a.display for a in study.algorithms)})")
+    out = _out_dir(args.out or str(Path("out") / study.name))
+    where = f"Dask scheduler {args.scheduler}" if args.scheduler else "a local process pool"
+    _say(f"study {study.name}: {len(study.problems)} problems x {len(study.algorithms)} algorithms x "
+         f"{len(study.seeds)} seeds = {len(study.runs())} runs on {where}; results in {out}")
+    try:
+        report = run_study(study, out, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet)
+    except StudyError as err:
+        raise UsageError("--scheduler" if err.field == "scheduler" else "FILE", str(err)) from None
+    _say(str(report))
+    written = _study_outputs(out, out, baseline, plots=not args.no_plots)
+    _say(f"wrote {len(written)} tables and figures under {out / 'tables'}"
+         + ("" if args.no_plots else f" and {out / 'figures'}"))
+    return 0 if not report.failures else 1
+
+
+def cmd_plot(args, parser: argparse.ArgumentParser) -> int:
+    import pandas as pd
+
+    from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
+
+    if args.what is None:
+        raise UsageError("WHAT", "say what to plot: study, front or trajectory")
+    if args.what == "study":
+        directory = Path(args.directory)
+        if not (directory / "runs").is_dir():
+            raise UsageError("DIR", f"{str(directory)!r} is not a study directory (no runs/ folder)")
+        out = _out_dir(args.out) if args.out else directory
+        written = _study_outputs(directory, out, args.baseline, plots=True)
+        for path in written:
+            _say(f"wrote {path}")
+        return 0
+    csv = Path(args.csv)
+    if not csv.is_file():
+        raise UsageError("CSV", f"no such file: {str(csv)!r}")
+    table = pd.read_csv(csv)
+    if args.what == "front":
+        objectives = [c for c in table.columns if c.startswith("f_")]
+        x = args.x or (objectives[0] if objectives else None)
+        y = args.y or (objectives[1] if len(objectives) > 1 else None)
+        for argument, column in (("--x", x), ("--y", y)):
+            if column is None or column not in table.columns:
+                raise UsageError(argument, f"column {column!r} is not in {csv.name} (columns: {', '.join(table.columns)})")
+        names = [_objective_of_column(x), _objective_of_column(y)]
+        highlight = None
+        if "chosen" in table.columns and table["chosen"].any():
+            highlight = table.loc[table["chosen"].astype(bool), [x, y]].to_numpy(float)[0]
+        reference = None
+        if args.reference:
+            ref = pd.read_csv(args.reference)
+            missing = [c for c in (x, y) if c not in ref.columns]
+            if missing:
+                raise UsageError("--reference", f"{args.reference!r} lacks column(s) {missing}")
+            reference = ref[[x, y]].to_numpy(float)
+        fig = plot_fronts({csv.stem: table[[x, y]].to_numpy(float)}, names, reference=reference,
+                          highlight=highlight, reference_label="reference front")
+        path = save_figure(fig, Path(args.out) if args.out else csv.with_suffix(".png"))
+    else:
+        case = _load_case("--case", args.case) if args.case else None
+        try:
+            fig = plot_speed_profile(table, case)
+        except ValueError as err:
+            raise UsageError("CSV", str(err)) from None
+        path = save_figure(fig, Path(args.out) if args.out else csv.with_suffix(".png"))
+    _say(f"wrote {path}")
+    return 0
+
+
+def _objective_of_column(column: str) -> str:
+    """Axis label key of a front column: ``f_energy`` -> energy, ``running_time_s`` -> running_time."""
+    if column.startswith("f_"):
+        return column[2:]
+    for name, col in OBJECTIVE_COLUMNS.items():
+        if column == col:
+            return name
+    return column
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``pymoo-rail``; returns the exit code (0 ok, 1 failure, 2 bad arguments)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exit_:  # --help, or argparse's own usage errors (already printed)
+        return int(exit_.code or 0)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    commands = {"cases": cmd_cases, "optimize": cmd_optimize, "optimise": cmd_optimize, "reference": cmd_reference,
+                "study": cmd_study}
+    subparser = parser._subparsers._group_actions[0].choices[args.command]  # for its usage line
+    try:
+        if args.command == "plot":
+            return cmd_plot(args, parser)
+        return commands[args.command](args)
+    except UsageError as err:
+        if args.command == "plot" and getattr(args, "what", None):
+            subparser = subparser._subparsers._group_actions[0].choices[args.what]
+        subparser.print_usage(sys.stderr)
+        print(f"{subparser.prog}: error: argument {err.argument}: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("pymoo-rail: interrupted (a study keeps every run it finished; run it again to resume)",
+              file=sys.stderr)
+        return 130
+    except Exception as err:  # noqa: BLE001 - one clear line unless --debug
+        if args.debug:
+            raise
+        print(f"pymoo-rail {args.command}: error: {type(err).__name__}: {err}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,108 @@
+"""Indicators of one front, as stored in each run's record.
+
+Conventions (written down because papers differ):
+
+- ``igd``, ``gd``: pymoo's IGD and GD, i.e. the *mean* Euclidean distance to the nearest point
+  (of the front for GD, of the approximation for IGD), in raw objective units.
+- ``gd_vv``: Van Veldhuizen's form ``sqrt(sum d_i^2) / n``, the GD of seed 003 eq. 13.
+- ``hv``: hypervolume of the front normalised by the true front's ideal and nadir points, with
+  the reference point 1.1 in every normalised objective (points beyond it add nothing).
+- ``spacing``: Schott's spacing (``pymoo_rail.indicators.Spacing``, divides by n - 1, seed 003
+  eqs. 11-12), raw objective units; undefined (missing) for fewer than 2 points.
+- single objective: ``f_best`` and, where the optimum is known, ``error = f_best - f_opt``.
+
+An indicator that does not apply (no known front, a single point) is left out of the record,
+and shows as a missing value (NaN) in the results table: never a number that means nothing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+HV_REFERENCE = 1.1
+LOWER_IS_BETTER = {"igd": True, "gd": True, "gd_vv": True, "hv": False, "spacing": True, "f_best": True,
+                   "error": True, "energy_gap": True, "energy_gap_max": True, "hv_ratio": False, "energy_gap_pct": True, "n_front": False,
+                   "igd_ref": True, "gd_ref": True, "hv_ref": False}
+
+
+def spacing_indicator():
+    """Schott's spacing: ``pymoo_rail.indicators.Spacing``."""
+    from pymoo_rail.indicators import Spacing
+
+    return Spacing()
+
+
+def true_front(problem) -> np.ndarray | None:
+    """The problem's known Pareto front (dense where pymoo allows), or None."""
+    try:
+        try:
+            pf = problem.pareto_front(n_pareto_points=1000, use_cache=False)
+        except TypeError:
+            pf = problem.pareto_front()
+    except Exception:  # pymoo problems without a front raise all sorts of things
+        return None
+    if pf is None:
+        return None
+    pf = np.atleast_2d(np.asarray(pf, dtype=float))
+    if pf.size == 0 or not np.all(np.isfinite(pf)):
+        return None
+    if pf.shape[1] != problem.n_obj:
+        pf = pf.reshape(-1, problem.n_obj)
+    return pf
+
+
+def normalised_hv(F: np.ndarray, ideal: np.ndarray, nadir: np.ndarray) -> float:
+    """Hypervolume of ``F`` scaled to [ideal, nadir], reference point 1.1 per objective."""
+    from pymoo.indicators.hv import HV
+
+    span = np.where(nadir - ideal > 0, nadir - ideal, 1.0)
+    Fn = (F - ideal) / span
+    return float(HV(ref_point=np.full(F.shape[1], HV_REFERENCE))(Fn))
+
+
+def gd_van_veldhuizen(F: np.ndarray, pf: np.ndarray) -> float:
+    from scipy.spatial.distance import cdist
+
+    d = cdist(F, pf).min(axis=1)
+    return float(np.sqrt(np.sum(d * d)) / len(d))
+
+
+def front_indicators(F: np.ndarray, pf: np.ndarray | None) -> dict[str, float]:
+    """Indicators of a feasible front ``F`` (n, m); see the module docstring."""
+    out: dict[str, float] = {"n_front": float(len(F))}
+    if len(F) == 0:
+        return out
+    m = F.shape[1]
+    if m == 1:
+        out["f_best"] = float(F.min())
+        if pf is not None:
+            out["error"] = float(F.min() - pf.min())
+        return out
+    if pf is not None:
+        from pymoo.indicators.gd import GD
+        from pymoo.indicators.igd import IGD
+
+        out["igd"] = float(IGD(pf)(F))
+        out["gd"] = float(GD(pf)(F))
+        out["gd_vv"] = gd_van_veldhuizen(F, pf)
+        out["hv"] = normalised_hv(F, pf.min(axis=0), pf.max(axis=0))
+    if len(F) >= 2:
+        out["spacing"] = float(spacing_indicator()(F))
+    return out
+
+
+def convergence_point(F: np.ndarray, pf: np.ndarray | None) -> dict[str, float]:
+    """The cheap per-generation values: best per objective, and IGD / HV where ``pf`` is known."""
+    out: dict[str, float] = {}
+    if len(F) == 0:
+        return out
+    for j, value in enumerate(F.min(axis=0)):
+        out[f"f{j}_min"] = float(value)
+    if pf is not None and F.shape[1] >= 2:
+        from pymoo.indicators.igd import IGD
+
+        out["igd"] = float(IGD(pf)(F))
+        out["hv"] = normalised_hv(F, pf.min(axis=0), pf.max(axis=0))
+    elif pf is not None:
+        out["error"] = float(F.min() - pf.min())
+    return out

@@ -1,0 +1,293 @@
+"""Names of problems and algorithms a study can use, and how to build them.
+
+The tables below are constants: a worker process (local or on a Dask cluster) rebuilds any
+problem or algorithm from its name and keyword arguments alone. Beyond the built-in names, any
+importable callable works as ``"package.module:attribute"``, called with the spec's keyword
+arguments, so users extend a study without touching this module and without registering
+anything at run time (a run-time registry would not reach remote workers).
+
+Rail problems and algorithms are imported inside their factories, so this module works, and
+lists them, before or without those parts of the package.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from pymoo_rail.experiments.spec import AlgorithmSpec, ProblemSpec, StudyError
+
+# --------------------------------------------------------------------------------- problems
+
+
+def _pymoo_problem(name: str) -> Callable[..., Any]:
+    def factory(**params):
+        from pymoo.problems import get_problem
+
+        return get_problem(name, **params)
+
+    factory.__doc__ = f"pymoo's {name.upper()} (keyword arguments go to pymoo.problems.get_problem)."
+    return factory
+
+
+def _sphere(n_var: int = 10):
+    """Sphere on [-100, 100]^n (seed 000 eq. 3-6)."""
+    from pymoo_rail.experiments.functions import Sphere
+
+    return Sphere(n_var)
+
+
+def _griewank(n_var: int = 10):
+    """Griewank on [-600, 600]^n (seed 000 eq. 3-7)."""
+    from pymoo_rail.experiments.functions import Griewank
+
+    return Griewank(n_var)
+
+
+def _rosenbrock(n_var: int = 10):
+    """Rosenbrock on [-2.048, 2.048]^n (seed 000 eq. 3-8)."""
+    from pymoo_rail.experiments.functions import Rosenbrock
+
+    return Rosenbrock(n_var)
+
+
+def _case(case: Any):
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.model import Case
+
+    if isinstance(case, Case):
+        return case
+    if not isinstance(case, str):
+        raise StudyError("case", case, "must be a built-in case name or the path of a case file")
+    return load_case(case)
+
+
+def _tuples(params: dict) -> dict:
+    """TOML gives lists; the rail problems take sequences of names (tuples keep them hashable)."""
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
+
+
+def _speed_profile(case: Any = "yizhuang", **params):
+    """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path)."""
+    from pymoo_rail.problems import SpeedProfileProblem
+
+    return SpeedProfileProblem(_case(case), **_tuples(params))
+
+
+def _cooperative_trains(case: Any = "cooperative-pair", **params):
+    """``pymoo_rail.problems.CooperativeTrainsProblem`` (seed 001)."""
+    from pymoo_rail.problems import CooperativeTrainsProblem
+
+    return CooperativeTrainsProblem(_case(case), **_tuples(params))
+
+
+PROBLEMS: dict[str, Callable[..., Any]] = {
+    **{f"zdt{i}": _pymoo_problem(f"zdt{i}") for i in range(1, 7)},
+    **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}") for i in range(1, 8)},
+    "sphere": _sphere,
+    "griewank": _griewank,
+    "rosenbrock": _rosenbrock,
+    "speed_profile": _speed_profile,
+    "cooperative_trains": _cooperative_trains,
+}
+
+# ------------------------------------------------------------------------------- algorithms
+
+
+def _ref_dirs(n_obj: int, n_points: int):
+    """Reference directions with about ``n_points`` members (exactly that many for 2 objectives)."""
+    from pymoo.util.ref_dirs import get_reference_directions
+
+    if n_obj == 2:
+        return get_reference_directions("uniform", 2, n_partitions=max(n_points - 1, 1))
+    return get_reference_directions("energy", n_obj, n_points, seed=1)
+
+
+def _nsga2(problem, **params):
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+
+    return NSGA2(**params)
+
+
+def _nsga3(problem, pop_size: int = 100, **params):
+    from pymoo.algorithms.moo.nsga3 import NSGA3
+
+    return NSGA3(ref_dirs=_ref_dirs(problem.n_obj, pop_size), pop_size=pop_size, **params)
+
+
+def _moead(problem, pop_size: int = 100, n_neighbors: int = 20, **params):
+    """MOEA/D with ``pop_size`` uniform weight vectors (the population is one per vector)."""
+    from pymoo.algorithms.moo.moead import MOEAD
+
+    ref_dirs = _ref_dirs(problem.n_obj, pop_size)
+    return MOEAD(ref_dirs=ref_dirs, n_neighbors=min(n_neighbors, len(ref_dirs)), **params)
+
+
+def _smsemoa(problem, **params):
+    from pymoo.algorithms.moo.sms import SMSEMOA
+
+    return SMSEMOA(**params)
+
+
+def _de(problem, **params):
+    from pymoo.algorithms.soo.nonconvex.de import DE
+
+    return DE(**params)
+
+
+def _pso(problem, **params):
+    from pymoo.algorithms.soo.nonconvex.pso import PSO
+
+    return PSO(**params)
+
+
+def _ga(problem, **params):
+    from pymoo.algorithms.soo.nonconvex.ga import GA
+
+    return GA(**params)
+
+
+def _rail_algorithm(name: str, module: str) -> Any:
+    """``pymoo_rail.algorithms.<name>``, or straight from its module before it is exported."""
+    try:
+        return getattr(importlib.import_module("pymoo_rail.algorithms"), name)
+    except (ImportError, AttributeError):
+        pass
+    try:
+        return getattr(importlib.import_module(f"pymoo_rail.algorithms.{module}"), name)
+    except (ImportError, AttributeError) as err:
+        raise StudyError("algorithm", name, f"pymoo_rail.algorithms.{name} is not available in this "
+                                            f"installation ({err})") from None
+
+
+def _abc(problem, **params):
+    """``pymoo_rail.algorithms.ABC`` (seed 000, 3.2-3.3)."""
+    return _rail_algorithm("ABC", "abc")(**params)
+
+
+def _moabc(problem, **params):
+    """``pymoo_rail.algorithms.MOABC`` (seed 000, 4.5.2)."""
+    return _rail_algorithm("MOABC", "moabc")(**params)
+
+
+def _fixed_genes(problem):
+    """Genes a rail encoding holds constant (speed codes inside neutral sections), if any."""
+    fixed = getattr(getattr(problem, "encoding", None), "fixed", None)
+    if not callable(fixed):
+        return None
+    mask = fixed()
+    return mask if mask.any() else None
+
+
+def _grnsga2(problem, **params):
+    """``pymoo_rail.algorithms.GoldenRatioNSGA2`` (seed 003, 3.1); on a rail problem the genes of
+    neutral sections are passed as ``fixed_genes`` unless given."""
+    if "fixed_genes" not in params:
+        fixed = _fixed_genes(problem)
+        if fixed is not None:
+            params["fixed_genes"] = fixed
+    return _rail_algorithm("GoldenRatioNSGA2", "golden_ratio_nsga2")(**params)
+
+
+@dataclass(frozen=True)
+class AlgorithmEntry:
+    """A built-in algorithm: its factory ``(problem, **params)`` and what problems it takes."""
+
+    factory: Callable[..., Any]
+    objectives: str  # "single" (n_obj == 1), "multi" (n_obj >= 2) or "any"
+    summary: str
+
+
+ALGORITHMS: dict[str, AlgorithmEntry] = {
+    "nsga2": AlgorithmEntry(_nsga2, "any", "NSGA-II (pymoo)"),
+    "nsga3": AlgorithmEntry(_nsga3, "multi", "NSGA-III with pop_size reference directions (pymoo)"),
+    "moead": AlgorithmEntry(_moead, "multi", "MOEA/D with pop_size weight vectors (pymoo)"),
+    "sms-emoa": AlgorithmEntry(_smsemoa, "multi", "SMS-EMOA (pymoo)"),
+    "de": AlgorithmEntry(_de, "single", "differential evolution (pymoo)"),
+    "pso": AlgorithmEntry(_pso, "single", "particle swarm (pymoo)"),
+    "ga": AlgorithmEntry(_ga, "single", "genetic algorithm (pymoo)"),
+    "abc": AlgorithmEntry(_abc, "single", "artificial bee colony (pymoo_rail, seed 000)"),
+    "moabc": AlgorithmEntry(_moabc, "any", "multi-objective bee colony (pymoo_rail, seed 000)"),
+    "grnsga2": AlgorithmEntry(_grnsga2, "any", "golden-ratio NSGA-II (pymoo_rail, seed 003)"),
+}
+
+ALIASES = {"smsemoa": "sms-emoa", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
+           "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
+           "cooperative-trains": "cooperative_trains"}
+
+# ------------------------------------------------------------------------------ resolving
+
+
+def canonical_name(name: str) -> str:
+    """Lower case, ``_`` and ``-`` accepted for each other, common aliases mapped."""
+    key = name.strip().lower()
+    if key in ALIASES:
+        return ALIASES[key]
+    if key.replace("_", "-") in ALGORITHMS:
+        return key.replace("_", "-")
+    return ALIASES.get(key.replace("_", "-"), key)
+
+
+def _import_path(path: str, kind: str) -> Callable[..., Any]:
+    module_name, _, attribute = path.partition(":")
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as err:
+        raise StudyError(kind, path, f"cannot import module '{module_name}': {err}") from None
+    try:
+        return getattr(module, attribute)
+    except AttributeError:
+        raise StudyError(kind, path, f"module '{module_name}' has no attribute '{attribute}'") from None
+
+
+def problem_names() -> list[str]:
+    return sorted(PROBLEMS)
+
+
+def algorithm_names() -> list[str]:
+    return sorted(ALGORITHMS)
+
+
+def check_problem_name(name: str) -> None:
+    """Raise :class:`StudyError` for a name that is neither built in nor an import path."""
+    if ":" not in name and canonical_name(name) not in PROBLEMS:
+        raise StudyError("problem", name, f"unknown problem (built-in: {', '.join(problem_names())}; "
+                                          "or give 'package.module:factory')")
+
+
+def check_algorithm_name(name: str) -> None:
+    if ":" not in name and canonical_name(name) not in ALGORITHMS:
+        raise StudyError("algorithm", name, f"unknown algorithm (built-in: {', '.join(algorithm_names())}; "
+                                            "or give 'package.module:factory')")
+
+
+def _call(factory: Callable[..., Any], kind: str, spec, *args) -> Any:
+    try:
+        return factory(*args, **spec.params)
+    except TypeError as err:
+        # an unknown or missing keyword argument: say which spec it came from
+        raise StudyError(f"{kind} '{spec.display}'", spec.params, f"bad parameters: {err}") from None
+
+
+def build_problem(spec: ProblemSpec):
+    """The pymoo problem a spec names."""
+    if ":" in spec.name:
+        return _call(_import_path(spec.name, "problem"), "problem", spec)
+    check_problem_name(spec.name)
+    return _call(PROBLEMS[canonical_name(spec.name)], "problem", spec)
+
+
+def build_algorithm(spec: AlgorithmSpec, problem):
+    """The pymoo algorithm a spec names, set up for ``problem``'s number of objectives."""
+    if ":" in spec.name:
+        return _call(_import_path(spec.name, "algorithm"), "algorithm", spec)
+    check_algorithm_name(spec.name)
+    name = canonical_name(spec.name)
+    entry = ALGORITHMS[name]
+    n_obj = problem.n_obj
+    if entry.objectives == "single" and n_obj != 1:
+        raise StudyError("algorithm", spec.name, f"is single-objective; the problem has {n_obj} objectives")
+    if entry.objectives == "multi" and n_obj < 2:
+        raise StudyError("algorithm", spec.name, "is multi-objective; the problem has 1 objective")
+    return _call(entry.factory, "algorithm", spec, problem)

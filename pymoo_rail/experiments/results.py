@@ -1,0 +1,102 @@
+"""Stored runs as a pandas DataFrame."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.experiments.spec import Study
+from pymoo_rail.experiments.store import STUDY_FILE, ResultStore
+
+BASE_COLUMNS = ("run_id", "problem", "algorithm", "seed", "budget", "n_var", "n_obj", "n_eval", "n_gen",
+                "wall_time_s", "feasible")
+
+
+def _study_of(directory: Path, study: Study | None) -> Study | None:
+    if study is not None:
+        return study
+    path = directory / STUDY_FILE
+    if path.is_file():
+        from pymoo_rail.experiments.study_file import read_study
+
+        return read_study(path)
+    return None
+
+
+def load_records(directory: str | Path, study: Study | None = None, all_runs: bool = False) -> list[dict]:
+    """The stored records of a study directory.
+
+    Parameters
+    ----------
+    directory : path
+    study : Study, optional
+        Keep the runs of this study and label them with its current labels. By default the
+        directory's ``study.toml`` is used; records of runs the study no longer contains
+        (e.g. after its parameters were edited) are left out unless ``all_runs``.
+    all_runs : bool
+        Return every record in the directory, with the labels stored in it.
+    """
+    directory = Path(directory)
+    study = None if all_runs else _study_of(directory, study)
+    store = ResultStore(directory)
+    if study is None:
+        return list(store.records())
+    runs = {r.run_id: r for r in study.runs()}
+    records = []
+    for record in store.records(set(runs)):
+        run = runs[record["run_id"]]
+        record["problem_label"] = run.problem.display
+        record["algorithm_label"] = run.algorithm.display
+        records.append(record)
+    return records
+
+
+def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
+    """One row per run: ids, labels, budget, evaluations, wall time, one column per indicator.
+
+    ``problem_spec`` and ``algorithm_spec`` hold the specs (dicts) the run was built from.
+    With ``fronts``, the columns ``F`` and ``X`` hold the final front as arrays, ``extras`` a
+    dict of per-member arrays (rail problems: ``energy_kwh``, ``running_time_s``,
+    ``stop_error_m``) and ``history`` the per-generation dict of lists.
+    Indicators that do not apply to a run are missing (NaN).
+    """
+    rows = []
+    for r in records:
+        budget_kind, budget_value = next(iter(r["budget"].items()))
+        row = {"run_id": r["run_id"], "problem": r["problem_label"], "algorithm": r["algorithm_label"],
+               "seed": r["seed"], "budget": f"{budget_kind}={budget_value}", "n_var": r["n_var"],
+               "n_obj": r["n_obj"], "n_eval": r["n_eval"], "n_gen": r["n_gen"], "wall_time_s": r["wall_time_s"],
+               "feasible": r["feasible"], "problem_spec": r["problem"], "algorithm_spec": r["algorithm"]}
+        row.update(r["indicators"])
+        if fronts:
+            n_obj, n_var = r["n_obj"], r["n_var"]
+            row["F"] = np.asarray(r["front"]["F"], dtype=float).reshape(-1, n_obj)
+            row["X"] = np.asarray(r["front"]["X"], dtype=float).reshape(-1, n_var)
+            row["CV"] = np.asarray(r["front"]["CV"], dtype=float)
+            row["extras"] = {k: np.asarray(v, dtype=float) for k, v in r["front"].get("extras", {}).items()}
+            row["history"] = r.get("history")
+        rows.append(row)
+    frame = pd.DataFrame(rows, columns=None if rows else list(BASE_COLUMNS))
+    if len(frame):
+        frame = frame.sort_values(["problem", "algorithm", "seed"], kind="stable").reset_index(drop=True)
+    return frame
+
+
+def load_results(directory: str | Path, study: Study | None = None, fronts: bool = True,
+                 all_runs: bool = False) -> pd.DataFrame:
+    """The runs stored in a study directory as a DataFrame (see :func:`records_frame`).
+
+    >>> results = load_results("out/zdt")                                    # doctest: +SKIP
+    >>> results.groupby(["problem", "algorithm"])["igd"].median()            # doctest: +SKIP
+    """
+    return records_frame(load_records(directory, study, all_runs), fronts=fronts)
+
+
+def indicator_columns(results: pd.DataFrame) -> list[str]:
+    """The indicator columns present in a results frame, in a fixed order."""
+    from pymoo_rail.experiments.metrics import LOWER_IS_BETTER
+
+    preferred = [c for c in LOWER_IS_BETTER if c in results.columns and c != "n_front"]
+    return preferred

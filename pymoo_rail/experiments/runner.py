@@ -1,0 +1,300 @@
+"""Running a study: every pending run, on a local process pool or a Dask cluster.
+
+The same function, :func:`execute_run`, runs in every worker: it rebuilds the problem and the
+algorithm from their specs, calls pymoo's ``minimize`` with the run's seed and returns a plain
+record. The driver stores each record the moment it arrives (see :mod:`.store`), so stopping a
+study at any point loses only the runs still in flight; the next start skips every stored run.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import multiprocessing
+import os
+import platform
+import socket
+import time
+import traceback
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+from contextlib import ExitStack
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pymoo_rail.experiments.metrics import convergence_point, front_indicators, true_front
+from pymoo_rail.experiments.registry import build_algorithm, build_problem
+from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
+from pymoo_rail.experiments.store import RECORD_FORMAT, STUDY_FILE, ResultStore
+
+# per-individual outputs a rail problem puts next to F (DESIGN.md section 3); kept with the front
+EXTRA_KEYS = ("energy_kwh", "running_time_s", "stop_error_m")
+
+
+def versions() -> dict[str, str]:
+    import pymoo
+
+    import pymoo_rail
+
+    return {"pymoo": pymoo.__version__, "pymoo_rail": pymoo_rail.__version__, "numpy": np.__version__,
+            "python": platform.python_version()}
+
+
+def _extras(problem, opt, X: np.ndarray) -> dict[str, list[float]]:
+    """Running time, energy and stop error of each front member, when the problem knows them."""
+    extras: dict[str, list[float]] = {}
+    for key in EXTRA_KEYS:
+        values = opt.get(key)
+        if values is not None and len(values) and all(v is not None for v in values):
+            extras[key] = [float(v) for v in values]
+    if not extras and hasattr(problem, "trajectory") and len(X):
+        trajectories = [problem.trajectory(x) for x in X]
+        extras = {"energy_kwh": [t.energy.net_kwh for t in trajectories],
+                  "running_time_s": [t.running_time_s for t in trajectories],
+                  "stop_error_m": [t.stop_error_m for t in trajectories]}
+    return extras
+
+
+class _History:
+    """pymoo callback: per generation, evaluations so far and cheap indicators of the feasible front."""
+
+    def __init__(self, pf: np.ndarray | None):
+        self.pf = pf
+        self.rows: list[dict[str, float]] = []
+
+    def __call__(self, algorithm) -> None:
+        opt = algorithm.opt
+        row: dict[str, float] = {"n_gen": float(algorithm.n_iter), "n_eval": float(algorithm.evaluator.n_eval)}
+        if opt is not None and len(opt):
+            F, CV = opt.get("F", "CV")
+            row.update(convergence_point(F[CV.reshape(-1) <= 0.0], self.pf))
+        self.rows.append(row)
+
+    def columns(self) -> dict[str, list[float | None]]:
+        keys: list[str] = []
+        for row in self.rows:
+            keys += [k for k in row if k not in keys]
+        return {k: [row.get(k) for row in self.rows] for k in keys}
+
+
+def execute_run(run: RunSpec) -> dict[str, Any]:
+    """Run one study run and return its record (a JSON-ready dict).
+
+    The record holds the final front (``F``, ``X``, constraint violation and, for rail problems,
+    energy, running time and stop error of each member), its indicators, the evaluations used,
+    the wall time, the per-generation history and the versions of pymoo and pymoo-rail.
+    """
+    from pymoo.optimize import minimize
+
+    problem = build_problem(run.problem)
+    algorithm = build_algorithm(run.algorithm, problem)
+    pf = true_front(problem)
+    history = _History(pf) if run.history else None
+    start = time.perf_counter()
+    res = minimize(problem, algorithm, run.budget.termination, seed=run.seed, verbose=False,
+                   callback=history, copy_algorithm=False)
+    wall_time_s = time.perf_counter() - start
+
+    opt = res.algorithm.opt
+    X = np.asarray(opt.get("X"), dtype=float) if opt is not None else np.empty((0, problem.n_var))
+    F = np.asarray(opt.get("F"), dtype=float) if opt is not None else np.empty((0, problem.n_obj))
+    CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1) if opt is not None else np.empty(0)
+    feasible = CV <= 0.0
+    indicators = front_indicators(F[feasible], pf)
+    return {
+        "format": RECORD_FORMAT,
+        "run_id": run.run_id,
+        "problem": run.problem.identity(),
+        "problem_label": run.problem.display,
+        "algorithm": run.algorithm.identity(),
+        "algorithm_label": run.algorithm.display,
+        "seed": run.seed,
+        "budget": run.budget.to_dict(),
+        "n_var": int(problem.n_var),
+        "n_obj": int(problem.n_obj),
+        "n_eval": int(res.algorithm.evaluator.n_eval),
+        "n_gen": int(res.algorithm.n_iter - 1),
+        "wall_time_s": wall_time_s,
+        "feasible": bool(feasible.any()),
+        "indicators": indicators,
+        "front": {"F": F.tolist(), "X": X.tolist(), "CV": CV.tolist(),
+                  "extras": _extras(problem, opt, X) if len(X) else {}},
+        "history": history.columns() if history is not None else None,
+        "versions": versions(),
+        "host": socket.gethostname(),
+        "finished_at": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+    }
+
+
+def execute_run_safely(run: RunSpec) -> tuple[str, dict[str, Any]]:
+    """:func:`execute_run` that returns an error as data (with its traceback) instead of raising."""
+    try:
+        return "ok", execute_run(run)
+    except Exception as err:  # noqa: BLE001 - reported per run; the study goes on
+        return "error", {"run_id": run.run_id, "run": run.describe(), "error": f"{type(err).__name__}: {err}",
+                         "traceback": traceback.format_exc(),
+                         "finished_at": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")}
+
+
+def _worker_init() -> None:
+    # one numba thread per worker process: the pool already uses every core
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+
+@dataclass
+class StudyReport:
+    """What :func:`run_study` did."""
+
+    directory: Path
+    n_runs: int
+    n_skipped: int
+    n_finished: int
+    failures: list[dict] = field(default_factory=list)
+
+    @property
+    def complete(self) -> bool:
+        return self.n_skipped + self.n_finished == self.n_runs
+
+    def __str__(self) -> str:
+        text = (f"{self.n_runs} runs: {self.n_skipped} already stored, {self.n_finished} run now, "
+                f"{len(self.failures)} failed; results in {self.directory}")
+        for f in self.failures:
+            text += f"\n  FAILED {f['run']}: {f['error']}"
+        return text
+
+
+def _check_study(study: Study) -> None:
+    """Build every problem and every (algorithm, problem) pair once: fail before any work starts."""
+    for p in study.problems:
+        try:
+            problem = build_problem(p)
+        except StudyError:
+            raise
+        except Exception as err:
+            raise StudyError(f"problem '{p.display}'", p.to_dict(), f"cannot be built: {err}") from err
+        for a in study.algorithms:
+            try:
+                build_algorithm(a, problem)
+            except StudyError as err:
+                raise StudyError(f"algorithm '{a.display}'", a.to_dict(),
+                                 f"cannot run on problem '{p.display}': {err.reason}") from None
+            except Exception as err:
+                raise StudyError(f"algorithm '{a.display}'", a.to_dict(), f"cannot be built: {err}") from err
+
+
+def _dask_executor(stack: ExitStack, scheduler: Any, workers: int) -> Executor:
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise StudyError("scheduler", scheduler, "needs dask.distributed: pip install 'pymoo-rail[distributed]'") \
+            from None
+    if isinstance(scheduler, Client):
+        client = scheduler
+    elif scheduler == "local":
+        cluster = stack.enter_context(LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+            dashboard_address=None, env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}))
+        client = stack.enter_context(Client(cluster))
+    else:
+        try:
+            client = stack.enter_context(Client(scheduler, timeout="20s"))
+        except (OSError, TimeoutError) as err:
+            raise StudyError("scheduler", scheduler, f"cannot connect to the Dask scheduler: {err}") from None
+    return client.get_executor(pure=False)
+
+
+def run_study(study: Study, directory: str | Path, workers: int | None = None, scheduler: Any = None,
+              progress: bool = True, check: bool = True) -> StudyReport:
+    """Run every run of ``study`` that is not yet stored in ``directory``.
+
+    Parameters
+    ----------
+    study : Study
+    directory : path
+        The study directory (created if needed): ``runs/<run_id>.json`` per finished run.
+    workers : int, optional
+        Worker processes (default: the number of CPUs). ``1`` runs in this process.
+    scheduler : None, "local", str or distributed.Client
+        ``None``: a local ``ProcessPoolExecutor``. ``"local"``: a Dask ``LocalCluster`` with
+        ``workers`` single-threaded worker processes on the loopback interface. Any other string:
+        the address of a running Dask scheduler (``"tcp://host:8786"``). A ``Client`` is used as is.
+        Results are the same whichever runs them: each run is seeded by its own seed.
+    progress : bool
+        Show a progress bar (tqdm, on stderr).
+    check : bool
+        Build every problem and algorithm once before starting, so a typo fails at once.
+
+    Returns
+    -------
+    StudyReport
+        Counts of skipped, finished and failed runs. Failed runs are stored in ``failed/`` with
+        their traceback and are retried at the next start.
+    """
+    from tqdm import tqdm
+
+    from pymoo_rail.experiments.study_file import write_study
+
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise StudyError("workers", workers, "must be a positive integer")
+    if check:
+        _check_study(study)
+
+    store = ResultStore(directory)
+    store.prepare()
+    write_study(study, store.directory / STUDY_FILE)
+    runs = study.runs()
+    done = store.done_ids()
+    pending = [r for r in runs if r.run_id not in done]
+    report = StudyReport(store.directory, len(runs), len(runs) - len(pending), 0)
+    if not pending:
+        return report
+
+    with ExitStack() as stack:
+        bar = stack.enter_context(tqdm(total=len(runs), initial=report.n_skipped, desc=f"study {study.name}",
+                                       unit="run", disable=not progress, dynamic_ncols=True))
+
+        def store_result(status: str, payload: dict) -> None:
+            if status == "ok":
+                store.write(payload)
+                report.n_finished += 1
+            else:
+                store.write_failure(payload["run_id"], payload)
+                report.failures.append(payload)
+                bar.write(f"FAILED {payload['run']}: {payload['error']}")
+            bar.update(1)
+
+        if scheduler is None and workers == 1:
+            for run in pending:
+                store_result(*execute_run_safely(run))
+            return report
+
+        if scheduler is not None:
+            executor = _dask_executor(stack, scheduler, workers)
+        else:
+            executor = stack.enter_context(ProcessPoolExecutor(
+                max_workers=min(workers, len(pending)), mp_context=multiprocessing.get_context("spawn"),
+                initializer=_worker_init))
+        futures: dict[Future, RunSpec] = {}
+        try:
+            for run in pending:
+                futures[executor.submit(execute_run_safely, run)] = run
+            for future in as_completed(futures):
+                store_result(*future.result())
+        except BrokenProcessPool as err:
+            raise RuntimeError(
+                "a worker process of the local pool died, so the study stopped (finished runs are stored; "
+                "run again to resume). If it died at start-up: the pool starts fresh interpreters that "
+                "import your main script, so call run_study under `if __name__ == \"__main__\":` and not "
+                "from standard input; or use workers=1 or a Dask scheduler.") from err
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            if isinstance(executor, ProcessPoolExecutor):
+                executor.shutdown(wait=False, cancel_futures=True)
+            raise
+    return report

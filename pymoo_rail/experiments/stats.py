@@ -1,0 +1,368 @@
+"""Statistics of a study: summaries per problem and algorithm, rank-sum tests, publishable tables.
+
+Everything here takes the results frame of :func:`pymoo_rail.experiments.load_results` (one
+row per run, one column per indicator) and returns pandas objects, so the tables can be
+reshaped further; :func:`write_tables` writes the usual set as CSV and Markdown.
+
+Tests: Wilcoxon's rank-sum test (the two-sample Mann-Whitney U test), two-sided, exact for
+small samples without ties (scipy chooses), of each algorithm against a baseline on each
+problem and indicator. A verdict ``+`` means significantly better than the baseline at level
+``alpha``, ``-`` significantly worse, ``=`` no significant difference; "better" follows the
+indicator's direction (lower IGD, higher HV, ...) and the side of the U statistic.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.experiments.metrics import LOWER_IS_BETTER, gd_van_veldhuizen, normalised_hv
+from pymoo_rail.experiments.results import indicator_columns
+
+STATS = ("min", "mean", "median", "max", "std")
+
+
+def _check_indicators(results: pd.DataFrame, indicators: Sequence[str] | None) -> list[str]:
+    if indicators is None:
+        indicators = indicator_columns(results)
+    for name in indicators:
+        if name not in results.columns:
+            raise ValueError(f"indicator {name!r} is not in the results (present: {', '.join(indicator_columns(results))})")
+    return list(indicators)
+
+
+def lower_is_better(indicator: str) -> bool:
+    """Direction of an indicator (unknown names are taken as 'lower is better')."""
+    return LOWER_IS_BETTER.get(indicator, True)
+
+
+def summarize(results: pd.DataFrame, indicators: Sequence[str] | None = None,
+              stats: Sequence[str] = STATS) -> pd.DataFrame:
+    """Min / mean / median / max / std of each indicator per problem and algorithm.
+
+    Returns a frame indexed by (problem, algorithm) with columns (indicator, statistic) and a
+    column ``("runs", "n")``: the number of runs. ``std`` is the sample standard deviation
+    (n - 1). Runs where an indicator does not apply are left out of that indicator's figures;
+    ``(indicator, "n")`` says how many runs it covers when that differs from ``runs``.
+    """
+    indicators = _check_indicators(results, indicators)
+    grouped = results.groupby(["problem", "algorithm"], sort=True)
+    parts = {("runs", "n"): grouped.size()}
+    for name in indicators:
+        agg = grouped[name].agg(list(stats))
+        for stat in stats:
+            parts[(name, stat)] = agg[stat]
+        counts = grouped[name].count()
+        if not counts.equals(parts[("runs", "n")]):
+            parts[(name, "n")] = counts
+    frame = pd.DataFrame(parts)
+    frame.columns = pd.MultiIndex.from_tuples(frame.columns, names=["indicator", "statistic"])
+    return frame
+
+
+def rank_sum(sample: Sequence[float], baseline: Sequence[float], lower_better: bool = True,
+             alpha: float = 0.05) -> tuple[float, float, str]:
+    """Wilcoxon rank-sum test of ``sample`` against ``baseline``: ``(U, p, verdict)``.
+
+    ``U`` counts the pairs where the sample value exceeds the baseline value (ties count 1/2).
+    The verdict is ``"+"`` (sample significantly better), ``"-"`` (worse), ``"="`` (no
+    significant difference), or ``"n/a"`` when a side has fewer than 2 values (U and p NaN).
+    """
+    from scipy.stats import mannwhitneyu
+
+    a = np.asarray(sample, dtype=float)
+    b = np.asarray(baseline, dtype=float)
+    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
+    if len(a) < 2 or len(b) < 2:
+        return float("nan"), float("nan"), "n/a"
+    if np.all(a == a[0]) and np.all(b == a[0]):
+        return len(a) * len(b) / 2.0, 1.0, "="
+    u, p = mannwhitneyu(a, b, alternative="two-sided")
+    u, p = float(u), float(p)
+    if p >= alpha:
+        return u, p, "="
+    sample_larger = u > len(a) * len(b) / 2.0
+    better = (not sample_larger) if lower_better else sample_larger
+    return u, p, "+" if better else "-"
+
+
+def rank_sum_tests(results: pd.DataFrame, baseline: str, indicators: Sequence[str] | None = None,
+                   alpha: float = 0.05) -> pd.DataFrame:
+    """Each algorithm against ``baseline`` on each problem and indicator (see :func:`rank_sum`).
+
+    Columns: problem, algorithm, indicator, n, n_baseline, median, median_baseline, U, p_value,
+    verdict.
+    """
+    indicators = _check_indicators(results, indicators)
+    algorithms = sorted(results["algorithm"].unique())
+    if baseline not in algorithms:
+        raise ValueError(f"baseline {baseline!r} is not among the algorithms ({', '.join(algorithms)})")
+    rows = []
+    for problem_name, group in results.groupby("problem", sort=True):
+        base = group[group["algorithm"] == baseline]
+        for algorithm_name in algorithms:
+            if algorithm_name == baseline:
+                continue
+            other = group[group["algorithm"] == algorithm_name]
+            if other.empty:
+                continue
+            for name in indicators:
+                a, b = other[name].dropna().to_numpy(float), base[name].dropna().to_numpy(float)
+                if len(a) == 0 and len(b) == 0:
+                    continue  # the indicator does not apply to this problem
+                u, p, verdict = rank_sum(a, b, lower_is_better(name), alpha)
+                rows.append({"problem": problem_name, "algorithm": algorithm_name, "indicator": name,
+                             "n": len(a), "n_baseline": len(b),
+                             "median": float(np.median(a)) if len(a) else np.nan,
+                             "median_baseline": float(np.median(b)) if len(b) else np.nan,
+                             "U": u, "p_value": p, "verdict": verdict})
+    return pd.DataFrame(rows, columns=["problem", "algorithm", "indicator", "n", "n_baseline", "median",
+                                       "median_baseline", "U", "p_value", "verdict"])
+
+
+def indicator_table(results: pd.DataFrame, indicator: str, baseline: str | None = None, alpha: float = 0.05,
+                    digits: int = 4) -> pd.DataFrame:
+    """The table papers print: problems x algorithms, cells ``mean (std)``.
+
+    With a baseline, each other cell ends in the rank-sum verdict ``+``, ``-`` or ``=``. The best
+    mean per problem is marked with ``*`` (Markdown bold in :func:`write_tables`).
+    """
+    _check_indicators(results, [indicator])
+    lower = lower_is_better(indicator)
+    tests = rank_sum_tests(results, baseline, [indicator], alpha) if baseline else None
+    table = {}
+    for problem_name, group in results.groupby("problem", sort=True):
+        stats = group.groupby("algorithm")[indicator].agg(["mean", "std", "count"])
+        stats = stats[stats["count"] > 0]
+        if stats.empty:
+            continue
+        best = stats["mean"].idxmin() if lower else stats["mean"].idxmax()
+        row = {}
+        for algorithm_name, s in stats.iterrows():
+            std = f"{s['std']:.{digits}g}" if s["count"] > 1 else "-"
+            cell = f"{s['mean']:.{digits}g} ({std})"
+            if tests is not None and algorithm_name != baseline:
+                hit = tests[(tests["problem"] == problem_name) & (tests["algorithm"] == algorithm_name)]
+                if len(hit):
+                    cell += f" {hit['verdict'].iloc[0]}"
+            if algorithm_name == best:
+                cell = "*" + cell
+            row[algorithm_name] = cell
+        table[problem_name] = row
+    frame = pd.DataFrame.from_dict(table, orient="index")
+    frame.index.name = "problem"
+    columns = sorted(frame.columns)
+    if baseline in columns:
+        columns.remove(baseline)
+        columns.insert(0, baseline)
+    return frame[columns].fillna("")
+
+
+def verdict_counts(tests: pd.DataFrame) -> pd.DataFrame:
+    """How often each algorithm is better / equal / worse than the baseline, per indicator."""
+    if tests.empty:
+        return pd.DataFrame(columns=["+", "=", "-"])
+    counts = tests.groupby(["algorithm", "indicator"])["verdict"].value_counts().unstack(fill_value=0)
+    for column in ("+", "=", "-"):
+        if column not in counts.columns:
+            counts[column] = 0
+    return counts[["+", "=", "-"]]
+
+
+# ------------------------------------------------------------------- reference indicators
+
+
+def nondominated(F: np.ndarray) -> np.ndarray:
+    """The non-dominated rows of ``F`` (duplicates kept once)."""
+    from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+    F = np.unique(np.asarray(F, dtype=float), axis=0)
+    if len(F) == 0:
+        return F
+    return F[NonDominatedSorting().do(F, only_non_dominated_front=True)]
+
+
+def reference_fronts(results: pd.DataFrame) -> dict[str, np.ndarray]:
+    """Per problem, the non-dominated union of every run's feasible final front.
+
+    The usual reference when the true front is unknown (rail problems): the best front the
+    study found. Indicators against it compare the algorithms of *this* study only.
+    """
+    out = {}
+    for problem_name, group in results.groupby("problem", sort=True):
+        fronts = [F[CV <= 0] for F, CV in zip(group["F"], group["CV"]) if len(F)]
+        fronts = [F for F in fronts if len(F)]
+        if fronts:
+            out[problem_name] = nondominated(np.vstack(fronts))
+    return out
+
+
+def add_reference_indicators(results: pd.DataFrame, references: Mapping[str, np.ndarray] | None = None,
+                             problems: Sequence[str] | None = None) -> pd.DataFrame:
+    """Add ``igd_ref``, ``gd_ref`` and ``hv_ref``: indicators against a reference front.
+
+    Parameters
+    ----------
+    results : DataFrame with fronts (``load_results(..., fronts=True)``).
+    references : mapping problem -> front (n, m), optional
+        Default: :func:`reference_fronts`, the non-dominated union of the study's fronts.
+    problems : sequence of str, optional
+        Problems to treat (default: the multi-objective ones without a true-front ``igd``).
+
+    ``hv_ref`` is normalised by the reference front's ideal and nadir points with the reference
+    point 1.1 (as ``hv``); ``gd_ref`` is pymoo's (mean-distance) GD. A copy is returned.
+    """
+    from pymoo.indicators.gd import GD
+    from pymoo.indicators.igd import IGD
+
+    if "F" not in results.columns:
+        raise ValueError("results have no fronts: load them with load_results(..., fronts=True)")
+    references = dict(reference_fronts(results) if references is None else references)
+    if problems is None:
+        multi = results[results["n_obj"] >= 2]
+        has_true = set(multi.loc[multi["igd"].notna(), "problem"]) if "igd" in multi.columns else set()
+        problems = sorted(set(multi["problem"]) - has_true)
+    out = results.copy()
+    for column in ("igd_ref", "gd_ref", "hv_ref"):
+        if column not in out.columns:
+            out[column] = np.nan
+    for index, row in out.iterrows():
+        if row["problem"] not in problems or row["problem"] not in references:
+            continue
+        ref = np.asarray(references[row["problem"]], dtype=float)
+        F = row["F"][row["CV"] <= 0]
+        if len(F) == 0:
+            continue
+        out.at[index, "igd_ref"] = float(IGD(ref)(F))
+        out.at[index, "gd_ref"] = float(GD(ref)(F))
+        out.at[index, "hv_ref"] = normalised_hv(F, ref.min(axis=0), ref.max(axis=0))
+    return out
+
+
+def _energy_gap_function():
+    """``pymoo_rail.indicators.energy.energy_gap`` when that part is installed, else None."""
+    try:
+        from pymoo_rail.indicators.energy import energy_gap
+    except ImportError:
+        return None
+    return energy_gap
+
+
+def add_energy_gap(results: pd.DataFrame, references: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
+    """Add the gap of each rail front to the exact optimal front.
+
+    Columns: ``energy_gap`` (mean relative energy above the optimum at the same running time,
+    over the front's points inside the reference's time range), ``energy_gap_max`` and
+    ``hv_ratio`` (the front's hypervolume over the reference's).
+
+    ``references`` maps a problem label to the optimal front of its case, a DataFrame with
+    columns ``running_time_s`` and ``energy_kwh`` (``pymoo_rail.optimal.optimal_front``). Each
+    run's front is taken from its stored ``running_time_s`` and ``energy_kwh`` per member, and
+    compared with ``pymoo_rail.indicators.energy.energy_gap``. Problems without a reference,
+    or runs without those extras, get no value. Raises ImportError when the indicator is not
+    installed.
+    """
+    energy_gap = _energy_gap_function()
+    if energy_gap is None:
+        raise ImportError("energy_gap needs pymoo_rail.indicators.energy (the exact reference solver part)")
+    out = results.copy()
+    for column in ("energy_gap", "energy_gap_max", "hv_ratio"):
+        if column not in out.columns:
+            out[column] = np.nan
+    for index, row in out.iterrows():
+        reference = references.get(row["problem"])
+        extras = row.get("extras") or {}
+        if reference is None or "running_time_s" not in extras or "energy_kwh" not in extras:
+            continue
+        feasible = row["CV"] <= 0
+        if not feasible.any():
+            continue
+        front = pd.DataFrame({"running_time_s": extras["running_time_s"][feasible],
+                              "energy_kwh": extras["energy_kwh"][feasible]})
+        gap = energy_gap(front, reference)
+        out.at[index, "energy_gap"] = gap["mean_gap_rel"]  # mean relative energy above the optimum
+        out.at[index, "energy_gap_max"] = gap["max_gap_rel"]
+        out.at[index, "hv_ratio"] = gap["hv_ratio"]
+    return out
+
+
+# --------------------------------------------------------------------------------- tables
+
+
+def _cell(value) -> str:
+    if isinstance(value, float):
+        if np.isnan(value):
+            return ""
+        return f"{value:.4g}"
+    return str(value)
+
+
+def to_markdown(frame: pd.DataFrame, bold_marker: str | None = "*") -> str:
+    """A GitHub-flavoured Markdown table (no extra dependency). Cells starting with
+    ``bold_marker`` are printed in bold without it."""
+    flat = frame.reset_index() if frame.index.name or any(frame.index.names) else frame.copy()
+    if isinstance(flat.columns, pd.MultiIndex):
+        flat.columns = [" ".join(str(c) for c in col if str(c)) for col in flat.columns]
+    header = [str(c) for c in flat.columns]
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    for _, row in flat.iterrows():
+        cells = []
+        for value in row:
+            text = _cell(value)
+            if bold_marker and text.startswith(bold_marker):
+                text = f"**{text[len(bold_marker):]}**"
+            cells.append(text.replace("|", "\\|"))
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | None = None,
+                 indicators: Sequence[str] | None = None, alpha: float = 0.05) -> list[Path]:
+    """Write the statistics of a study as CSV and Markdown into ``directory``.
+
+    Files: ``summary.csv`` / ``summary.md`` (min / mean / median / max / std per problem and
+    algorithm), ``<indicator>.md`` / ``.csv`` (mean (std) tables with verdicts), and with a
+    baseline ``ranksum.csv`` / ``ranksum.md`` (every test) and ``verdicts.md`` (+/=/- counts).
+    Returns the paths written.
+    """
+    from pymoo_rail.experiments.store import atomic_write_text
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    indicators = _check_indicators(results, indicators)
+    written = []
+
+    def emit(name: str, text: str) -> None:
+        written.append(atomic_write_text(directory / name, text))
+
+    summary = summarize(results, indicators)
+    emit("summary.csv", summary.to_csv())
+    sections = []
+    for name in indicators:
+        if results[name].notna().any():
+            part = summary[name].copy()
+            part.insert(0, "n", summary[("runs", "n")] if "n" not in part.columns else part.pop("n"))
+            sections.append(f"## {name}\n\n" + to_markdown(part, bold_marker=None))
+    emit("summary.md", f"# Summary over seeds (std: sample standard deviation)\n\n" + "\n".join(sections))
+    for name in indicators:
+        if results[name].notna().any():
+            table = indicator_table(results, name, baseline, alpha)
+            emit(f"{name}.csv", table.to_csv())
+            title = f"{name}: mean (std) over seeds" + (
+                f"; vs {baseline}: + better, - worse, = no significant difference "
+                f"(Wilcoxon rank-sum, alpha = {alpha})" if baseline else "") + "; best mean in bold\n\n"
+            emit(f"{name}.md", title + to_markdown(table))
+    if baseline is not None:
+        tests = rank_sum_tests(results, baseline, indicators, alpha)
+        emit("ranksum.csv", tests.to_csv(index=False))
+        emit("ranksum.md", to_markdown(tests, bold_marker=None))
+        emit("verdicts.md", to_markdown(verdict_counts(tests), bold_marker=None))
+    return written
+
+
+__all__ = ["summarize", "rank_sum", "rank_sum_tests", "indicator_table", "verdict_counts", "reference_fronts",
+           "add_reference_indicators", "add_energy_gap", "to_markdown", "write_tables", "nondominated",
+           "gd_van_veldhuizen"]

@@ -1,0 +1,34 @@
+"""Whole-line journeys: consecutive sections, one train, and the energy-minimal split of the trip time.
+
+>>> from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
+>>> from pymoo_rail.journeys import Journey, allocate_running_time, section_fronts
+>>> journey = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
+>>> fronts = section_fronts(journey)                    # one convex energy-time front per section
+>>> best = allocate_running_time(journey, journey.running_time_s(30 * 60), fronts=fronts)
+>>> best.table[["label", "running_time_s", "energy_kwh"]]  # doctest: +SKIP
+"""
+
+from pymoo_rail.journeys.allocation import (
+    DEFAULT_FRONT_SOURCE,
+    Allocation,
+    allocate_on_fronts,
+    allocate_running_time,
+    marginal_slopes,
+    section_fronts,
+    supplement_split,
+)
+from pymoo_rail.journeys.fronts import (
+    check_front,
+    convex_front,
+    front_energy,
+    front_slopes,
+    strategy_front,
+    strategy_programs,
+)
+from pymoo_rail.journeys.journey import Journey
+from pymoo_rail.journeys.problem import BudgetRepair, RunningTimeAllocationProblem, project_to_budget
+
+__all__ = ["Journey", "Allocation", "allocate_running_time", "allocate_on_fronts", "supplement_split",
+           "section_fronts", "marginal_slopes", "strategy_front", "strategy_programs", "convex_front",
+           "check_front", "front_energy", "front_slopes", "RunningTimeAllocationProblem", "BudgetRepair",
+           "project_to_budget", "DEFAULT_FRONT_SOURCE"]

@@ -1,0 +1,414 @@
+"""Numba kernels of the exact solver: dynamic programming over (position, kinetic energy).
+
+The state at grid node ``i`` is the speed; the cost-to-go ``V_i`` is stored on ``n_speeds``
+nodes in ``u = v^2`` between 0 and the braking envelope ``env_i^2`` (the highest speed from which
+every limit ahead and the platform can still be met; the nodes are packed towards it by
+``bias``, see :func:`node_u`), and interpolated linearly in ``u`` between them. Interpolating, rather than snapping transitions to the nearest node, is what
+lets the solver represent coasting and gentle partial traction, whose changes of speed over one
+cell are far smaller than the node spacing (DESIGN.md section 8). Interpolating in ``u`` rather
+than ``v`` makes the kinetic-energy part of the cost-to-go, which is linear in ``u``, exact.
+
+Controls of one cell are exactly the simulator's driving modes (``pymoo_rail.sim.kernel``):
+maximum traction, coasting, maximum braking, holding the entry speed, and ``toward`` a target
+speed, which lands exactly on a speed node of the next position by partial traction (or partial
+braking). Each transition is computed by the simulator's own step functions, including its
+braking-envelope override (``clamp_to_envelope``), so a control sequence chosen here replays bit
+for bit in the simulator. The cost of a cell is the simulator's own accounting
+(``complete_cell``): ``traction work / eta_traction - eta_regen * electric braking work +
+(P_aux + lambda) * dt``, the net energy plus ``lambda`` times time.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from pymoo_rail.sim.kernel import (
+    _KIND_BRAKE,
+    _KIND_COAST,
+    _KIND_TRACTION,
+    _T_ELEC,
+    _T_TIME,
+    _T_TRAC,
+    MODE_BRAKE,
+    MODE_COAST,
+    MODE_HOLD,
+    MODE_TOWARD,
+    MODE_TRACTION,
+    REGIME_COAST,
+    _full_step,
+    _landing_force,
+    clamp_to_envelope,
+    complete_cell,
+    new_totals,
+)
+
+INF = math.inf
+# Cost-to-go stored for a node from which the platform cannot be reached (e.g. too slow to clear a
+# neutral section on a climb). Finite, so that linear interpolation next to such a node gives a
+# steep but finite penalty instead of spreading infinity over the whole interval (which, step by
+# step backwards, would make every slow state look infeasible); far above any energy + lambda T.
+PENALTY_J = 1.0e20
+# Tolerance for a transition that ends on the envelope but above it by rounding (the simulator
+# then brakes fully and records an excess of ~1e-9 m/s, or the single-precision tables round
+# the envelope up): counted as the top node.
+_TOP_RTOL = 1e-6
+
+
+@njit(cache=True)
+def node_u(top_u, k, k_max, bias):
+    """Kinetic energy of speed node ``k``: ``top_u g(k / k_max)`` with ``g(s) = s + bias s (1 - s)``.
+
+    ``bias`` in [0, 1) packs the nodes towards the top (the braking envelope, where runs hold
+    a speed limit): the spacing there is ``1 - bias`` times the uniform one.
+    """
+    s = k / k_max
+    return top_u * (s + bias * s * (1.0 - s))
+
+
+@njit(cache=True)
+def node_position(top_u, u, k_max, bias):
+    """Fractional node index of kinetic energy ``u`` (the inverse of :func:`node_u`), top_u > 0."""
+    y = u / top_u
+    if bias <= 0.0:
+        return y * k_max
+    b1 = 1.0 + bias
+    disc = b1 * b1 - 4.0 * bias * y
+    if disc < 0.0:
+        disc = 0.0
+    return (b1 - math.sqrt(disc)) / (2.0 * bias) * k_max
+
+
+@njit(cache=True)
+def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w):
+    """What the simulator's ``run_program`` does in one cell for a program row of its own.
+
+    The mode logic of ``run_program`` (a hold row holds the speed on entering it; ``toward`` pulls
+    or coasts to its target and lands on it), then the simulator's ``clamp_to_envelope``.
+    ``tr_*``, ``co_*``, ``br_*`` are the cell's full traction, coast and brake steps from ``v0``
+    (``_full_step``), computed once and shared by every control. Returns ``(u1, force_n, w0_n)``.
+    """
+    if mode == MODE_HOLD:
+        if v0 <= 0.0:
+            mode = MODE_TRACTION
+        else:
+            mode = MODE_TOWARD
+            target = v0
+    if mode == MODE_TOWARD:
+        if v0 < target:
+            u1, f, w0 = tr_u, tr_f, tr_w
+            landed = u1 > target * target
+        else:
+            u1, f, w0 = co_u, co_f, co_w
+            landed = u1 < target * target
+        if landed:
+            fl, w0l, ok = _landing_force(m, v0, target, cell)
+            if ok:
+                u1, f, w0 = target * target, fl, w0l
+    elif mode == MODE_TRACTION:
+        u1, f, w0 = tr_u, tr_f, tr_w
+    elif mode == MODE_BRAKE:
+        u1, f, w0 = br_u, br_f, br_w
+    else:
+        u1, f, w0 = co_u, co_f, co_w
+    u1, f, w0, _, _ = clamp_to_envelope(m, v0, cell, u1, f, w0, REGIME_COAST)
+    return u1, f, w0
+
+
+@njit(cache=True)
+def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
+    """Net energy of the cell plus ``time_price_w`` x its time (J), and its time (s).
+
+    The simulator's own accounting (``complete_cell``): traction work / eta_traction minus
+    eta_regen x the electric braking work above the regen cut-off. Infinite when the train stops
+    inside the cell before the platform (the simulator ends the run there).
+    """
+    v1, stopped, _, _, totals = complete_cell(m, new_totals(), cell, v0, u1, f, w0, REGIME_COAST)
+    if stopped or v0 + v1 <= 0.0:  # (at rest in the last cell: it never arrives)
+        return INF, INF
+    dt = totals[_T_TIME]
+    e = totals[_T_TRAC] / m.traction_efficiency - m.regen_efficiency * totals[_T_ELEC]
+    return e + time_price_w * dt, dt
+
+
+@njit(cache=True)
+def interp_value(v_next, top_u, u, bias):
+    """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
+    k_max = v_next.shape[0] - 1
+    if u > top_u:
+        if u <= top_u * (1.0 + _TOP_RTOL) + 1e-12:
+            return v_next[k_max]
+        return INF
+    if top_u <= 0.0:
+        return v_next[0]
+    p = node_position(top_u, u, k_max, bias)
+    k = int(p)
+    if k >= k_max:
+        return v_next[k_max]
+    w = p - k
+    a = v_next[k]
+    if w <= 0.0:
+        return a
+    b = v_next[k + 1]
+    if a == INF or b == INF:
+        return INF
+    return a + w * (b - a)
+
+
+N_FIXED = 4  # traction, coast, brake, hold
+
+
+@njit(cache=True)
+def _fixed_mode(c):
+    if c == 0:
+        return MODE_TRACTION
+    if c == 1:
+        return MODE_COAST
+    if c == 2:
+        return MODE_BRAKE
+    return MODE_HOLD
+
+
+@njit(cache=True)
+def _target_range(top_u, k_max, u0, tr_u, co_u, bias):
+    """Speed nodes of the next position that partial traction (or braking) can land on exactly."""
+    lo = co_u if co_u < u0 else u0
+    hi = tr_u if tr_u < top_u else top_u
+    if lo < 0.0:
+        lo = 0.0
+    k_lo = int(math.floor(node_position(top_u, lo, k_max, bias))) + 1
+    if k_lo < 1:
+        k_lo = 1
+    k_hi = int(math.ceil(node_position(top_u, hi, k_max, bias))) - 1
+    if k_hi > k_max:
+        k_hi = k_max
+    return k_lo, k_hi
+
+
+@njit(cache=True)
+def _n_targets(k_lo, k_hi, max_targets):
+    count = k_hi - k_lo + 1
+    if count <= 0:
+        return 0, 1
+    stride = 1
+    if count > max_targets:
+        stride = (count + max_targets - 1) // max_targets
+    return (count + stride - 1) // stride, stride
+
+
+@njit(cache=True)
+def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
+    """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
+
+    Returns ``(total_cost, mode, target_ms)``; ``total_cost`` is at least ``PENALTY_J`` when no
+    control can reach the platform.
+    """
+    top_u = m.envelope_ms[cell + 1] ** 2
+    k_max = v_next.shape[0] - 1
+    tr_u, tr_f, tr_w, _ = _full_step(m, v0, cell, _KIND_TRACTION)
+    co_u, co_f, co_w, _ = _full_step(m, v0, cell, _KIND_COAST)
+    br_u, br_f, br_w, _ = _full_step(m, v0, cell, _KIND_BRAKE)
+    best = INF
+    best_mode = MODE_COAST
+    best_target = 0.0
+    n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
+    for c in range(n_fixed):
+        mode = _fixed_mode(c)
+        u1, f, w0 = cell_outcome(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+        cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
+        if cost < INF:
+            cost += interp_value(v_next, top_u, u1, bias)
+        if cost < best:
+            best = cost
+            best_mode = mode
+            best_target = 0.0
+    # partial traction (or braking) landing exactly on a speed node of the next position
+    if top_u > 0.0 and k_max > 0:
+        k_lo, k_hi = _target_range(top_u, k_max, v0 * v0, tr_u, co_u, bias)
+        stride = _n_targets(k_lo, k_hi, max_targets)[1]
+        for k in range(k_lo, k_hi + 1, stride):
+            target = math.sqrt(node_u(top_u, k, k_max, bias))
+            u1, f, w0 = cell_outcome(m, v0, cell, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+                                     br_u, br_f, br_w)
+            cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
+            if cost < INF:
+                cost += interp_value(v_next, top_u, u1, bias)
+            if cost < best:
+                best = cost
+                best_mode = MODE_TOWARD
+                best_target = target
+    return best, best_mode, best_target
+
+
+@njit(cache=True, parallel=True)
+def _count_targets(m, n_speeds, max_targets, bias, counts):
+    n = m.position_m.shape[0]
+    k_max = n_speeds - 1
+    for i in prange(n - 1):
+        top0 = m.envelope_ms[i] ** 2
+        top1 = m.envelope_ms[i + 1] ** 2
+        for j in range(n_speeds):
+            counts[i * n_speeds + j] = 0
+            if top1 <= 0.0:
+                continue
+            v0 = math.sqrt(node_u(top0, j, k_max, bias))
+            tr_u = _full_step(m, v0, i, _KIND_TRACTION)[0]
+            co_u = _full_step(m, v0, i, _KIND_COAST)[0]
+            k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
+            counts[i * n_speeds + j] = _n_targets(k_lo, k_hi, max_targets)[0]
+
+
+@njit(cache=True, parallel=True)
+def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e, fixed_dt, tgt_u1, tgt_e, tgt_dt):
+    n = m.position_m.shape[0]
+    k_max = n_speeds - 1
+    aux = m.aux_power_w
+    for i in prange(n - 1):
+        top0 = m.envelope_ms[i] ** 2
+        top1 = m.envelope_ms[i + 1] ** 2
+        for j in range(n_speeds):
+            v0 = math.sqrt(node_u(top0, j, k_max, bias))
+            tr_u, tr_f, tr_w, _ = _full_step(m, v0, i, _KIND_TRACTION)
+            co_u, co_f, co_w, _ = _full_step(m, v0, i, _KIND_COAST)
+            br_u, br_f, br_w, _ = _full_step(m, v0, i, _KIND_BRAKE)
+            for c in range(N_FIXED):
+                u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+                                         br_u, br_f, br_w)
+                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
+                fixed_u1[i, j, c] = u1
+                fixed_e[i, j, c] = e
+                fixed_dt[i, j, c] = dt
+            s = i * n_speeds + j
+            if offsets[s + 1] == offsets[s]:
+                continue
+            k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
+            stride = _n_targets(k_lo, k_hi, max_targets)[1]
+            p = offsets[s]
+            for k in range(k_lo, k_hi + 1, stride):
+                target = math.sqrt(node_u(top1, k, k_max, bias))
+                u1, f, w0 = cell_outcome(m, v0, i, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+                                         br_u, br_f, br_w)
+                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
+                tgt_u1[p] = u1
+                tgt_e[p] = e
+                tgt_dt[p] = dt
+                p += 1
+
+
+def transitions(m, n_speeds: int, max_targets: int, bias: float):
+    """Every cell's transitions from every speed node, which do not depend on the price of time.
+
+    Returns a tuple ``(fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt)``: for the four
+    fixed controls arrays (n_cells, n_speeds, 4) of the kinetic energy reached, the net energy (J,
+    with auxiliary power) and the time of the cell; for partial traction onto speed nodes the same
+    in flat arrays, state ``s = i * n_speeds + j`` owning entries ``offsets[s]:offsets[s + 1]``.
+    Infeasible transitions (a stop before the platform) have infinite energy. Stored in single
+    precision.
+    """
+    n_cells = m.position_m.shape[0] - 1
+    counts = np.zeros(n_cells * n_speeds, dtype=np.int64)
+    _count_targets(m, n_speeds, max_targets, bias, counts)
+    offsets = np.zeros(counts.shape[0] + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
+    # single precision halves the memory; the tables only shape the cost-to-go (an error of 1e-7
+    # of a node spacing or of a cell's energy), the forward run recomputes every step exactly
+    fixed = [np.empty((n_cells, n_speeds, N_FIXED), dtype=np.float32) for _ in range(3)]
+    tgt = [np.empty(offsets[-1], dtype=np.float32) for _ in range(3)]
+    _fill_transitions(m, n_speeds, max_targets, bias, offsets, *fixed, *tgt)
+    return (*fixed, offsets, *tgt)
+
+
+@njit(cache=True)
+def backward_sweep(envelope_ms, time_price_w, bias, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value):
+    """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the platform backwards.
+
+    ``time_price_w`` is the price of time beyond the auxiliary power (already in the energies).
+    """
+    n, n_speeds = value.shape
+    value[n - 1, :] = 0.0  # standstill at the platform (the envelope is 0 there: one state)
+    for i in range(n - 2, -1, -1):
+        top1 = envelope_ms[i + 1] ** 2
+        v_next = value[i + 1]
+        for j in range(n_speeds):
+            best = INF
+            for c in range(N_FIXED):
+                e = fixed_e[i, j, c]
+                if e < INF:
+                    cost = e + time_price_w * fixed_dt[i, j, c] + interp_value(v_next, top1, fixed_u1[i, j, c], bias)
+                    if cost < best:
+                        best = cost
+            s = i * n_speeds + j
+            for p in range(offsets[s], offsets[s + 1]):
+                e = tgt_e[p]
+                if e < INF:
+                    cost = e + time_price_w * tgt_dt[p] + interp_value(v_next, top1, tgt_u1[p], bias)
+                    if cost < best:
+                        best = cost
+            value[i, j] = best if best < PENALTY_J else PENALTY_J
+
+
+@njit(cache=True)
+def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds):
+    """Drive from standstill choosing each cell's control from the cost-to-go (continuous state).
+
+    Between controls whose costs differ by at most ``tie_j`` (J) the run keeps its previous mode,
+    or holds its speed after a partial-traction landing: near-ties otherwise make the regime
+    chatter (coast, land on a node, coast...) for no measurable energy.
+
+    Writes per cell ``modes``, ``targets`` and per node ``speeds``. Returns
+    ``(n_cells_done, net_energy_j, time_s)``; ``n_cells_done < n_nodes - 1`` means no feasible
+    control was found at that cell.
+    """
+    n = m.position_m.shape[0]
+    v = 0.0
+    speeds[0] = 0.0
+    energy = 0.0
+    time = 0.0
+    previous = MODE_TRACTION
+    for i in range(n - 1):
+        cost, mode, target = best_control(m, i, v, time_price_w, value[i + 1], max_targets, bias)
+        if cost >= PENALTY_J:  # every control leads to a stop short of the platform
+            return i, energy, time
+        tr_u, tr_f, tr_w, _ = _full_step(m, v, i, _KIND_TRACTION)
+        co_u, co_f, co_w, _ = _full_step(m, v, i, _KIND_COAST)
+        br_u, br_f, br_w, _ = _full_step(m, v, i, _KIND_BRAKE)
+        if i > 0 and mode != previous and tie_j > 0.0:
+            keep = MODE_HOLD if previous == MODE_TOWARD else previous
+            if keep != mode:
+                u1, f, w0 = cell_outcome(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+                c_keep, _ = cell_cost(m, v, u1, f, w0, i, time_price_w)
+                if c_keep < INF:
+                    c_keep += interp_value(value[i + 1], m.envelope_ms[i + 1] ** 2, u1, bias)
+                    if c_keep <= cost + tie_j:
+                        mode, target = keep, 0.0
+        u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+        energy += c_energy
+        time += dt
+        modes[i] = mode
+        targets[i] = target
+        previous = mode
+        v = math.sqrt(u1)
+        speeds[i + 1] = v
+    return n - 1, energy, time
+
+
+def solve(model, tables, lambda_w: float, max_targets: int, bias: float, tie_j: float, value: np.ndarray):
+    """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
+
+    ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
+    cost-to-go. Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s).
+    Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
+    energy, and the tables already hold it.
+    """
+    backward_sweep(model.envelope_ms, float(lambda_w), float(bias), *tables, value)
+    n = model.position_m.shape[0]
+    modes = np.zeros(n - 1, dtype=np.int64)
+    targets = np.zeros(n - 1)
+    speeds = np.zeros(n)
+    price = float(lambda_w) + model.aux_power_w
+    done, energy, time = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j), modes,
+                                         targets, speeds)
+    return modes, targets, speeds, done, energy, time

@@ -1,0 +1,135 @@
+"""The closed-form optimum on level track, from Pontryagin's maximum principle.
+
+On level track without binding speed limits the minimum-energy run for a given time is
+maximum traction to a hold speed ``V``, holding ``V``, coasting down to ``W``, maximum braking
+(seed 000 section 2.2.5; Howlett and Pudney). With time priced at ``lambda`` and the Hamiltonian
+over distance ``H = f+/eta + lambda/v + p (f - R(v)) / (m_eff v)``:
+
+- on the hold arc the traction coefficient vanishes, ``p = -m_eff V / eta``, and ``dp/dx = 0`` gives
+  ``lambda = V^2 R'(V) / eta``;
+- braking begins where ``p = 0``; ``H`` is constant along the run (level track), so
+  ``lambda / W = R(V) / eta + lambda / V``.
+
+The phases are integrated by quadrature of the equations of motion, independently of the
+simulator and of the DP; ``lambda`` is then found so that the phases add up to the requested time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from pymoo_rail.model import Case
+
+
+@dataclass(frozen=True)
+class FlatTrackOptimum:
+    """The four phases of the optimum on level track (SI units, energies in kWh)."""
+
+    lambda_w: float
+    hold_speed_ms: float
+    brake_speed_ms: float
+    traction_end_m: float
+    coast_start_m: float
+    brake_start_m: float
+    running_time_s: float
+    energy_kwh: float
+
+
+def _check_flat(case: Case) -> None:
+    line, train = case.line, case.train
+    if any(g[2] != 0.0 for g in line.gradients) or line.curves or line.tunnels or line.neutral_sections:
+        raise ValueError(f"case '{case.name}': the closed form needs level track without curves, tunnels "
+                         "or neutral sections")
+    if train.regen_efficiency != 0.0 or train.aux_power_kw != 0.0:
+        raise ValueError(f"case '{case.name}': the closed form assumes no regeneration and no auxiliary power")
+
+
+def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
+    """The optimal traction-hold-coast-brake run of a level-track case taking ``running_time_s``.
+
+    The hold speed stays below every speed limit (``lambda`` is searched only up to the limit); the
+    train's acceleration and deceleration caps are honoured. Raises ``ValueError`` when the
+    case is not level, or when no hold speed fits the time.
+    """
+    _check_flat(case)
+    train = case.train
+    m = train.effective_mass_kg
+    a, b, c = train.resistance.coefficients_si(train.mass_kg)
+    eta = train.traction_efficiency
+    a_max = train.max_accel_ms2 if train.max_accel_ms2 is not None else math.inf
+    d_max = train.max_decel_ms2 if train.max_decel_ms2 is not None else math.inf
+    length = case.line.length_m
+    limit = min(min(row[2] for row in case.line.speed_limits), train.max_speed_kmh) / 3.6
+
+    def resist(v):
+        return a + b * v + c * v * v
+
+    def traction(v):
+        f = float(train.traction.force_kn(v * 3.6)[0]) * 1000.0
+        return min(f, m * a_max + resist(v))
+
+    def braking(v):
+        f = float(train.braking.force_kn(v * 3.6)[0]) * 1000.0
+        return min(f, m * d_max - resist(v))
+
+    def phases(lam):
+        # hold speed from lambda = V^2 R'(V) / eta (increasing in V)
+        hold = brentq(lambda v: v * v * (b + 2 * c * v) / eta - lam, 1e-9, 10 * limit)
+        brake = 1.0 / (1.0 / hold + resist(hold) / (eta * lam))
+        opts = {"limit": 200, "epsabs": 0.0, "epsrel": 1e-11}
+        s_a = quad(lambda v: m * v / (traction(v) - resist(v)), 0.0, hold, **opts)[0]
+        t_a = quad(lambda v: m / (traction(v) - resist(v)), 0.0, hold, **opts)[0]
+        e_a = quad(lambda v: traction(v) * m * v / (traction(v) - resist(v)), 0.0, hold, **opts)[0] / eta
+        s_c = quad(lambda v: m * v / resist(v), brake, hold, **opts)[0]
+        t_c = quad(lambda v: m / resist(v), brake, hold, **opts)[0]
+        s_b = quad(lambda v: m * v / (braking(v) + resist(v)), 0.0, brake, **opts)[0]
+        t_b = quad(lambda v: m / (braking(v) + resist(v)), 0.0, brake, **opts)[0]
+        s_h = length - s_a - s_c - s_b
+        t = t_a + s_h / hold + t_c + t_b
+        e = e_a + resist(hold) * s_h / eta
+        return hold, brake, s_a, s_h, s_c, t, e
+
+    def time_gap(log_lam):
+        return phases(math.exp(log_lam))[5] - running_time_s
+
+    # lambda from a crawl (1 W) up to the hold speed at the lowest limit, and a hold length >= 0
+    lo = math.log(1.0)
+    hi = math.log(limit * limit * (b + 2 * c * limit) / eta)
+    if phases(math.exp(hi))[3] < 0.0:
+        hi = brentq(lambda x: phases(math.exp(x))[3], lo, hi, xtol=1e-12)
+    if not time_gap(lo) > 0.0 > time_gap(hi):
+        raise ValueError(f"running_time_s = {running_time_s}: outside the times a hold phase can give "
+                         f"({phases(math.exp(hi))[5]:.2f} .. {phases(math.exp(lo))[5]:.2f} s)")
+    lam = math.exp(brentq(time_gap, lo, hi, xtol=1e-13, rtol=1e-13))
+    hold, brake, s_a, s_h, s_c, t, e = phases(lam)
+    return FlatTrackOptimum(lambda_w=lam, hold_speed_ms=hold, brake_speed_ms=brake, traction_end_m=s_a,
+                            coast_start_m=s_a + s_h, brake_start_m=s_a + s_h + s_c, running_time_s=t,
+                            energy_kwh=e / 3.6e6)
+
+
+def no_resistance_optimum(case: Case, running_time_s: float) -> tuple[float, float]:
+    """Level track, no resistance, constant forces: accelerate to V, coast, brake.
+
+    Returns ``(V m/s, energy kWh)`` with ``T = V / a + V / d + (L - V^2 / 2a - V^2 / 2d) / V``.
+    """
+    _check_flat(case)
+    train = case.train
+    m = train.effective_mass_kg
+    acc = float(train.traction.force_kn(0.0)[0]) * 1000.0 / m
+    dec = float(train.braking.force_kn(0.0)[0]) * 1000.0 / m
+    if train.max_accel_ms2 is not None:
+        acc = min(acc, train.max_accel_ms2)
+    if train.max_decel_ms2 is not None:
+        dec = min(dec, train.max_decel_ms2)
+    k = 0.5 / acc + 0.5 / dec
+    # T V = k V^2 + L  ->  k V^2 - T V + L = 0, smaller root
+    disc = running_time_s ** 2 - 4 * k * case.line.length_m
+    if disc < 0:
+        raise ValueError(f"running_time_s = {running_time_s}: below the minimum {math.sqrt(4 * k * case.line.length_m):.2f} s")
+    v = (running_time_s - math.sqrt(disc)) / (2 * k)
+    return v, 0.5 * m * v * v / train.traction_efficiency / 3.6e6
+

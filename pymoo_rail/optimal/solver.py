@@ -1,0 +1,395 @@
+"""The minimum-energy run for a given running time, and the energy / running-time front.
+
+``optimal_profile`` prices time at ``lambda`` (W = J/s), solves the dynamic programme of
+:mod:`pymoo_rail.optimal.dp` for ``net energy + lambda x time``, and searches ``lambda`` until the
+run takes the requested time. Larger ``lambda`` means faster, costlier runs; the running time
+falls monotonically as ``lambda`` grows, so the search is a safeguarded secant (Illinois) method
+on ``log lambda``. At the solution ``lambda`` is the slope of the front: the energy one more second
+of running time would save.
+
+The returned :class:`~pymoo_rail.sim.Trajectory` is not the DP's estimate: it is the simulator's
+run of the DP's control sequence (one program row per grid cell), so every figure in it comes from
+the same physics and energy accounting as any optimiser's result.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.model import Case, InfeasibleCaseError
+from pymoo_rail.optimal import dp
+from pymoo_rail.sim import Simulator, Trajectory
+from pymoo_rail.sim.kernel import (
+    MODE_COAST,
+    MODE_HOLD,
+    MODE_TOWARD,
+    MODE_TRACTION,
+    OUT_NET_KWH,
+    OUT_REACHED,
+    OUT_RUNNING_TIME_S,
+)
+
+DEFAULT_N_SPEEDS = 200
+DEFAULT_MAX_TARGETS = 16
+DEFAULT_TIME_TOL_S = 0.05
+DEFAULT_TOP_BIAS = 0.5
+MAX_TIME_ERROR_S = 0.5
+DEFAULT_TIE_J = 100.0
+LAMBDA_MIN_W = 1.0e2
+LAMBDA_MAX_W = 1.0e10
+_J_PER_KWH = 3.6e6
+
+
+@dataclass(frozen=True)
+class _Solve:
+    """One run found at one price of time: a simulator program (one row per cell) and its figures.
+
+    ``speeds`` are the DP's forward run, which the simulator's replay must reproduce; None for a
+    run whose last switch was moved to meet the time (a simulator run from the start).
+    """
+
+    lambda_w: float
+    program: np.ndarray
+    speeds: np.ndarray | None
+    energy_j: float
+    time_s: float
+    value_j: float
+
+
+def _check_time(name: str, value: float) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} = {value!r}: must be a number of seconds")
+    value = float(value)
+    if not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"{name} = {value!r}: must be a finite number of seconds > 0")
+    return value
+
+
+class OptimalSolver:
+    """Exact minimum-energy runs of one case on one grid (reused across running times).
+
+    Parameters
+    ----------
+    case : Case
+    dx_m : float, optional
+        Position step, the simulator's grid (default: the simulator's default, 1 m on metro lines).
+    n_speeds : int
+        Nodes of the cost-to-go in ``v^2`` at each position, from 0 to the braking envelope.
+    max_targets : int
+        Most partial-traction targets (speed nodes of the next position) tried per state.
+    time_tol_s : float
+        The ``lambda`` search stops once the run is this close to the requested time. The discrete
+        optimum can jump over the request (switch points move by whole cells); the run returned is
+        then the closest one, never more than 0.5 s off (the speed grid is refined if need be).
+    top_bias : float
+        In [0, 1): packs the speed nodes towards the braking envelope (node spacing there is
+        ``1 - top_bias`` times the uniform one), where runs hold speed limits.
+    tie_j : float
+        Controls within this many joules of the best count as tied, and the forward run then keeps
+        its regime: it removes chattering between coasting and partial traction at a measured cost
+        below 0.02 % (``docs/optimal.md``).
+    """
+
+    def __init__(self, case: Case, dx_m: float | None = None, n_speeds: int = DEFAULT_N_SPEEDS,
+                 max_targets: int = DEFAULT_MAX_TARGETS, time_tol_s: float = DEFAULT_TIME_TOL_S,
+                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J):
+        if isinstance(n_speeds, bool) or not isinstance(n_speeds, (int, np.integer)) or n_speeds < 3:
+            raise ValueError(f"n_speeds = {n_speeds!r}: must be an integer >= 3")
+        if isinstance(max_targets, bool) or not isinstance(max_targets, (int, np.integer)) or max_targets < 1:
+            raise ValueError(f"max_targets = {max_targets!r}: must be an integer >= 1")
+        if not (isinstance(top_bias, (int, float)) and 0.0 <= top_bias < 1.0):
+            raise ValueError(f"top_bias = {top_bias!r}: must be a number in [0, 1)")
+        self.top_bias = float(top_bias)
+        if not (isinstance(tie_j, (int, float)) and math.isfinite(tie_j) and tie_j >= 0.0):
+            raise ValueError(f"tie_j = {tie_j!r}: must be a finite number of joules >= 0")
+        self.tie_j = float(tie_j)
+        self.case = case
+        self.simulator = Simulator(case, dx_m)
+        self.n_speeds = int(n_speeds)
+        self.max_targets = int(max_targets)
+        self.time_tol_s = _check_time("time_tol_s", time_tol_s)
+        self._value = np.empty((self.simulator.grid.n_nodes, self.n_speeds))
+        self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
+        self._min_time_s: float | None = None
+        self.n_solves = 0  # DP solves so far (for benchmarks)
+
+    @property
+    def dx_m(self) -> float:
+        return self.simulator.grid.dx_m
+
+    def min_running_time_s(self) -> float:
+        """The flat-out running time on this grid (raises if the train cannot reach the platform)."""
+        if self._min_time_s is None:
+            self._min_time_s = self.simulator.check_planned_time(math.inf)
+        return self._min_time_s
+
+    def solve_price(self, lambda_w: float) -> _Solve:
+        """The DP optimum of ``net energy + lambda_w x time`` (one backward sweep and forward run)."""
+        if self._tables is None:
+            self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
+        self.n_solves += 1
+        run = dp.solve(self.simulator.model, self._tables, lambda_w, self.max_targets, self.top_bias, self.tie_j,
+                       self._value)
+        return self._record(lambda_w, run)
+
+    def _record(self, lambda_w: float, run: tuple) -> _Solve:
+        modes, targets, speeds, done, energy, time = run
+        if done < modes.shape[0]:
+            x = self.simulator.grid.position_m[done]
+            raise InfeasibleCaseError("line", self.case.name,
+                                      f"the solver finds no way to the platform beyond {x:.1f} m", self.case.name)
+        program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
+        return _Solve(lambda_w, program, speeds, energy, time, float(self._value[0, 0]))
+
+    def _adjust(self, solution: _Solve, target: float) -> _Solve | None:
+        """Move the run's last switch into the final coast until it takes the requested time.
+
+        The discrete optimum can jump over the requested time (where the front is nearly straight,
+        runs on either side are tied in ``energy + lambda x time``). The last powered phase is then
+        extended (the run is too slow) or cut short (too fast) cell by cell, found by bisection. At
+        an optimum the coast point trades time for energy at the rate ``lambda``, so the moved run
+        stays on the front to first order. Returns None when the run has no powered phase.
+        """
+        program = solution.program
+        modes = program[:, 1]
+        powered = np.flatnonzero((modes == MODE_TRACTION) | (modes == MODE_HOLD) | (modes == MODE_TOWARD))
+        if powered.size == 0:
+            return None
+        last = int(powered[-1])
+        n_cells = program.shape[0]
+        if solution.time_s > target:  # extend: hold the speed reached (or keep pulling)
+            mode = MODE_TRACTION if modes[last] == MODE_TRACTION else MODE_HOLD
+            slow_end, fast_end = 0, n_cells - 1 - last
+
+            def moved(j):
+                p = program.copy()
+                p[last + 1:last + 1 + j, 1:] = (mode, 0.0)
+                return p
+        else:  # cut short: coast earlier
+            slow_end, fast_end = last + 1, 0
+
+            def moved(j):
+                p = program.copy()
+                p[last + 1 - j:last + 1, 1:] = (MODE_COAST, 0.0)
+                return p
+
+        def run(j):
+            p = moved(j)
+            out = self.simulator.run_batch(p[None])[0]
+            time = out[OUT_RUNNING_TIME_S] if out[OUT_REACHED] > 0 else math.inf
+            return p, out[OUT_NET_KWH] * _J_PER_KWH, time
+
+        runs = {slow_end: run(slow_end), fast_end: run(fast_end)}
+        if not runs[slow_end][2] >= target >= runs[fast_end][2]:
+            return None
+        lo, hi = slow_end, fast_end  # lo: run >= target, hi: run <= target
+        while abs(hi - lo) > 1:
+            mid = (lo + hi) // 2
+            runs[mid] = run(mid)
+            if runs[mid][2] >= target:
+                lo = mid
+            else:
+                hi = mid
+        p, energy, time = min((runs[lo], runs[hi]), key=lambda r: abs(r[2] - target))
+        return _Solve(solution.lambda_w, p, None, energy, time, solution.value_j)
+
+    def _search(self, running_time_s: float, lambda_guess_w: float | None) -> _Solve:
+        """Find ``lambda`` whose optimum takes ``running_time_s`` (within ``time_tol_s``)."""
+        target = running_time_s
+        tol = self.time_tol_s
+        lam = lambda_guess_w if lambda_guess_w else 5.0e5
+        lam = min(max(lam, LAMBDA_MIN_W), LAMBDA_MAX_W)
+        first = self.solve_price(lam)
+        if abs(first.time_s - target) <= tol:
+            return first
+        # bracket: fast (time below target) at high lambda, slow at low lambda
+        fast = slow = None
+        if first.time_s > target:
+            slow = first
+            while fast is None:
+                if slow.lambda_w >= LAMBDA_MAX_W:
+                    return self._closest(slow, None, target, "fast")
+                s = self.solve_price(min(slow.lambda_w * 8.0, LAMBDA_MAX_W))
+                if abs(s.time_s - target) <= tol:
+                    return s
+                if s.time_s > target:
+                    slow = s
+                else:
+                    fast = s
+        else:
+            fast = first
+            while slow is None:
+                if fast.lambda_w <= LAMBDA_MIN_W:
+                    return self._closest(None, fast, target, "slow")
+                s = self.solve_price(max(fast.lambda_w / 8.0, LAMBDA_MIN_W))
+                if abs(s.time_s - target) <= tol:
+                    return s
+                if s.time_s < target:
+                    fast = s
+                else:
+                    slow = s
+        # Illinois regula falsi on log(lambda)
+        side = 0
+        f_fast, f_slow = fast.time_s - target, slow.time_s - target
+        lo, hi = math.log(slow.lambda_w), math.log(fast.lambda_w)
+        for _ in range(40):
+            if hi - lo < 1e-4:  # a jump of the discrete optimum: lambda cannot hit the time closer
+                break
+            x = hi - f_fast * (hi - lo) / (f_fast - f_slow)
+            if not (lo < x < hi):
+                x = 0.5 * (lo + hi)
+            s = self.solve_price(math.exp(x))
+            f = s.time_s - target
+            if abs(f) <= tol:
+                return s
+            if f > 0.0:
+                slow, lo, f_slow = s, x, f
+                if side == -1:
+                    f_fast *= 0.5
+                side = -1
+            else:
+                fast, hi, f_fast = s, x, f
+                if side == 1:
+                    f_slow *= 0.5
+                side = 1
+        return self._closest(slow, fast, target, "")
+
+    def _closest(self, slow: _Solve | None, fast: _Solve | None, target: float, missing: str) -> _Solve:
+        found = [s for s in (slow, fast) if s is not None]
+        best = min(found, key=lambda s: abs(s.time_s - target))
+        if abs(best.time_s - target) > self.time_tol_s:
+            moved = [m for m in (self._adjust(s, target) for s in found) if m is not None]
+            if moved:
+                # compare at the requested time along the front's slope
+                best = min(moved + [best], key=lambda s: (max(abs(s.time_s - target) - self.time_tol_s, 0.0),
+                                                          s.energy_j + s.lambda_w * (s.time_s - target)))
+        if abs(best.time_s - target) > 0.5:
+            if missing == "fast":
+                raise InfeasibleCaseError("running_time_s", target,
+                                          f"is below the minimum running time {best.time_s:.2f} s the solver reaches "
+                                          f"(flat out {self.min_running_time_s():.2f} s)", self.case.name)
+            if missing == "slow":
+                raise ValueError(f"running_time_s = {target}: longer than the slowest run the speed grid represents "
+                                 f"({best.time_s:.1f} s at lambda = {best.lambda_w:.3g} W)")
+        return best
+
+    def trajectory(self, solution: _Solve) -> Trajectory:
+        """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
+        tr = self.simulator.run(solution.program)
+        speeds = tr.speed_ms if solution.speeds is None else solution.speeds
+        mismatch = float(np.max(np.abs(tr.speed_ms - speeds[: tr.speed_ms.shape[0]])))
+        energy_j = tr.energy.net_kwh * _J_PER_KWH
+        if (not tr.reached or tr.speed_ms.shape[0] != speeds.shape[0] or mismatch > 1e-9
+                or abs(energy_j - solution.energy_j) > 1e-9 * max(abs(energy_j), 1.0)):
+            raise RuntimeError(f"the simulator's replay of the optimal controls departs from the solver's run "
+                               f"(max speed difference {mismatch:.3g} m/s, energy {tr.energy.net_kwh:.6f} against "
+                               f"{solution.energy_j / _J_PER_KWH:.6f} kWh): solver and simulator disagree")
+        summary = dict(tr.summary, lambda_w=solution.lambda_w, dp_value_j=solution.value_j,
+                       n_speeds=float(self.n_speeds), dx_m=float(self.dx_m),
+                       adjusted=float(solution.speeds is None))
+        return replace(tr, summary=summary)
+
+    def profile(self, running_time_s: float, lambda_guess_w: float | None = None) -> Trajectory:
+        """The minimum-energy run taking ``running_time_s`` (see :func:`optimal_profile`)."""
+        running_time_s = _check_time("running_time_s", running_time_s)
+        fastest = self.min_running_time_s()
+        if running_time_s < fastest - 1e-9:
+            raise InfeasibleCaseError("running_time_s", running_time_s,
+                                      f"is below the minimum running time {fastest:.2f} s of the train on this line",
+                                      self.case.name)
+        solution = self._search(running_time_s, lambda_guess_w)
+        if abs(solution.time_s - running_time_s) > MAX_TIME_ERROR_S:
+            # the discrete optimum jumps over the requested time at this lambda: a finer speed grid
+            # makes the jumps smaller
+            if self.n_speeds >= 4 * DEFAULT_N_SPEEDS:
+                raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
+                                   f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
+            finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
+                                  self.top_bias, self.tie_j)
+            return finer.profile(running_time_s, solution.lambda_w)
+        return self.trajectory(solution)
+
+
+def min_running_time(case: Case, dx_m: float | None = None) -> float:
+    """The shortest running time of the case: the simulator's flat-out run (s).
+
+    Raises :class:`~pymoo_rail.model.InfeasibleCaseError` if the train cannot reach the platform.
+    """
+    return Simulator(case, dx_m).check_planned_time(math.inf)
+
+
+def optimal_profile(case: Case, running_time_s: float, **settings) -> Trajectory:
+    """The minimum net-energy run that stops at the platform after ``running_time_s``.
+
+    Dynamic programming over (position, speed) for ``net energy + lambda x running time`` with
+    ``lambda`` found by a root search; the result is the simulator's replay of the optimal controls.
+
+    Parameters
+    ----------
+    case : Case
+    running_time_s : float
+        Requested running time; at least :func:`min_running_time`.
+    **settings
+        Grid and search settings of :class:`OptimalSolver` (``dx_m``, ``n_speeds``, ``max_targets``,
+        ``time_tol_s``, ``top_bias``, ``tie_j``); the defaults are within 0.5 % of the exact optimum
+        (``docs/optimal.md``).
+
+    Returns
+    -------
+    Trajectory
+        With ``running_time_s`` within ``time_tol_s`` of the request when the discrete optimum allows
+        it, never more than 0.5 s off; ``summary["lambda_w"]`` is the price of time (W) at which it
+        is optimal.
+
+    Raises
+    ------
+    InfeasibleCaseError
+        ``running_time_s`` below the minimum running time (the message gives the minimum).
+    ValueError
+        ``running_time_s`` not a finite positive number.
+    """
+    return OptimalSolver(case, **settings).profile(running_time_s)
+
+
+def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
+    """Minimum net energy at each running time: the energy / running-time front of the case.
+
+    Parameters
+    ----------
+    case : Case
+    running_times : sequence of float
+        Requested running times (s), each at least :func:`min_running_time`.
+    **settings
+        As for :func:`optimal_profile`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per requested time, sorted by time: ``running_time_s`` (of the run found) and
+        ``energy_kwh`` (net) of the simulated optimal run, ``requested_time_s``, ``traction_kwh``,
+        ``regen_kwh``, ``aux_kwh``, ``lambda_kwh_per_s`` (the front's slope ``-dE/dT``: the energy
+        one more second saves) and ``energy_at_request_kwh`` (the energy moved along that slope to
+        the requested time, to first order).
+    """
+    times = np.atleast_1d(np.asarray(running_times, dtype=float))
+    if times.ndim != 1 or times.size == 0:
+        raise ValueError(f"running_times has shape {times.shape}: give one or more running times")
+    for t in times:
+        _check_time("running_time_s", float(t))
+    solver = OptimalSolver(case, **settings)
+    rows = []
+    guess = None
+    for t in np.sort(times):
+        tr = solver.profile(float(t), lambda_guess_w=guess)
+        guess = tr.summary["lambda_w"]
+        e = tr.energy
+        slope = guess / _J_PER_KWH
+        rows.append({"running_time_s": tr.running_time_s, "energy_kwh": e.net_kwh, "requested_time_s": float(t),
+                     "traction_kwh": e.traction_kwh, "regen_kwh": e.regen_kwh, "aux_kwh": e.aux_kwh,
+                     "lambda_kwh_per_s": slope,
+                     "energy_at_request_kwh": e.net_kwh + slope * (tr.running_time_s - float(t))})
+    return pd.DataFrame(rows)

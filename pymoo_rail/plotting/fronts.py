@@ -1,0 +1,160 @@
+"""Pareto fronts: one front, or the fronts of several algorithms on one problem of a study."""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.plotting.style import new_figure, objective_labels
+
+
+def _as_front(F, name: str = "F") -> np.ndarray:
+    F = np.asarray(F, dtype=float)
+    if F.ndim == 1:
+        F = F[None, :]
+    if F.ndim != 2 or F.shape[1] < 2:
+        raise ValueError(f"{name} must be an (n, m) array with m >= 2 objectives, got shape {F.shape}")
+    if not np.all(np.isfinite(F)):
+        raise ValueError(f"{name} holds NaN or infinite values")
+    return F
+
+
+def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | None = None,
+                reference=None, reference_label: str = "optimal front", highlight=None,
+                highlight_label: str = "chosen", title: str | None = None, ax=None):
+    """Several fronts on one set of axes (2 or 3 objectives).
+
+    Parameters
+    ----------
+    fronts : mapping label -> (n, m) array
+        E.g. ``{"nsga2": F1, "moabc": F2}``.
+    objectives : sequence of str, optional
+        Objective names (``"energy"``, ``"time_error"``, ...) for labelled axes with units.
+    reference : (k, m) array or DataFrame, optional
+        The true or optimal front, drawn as a line (2 objectives) or small points (3).
+    highlight : (m,) array, optional
+        One point to mark, e.g. the solution chosen for the speed profile.
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if not fronts:
+        raise ValueError("fronts is empty: give at least one front")
+    fronts = {label: _as_front(F, f"fronts[{label!r}]") for label, F in fronts.items()}
+    n_obj = next(iter(fronts.values())).shape[1]
+    for label, F in fronts.items():
+        if F.shape[1] != n_obj:
+            raise ValueError(f"fronts[{label!r}] has {F.shape[1]} objectives, the first front {n_obj}")
+    if n_obj > 3:
+        raise ValueError(f"{n_obj} objectives: plot_fronts draws 2 or 3 (use pymoo.visualization.pcp for more)")
+    labels = objective_labels(objectives, n_obj)
+    if ax is None:
+        if n_obj == 3:
+            import matplotlib.pyplot as plt
+
+            fig = plt.figure(figsize=(7.0, 5.5), layout="constrained")
+            ax = fig.add_subplot(projection="3d")
+        else:
+            fig, axes = new_figure()
+            ax = axes[0, 0]
+    fig = ax.figure
+
+    if reference is not None:
+        ref = np.asarray(reference.to_numpy() if isinstance(reference, pd.DataFrame) else reference, dtype=float)
+        ref = _as_front(ref, "reference")
+        if n_obj == 2 and len(ref) < 200:
+            order = np.argsort(ref[:, 0])
+            ax.plot(ref[order, 0], ref[order, 1], "-", marker=".", ms=4, color="0.35", lw=1.2,
+                    label=reference_label, zorder=1)
+        elif n_obj == 2:  # dense true front: dots, so disconnected fronts (ZDT3) show their gaps
+            ax.scatter(ref[:, 0], ref[:, 1], s=1.5, color="0.35", label=reference_label, zorder=1)
+        else:
+            ax.scatter(*ref.T, s=2, color="0.6", label=reference_label)
+    markers = "os^Dvp<>h*"
+    for i, (label, F) in enumerate(fronts.items()):
+        order = np.argsort(F[:, 0])
+        ax.scatter(*F[order].T, s=22, marker=markers[i % len(markers)], label=f"{label} ({len(F)})",
+                   alpha=0.85, zorder=3)
+    if highlight is not None:
+        point = np.asarray(highlight, dtype=float).reshape(-1)
+        ax.scatter(*point, s=140, facecolors="none", edgecolors="black", linewidths=1.8, label=highlight_label,
+                   zorder=4)
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    if n_obj == 3:
+        ax.set_zlabel(labels[2])
+    else:
+        ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    if title:
+        ax.set_title(title)
+    return fig
+
+
+def plot_front(F, objectives: Sequence[str] | None = None, reference=None, highlight=None, label: str = "front",
+               title: str | None = None, ax=None):
+    """One Pareto front (see :func:`plot_fronts`)."""
+    return plot_fronts({label: F}, objectives, reference=reference, highlight=highlight, title=title, ax=ax)
+
+
+def representative_runs(results: pd.DataFrame, problem: str, indicator: str | None = None) -> pd.DataFrame:
+    """Per algorithm, the run with the median value of ``indicator`` on ``problem``.
+
+    Default indicator: ``igd`` where known, else ``hv_ref``/``igd_ref``, else ``n_front``
+    (largest). Ties and the even-count median go to the lower seed, so the choice is stable.
+    """
+    group = results[results["problem"] == problem]
+    if group.empty:
+        raise ValueError(f"problem {problem!r} is not in the results ({', '.join(sorted(results['problem'].unique()))})")
+    if indicator is None:
+        for candidate in ("igd", "igd_ref", "spacing", "n_front"):
+            if candidate in group.columns and group[candidate].notna().any():
+                indicator = candidate
+                break
+    rows = []
+    for _, runs in group.groupby("algorithm", sort=True):
+        runs = runs.dropna(subset=[indicator]) if indicator in runs.columns else runs
+        if runs.empty:
+            continue
+        runs = runs.sort_values([indicator, "seed"], kind="stable")
+        rows.append(runs.iloc[(len(runs) - 1) // 2])
+    return pd.DataFrame(rows)
+
+
+def plot_study_fronts(results: pd.DataFrame, problem: str, reference=None, objectives: Sequence[str] | None = None,
+                      indicator: str | None = None, ax=None):
+    """The median run's front of each algorithm on one problem of a study.
+
+    The true front is drawn when the problem knows one (rebuilt from its stored spec), or
+    ``reference`` when given (e.g. ``optimal_front`` for rail problems).
+    """
+    runs = representative_runs(results, problem, indicator)
+    fronts = {row["algorithm"]: row["F"][row["CV"] <= 0] for _, row in runs.iterrows()}
+    fronts = {k: v for k, v in fronts.items() if len(v)}
+    if not fronts:
+        raise ValueError(f"no feasible front on problem {problem!r}")
+    if reference is None and "problem_spec" in runs.columns:
+        reference = _true_front_of(runs.iloc[0]["problem_spec"])
+    if objectives is None and "problem_spec" in runs.columns:
+        names = runs.iloc[0]["problem_spec"].get("objectives")
+        if isinstance(names, list) and len(names) == next(iter(fronts.values())).shape[1]:
+            objectives = names
+    title = f"{problem}: median run of each algorithm"
+    return plot_fronts(fronts, objectives, reference=reference,
+                       reference_label="true front" if reference is not None else "", title=title, ax=ax)
+
+
+def _true_front_of(spec: dict):
+    from pymoo_rail.experiments.metrics import true_front
+    from pymoo_rail.experiments.registry import build_problem
+    from pymoo_rail.experiments.spec import ProblemSpec
+
+    try:
+        pf = true_front(build_problem(ProblemSpec.from_dict(spec)))
+    except Exception:  # a front is a nicety; the plot goes on without it
+        return None
+    return pf if pf is not None and pf.shape[1] >= 2 else None

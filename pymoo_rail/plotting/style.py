@@ -1,0 +1,71 @@
+"""Shared labels, colours and file output of the plots."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Sequence
+
+# axis labels with units for the rail objectives (pymoo_rail.problems.OBJECTIVES) and indicators
+OBJECTIVE_LABELS = {
+    "energy": "energy (kWh)",
+    "running_time": "running time (s)",
+    "time_error": "time error |T - T_plan| (s)",
+    "jerk": "jerk, total variation of acceleration (m/s²)",
+    "stop_error": "stop error (m)",
+}
+INDICATOR_LABELS = {
+    "igd": "IGD", "gd": "GD (mean distance)", "gd_vv": "GD (Van Veldhuizen)", "hv": "hypervolume (normalised)",
+    "spacing": "spacing (Schott)", "f_best": "best objective value", "error": "error to the optimum",
+    "energy_gap": "energy gap to the optimum (kWh)", "igd_ref": "IGD to the study's reference front",
+    "gd_ref": "GD to the study's reference front", "hv_ref": "hypervolume (study reference, normalised)",
+}
+REGIME_NAMES = ("traction", "cruise", "coast", "brake")
+REGIME_COLORS = ("tab:red", "tab:blue", "tab:green", "tab:orange")
+LIMIT_COLOR = "black"
+NEUTRAL_COLOR = "gold"
+
+
+def objective_label(name: str | None, index: int) -> str:
+    if name is None:
+        return f"f{index + 1}"
+    return OBJECTIVE_LABELS.get(name, name)
+
+
+def objective_labels(names: Sequence[str] | None, n_obj: int) -> list[str]:
+    if names is not None and len(names) != n_obj:
+        raise ValueError(f"objectives = {list(names)!r}: the front has {n_obj} objectives")
+    return [objective_label(None if names is None else names[i], i) for i in range(n_obj)]
+
+
+def indicator_label(name: str) -> str:
+    return INDICATOR_LABELS.get(name, name)
+
+
+def save_figure(fig, path: str | Path, dpi: int = 150, close: bool = True) -> Path:
+    """Save a figure (format from the suffix) through a temporary file, so no half-written image
+    is left behind; closes it by default to free memory in long loops."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-" + path.stem + ".", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        if close:
+            import matplotlib.pyplot as plt
+
+            plt.close(fig)
+    return path
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, figsize=(7.0, 4.5), **kwargs):
+    """A figure with a constrained layout (matplotlib.pyplot is imported only here)."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(nrows, ncols, figsize=figsize, layout="constrained", squeeze=False, **kwargs)
+    return fig, axes
