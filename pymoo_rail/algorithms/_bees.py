@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 from pymoo.core.algorithm import Algorithm
+from pymoo.core.population import Population
 from pymoo.util.display.column import Column
 
 
@@ -163,6 +164,31 @@ class BeeColony(Algorithm):
 
     def _observe(self, infills) -> None:
         """Called with every evaluated batch before it is used."""
+
+    def _start_colony(self, infills, order: np.ndarray) -> None:
+        """The first ``n_sources`` of ``order`` (indices of ``infills``) become the food sources."""
+        self.pop = infills[np.sort(order[: self.n_sources])]
+        self.trials = np.zeros(self.n_sources, dtype=int)
+        self.n_scouts = 0
+        self._phase = EMPLOYED
+
+    def _infill(self):
+        if self._phase == SCOUT:
+            self._parents = self._scouts
+            return self.sampling.do(self.problem, len(self._scouts), random_state=self.random_state)
+        if self._phase == EMPLOYED:
+            self._parents = np.arange(self.n_sources)
+        else:
+            self._parents = roulette(self._onlooker_probabilities(), self.n_sources, self.random_state)
+        return Population.new(X=self._candidates(self._parents))
+
+    def _onlooker_probabilities(self) -> np.ndarray:
+        """Probability of each food source to be chosen by an onlooker."""
+        raise NotImplementedError
+
+    def _candidates(self, parents: np.ndarray) -> np.ndarray:
+        """One neighbour of each source in ``parents``."""
+        raise NotImplementedError
 
     def _advance(self, infills=None, **kwargs) -> bool:
         if infills is None:

@@ -18,8 +18,6 @@ from pymoo.util.optimum import filter_optimum
 
 from pymoo_rail.algorithms._bees import (
     EMPLOYED,
-    ONLOOKER,
-    SCOUT,
     BeeColony,
     ScoutColumn,
     check_bounds,
@@ -28,7 +26,6 @@ from pymoo_rail.algorithms._bees import (
     feasibility_first_better,
     one_variable_move,
     random_partners,
-    roulette,
 )
 
 
@@ -161,32 +158,17 @@ class ABC(BeeColony):
 
     def _initialize_advance(self, infills=None, **kwargs) -> None:
         F, CV = infills.get("F")[:, 0], infills.get("CV")[:, 0]
-        best = np.lexsort((F, CV))[: self.n_sources]
-        self.pop = infills[np.sort(best)]
-        self.trials = np.zeros(self.n_sources, dtype=int)
-        self.n_scouts = 0
-        self._phase = EMPLOYED
+        self._start_colony(infills, np.lexsort((F, CV)))
 
     # ------------------------------------------------------------------ one cycle
-    def _infill(self) -> Population:
-        if self._phase == SCOUT:
-            self._parents = self._scouts
-            return self.sampling.do(
-                self.problem, len(self._scouts), random_state=self.random_state
-            )
-        if self._phase == EMPLOYED:
-            self._parents = np.arange(self.n_sources)
-        else:
-            F, CV = self.pop.get("F")[:, 0], self.pop.get("CV")[:, 0]
-            P = ONLOOKER_FITNESS[self.onlooker_fitness](F, CV)
-            self._parents = roulette(P, self.n_sources, self.random_state)
+    def _onlooker_probabilities(self) -> np.ndarray:
+        F, CV = self.pop.get("F")[:, 0], self.pop.get("CV")[:, 0]
+        return ONLOOKER_FITNESS[self.onlooker_fitness](F, CV)
 
+    def _candidates(self, parents: np.ndarray) -> np.ndarray:
         X = self.pop.get("X")
-        partners = random_partners(self.n_sources, self.random_state)[self._parents]
-        V = one_variable_move(
-            X[self._parents], X[partners], self._xl, self._xu, self.random_state
-        )
-        return Population.new(X=V)
+        partners = random_partners(self.n_sources, self.random_state)[parents]
+        return one_variable_move(X[parents], X[partners], self._xl, self._xu, self.random_state)
 
     def _greedy(self, infills: Population) -> None:
         """Replace sources by strictly better candidates, in draw order; count trials."""

@@ -18,8 +18,6 @@ from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from pymoo_rail.algorithms._bees import (
     EMPLOYED,
-    ONLOOKER,
-    SCOUT,
     BeeColony,
     ScoutColumn,
     check_bounds,
@@ -27,7 +25,6 @@ from pymoo_rail.algorithms._bees import (
     check_limit,
     constraint_dominates,
     one_variable_move,
-    roulette,
 )
 
 MOVES = ("centred", "canonical", "literal")
@@ -195,31 +192,18 @@ class MOABC(BeeColony):
 
     def _initialize_advance(self, infills=None, **kwargs) -> None:
         dom = domination_counts(infills.get("F"), infills.get("CV")[:, 0])
-        best = np.argsort(-dom, kind="stable")[: self.n_sources]
-        self.pop = infills[np.sort(best)]
         self.pareto_archive = Population.empty()
         self._update_archive(infills)
-        self.trials = np.zeros(self.n_sources, dtype=int)
-        self.n_scouts = 0
-        self._phase = EMPLOYED
+        self._start_colony(infills, np.argsort(-dom, kind="stable"))
 
     # ------------------------------------------------------------------ one cycle
-    def _infill(self) -> Population:
-        if self._phase == SCOUT:
-            self._parents = self._scouts
-            return self.sampling.do(
-                self.problem, len(self._scouts), random_state=self.random_state
-            )
-        if self._phase == EMPLOYED:
-            self._parents = np.arange(self.n_sources)
-        else:
-            P = dominance_probabilities(self.pop.get("F"), self.pop.get("CV")[:, 0])
-            self._parents = roulette(P, self.n_sources, self.random_state)
+    def _onlooker_probabilities(self) -> np.ndarray:
+        return dominance_probabilities(self.pop.get("F"), self.pop.get("CV")[:, 0])
 
-        X = self.pop.get("X")[self._parents]
+    def _candidates(self, parents: np.ndarray) -> np.ndarray:
+        X = self.pop.get("X")[parents]
         guides = self.random_state.integers(0, len(self.pareto_archive), size=len(X))
-        X_k = self.pareto_archive.get("X")[guides]
-        return Population.new(X=self._move(X, X_k))
+        return self._move(X, self.pareto_archive.get("X")[guides])
 
     def _move(self, X: np.ndarray, X_k: np.ndarray) -> np.ndarray:
         if self.move == "literal":
