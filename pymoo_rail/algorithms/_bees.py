@@ -157,10 +157,51 @@ class BeeColony(Algorithm):
 
     ``_advance`` returns False between the phases, so each phase is one ask/tell and nothing is
     evaluated inside the algorithm. Subclasses provide ``_infill`` for the current ``_phase``,
-    ``_greedy(infills)`` (keep better candidates, count trials), ``_end_cycle(n_scouts)``, and
-    may override ``_observe(infills)`` to see every evaluated candidate (MOABC's archive).
-    Subclasses set ``trials`` (per source) and ``_limit``.
+    ``_greedy(infills)`` (keep better candidates, count trials), ``_onlooker_probabilities``,
+    ``_candidates`` and ``_initialize_advance`` (which calls :meth:`_start_colony`), and may
+    override ``_observe(infills)`` to see every evaluated candidate (MOABC's archive).
+
+    Parameters
+    ----------
+    pop_size : int
+        Colony size (employed plus onlooker bees), even and at least ``min_pop_size``.
+    limit : int, optional
+        Trial limit before a food source is abandoned. Default ``SN * n_var``.
+    sampling : pymoo Sampling
+        Initial colony and scouts.
+    min_pop_size : int
+        Smallest colony the subclass accepts.
+    **kwargs
+        Passed on to :class:`pymoo.core.algorithm.Algorithm`.
     """
+
+    def __init__(self, pop_size: int, limit: int | None, sampling, min_pop_size: int, **kwargs) -> None:
+        super().__init__(**kwargs)
+        self.n_sources = check_colony_size(pop_size, minimum=min_pop_size)
+        self.pop_size = int(pop_size)
+        self.limit = check_limit(limit)
+        self.sampling = sampling
+
+        self.trials: np.ndarray | None = None
+        self.n_scouts = 0
+        self.n_scouts_total = 0
+        self._phase = EMPLOYED
+        self._parents: np.ndarray | None = None
+        self._scouts: np.ndarray | None = None
+        self._xl: np.ndarray | None = None
+        self._xu: np.ndarray | None = None
+        self._limit: int | None = None
+
+    def _setup(self, problem, **kwargs) -> None:
+        self._xl, self._xu = check_bounds(problem)
+        self._limit = self.limit if self.limit is not None else self.n_sources * problem.n_var
+
+    def _initialize_infill(self) -> Population:
+        return self.sampling.do(self.problem, self.pop_size, random_state=self.random_state)
+
+    def run_counters(self) -> dict[str, int]:
+        """Totals of the run so far, stored with each study record: scouts sent."""
+        return {"n_scouts_total": int(self.n_scouts_total)}
 
     def _observe(self, infills) -> None:
         """Called with every evaluated batch before it is used."""
@@ -170,6 +211,7 @@ class BeeColony(Algorithm):
         self.pop = infills[np.sort(order[: self.n_sources])]
         self.trials = np.zeros(self.n_sources, dtype=int)
         self.n_scouts = 0
+        self.n_scouts_total = 0
         self._phase = EMPLOYED
 
     def _infill(self):
@@ -198,6 +240,7 @@ class BeeColony(Algorithm):
         if self._phase == SCOUT:
             self.pop[self._scouts] = infills
             self.trials[self._scouts] = 0
+            self.n_scouts_total += len(self._scouts)
             self._end_cycle(len(self._scouts))
             return True
 
@@ -213,6 +256,12 @@ class BeeColony(Algorithm):
             return False
         self._end_cycle(0)
         return True
+
+    def _end_cycle(self, n_scouts: int) -> None:
+        self.n_scouts = n_scouts
+        self._phase = EMPLOYED
+        self._parents = None
+        self._scouts = None
 
 
 class ScoutColumn:

@@ -17,12 +17,8 @@ from pymoo.util.display.single import SingleObjectiveOutput
 from pymoo.util.optimum import filter_optimum
 
 from pymoo_rail.algorithms._bees import (
-    EMPLOYED,
     BeeColony,
     ScoutColumn,
-    check_bounds,
-    check_colony_size,
-    check_limit,
     feasibility_first_better,
     one_variable_move,
     random_partners,
@@ -125,37 +121,20 @@ class ABC(BeeColony):
         output=ABCOutput(),
         **kwargs,
     ) -> None:
-        super().__init__(output=output, **kwargs)
-        self.n_sources = check_colony_size(pop_size, minimum=4)
-        self.pop_size = int(pop_size)
-        self.limit = check_limit(limit)
+        super().__init__(pop_size, limit, sampling, min_pop_size=4, output=output, **kwargs)
         if onlooker_fitness not in ONLOOKER_FITNESS:
             raise ValueError(
                 f"onlooker_fitness must be one of {tuple(ONLOOKER_FITNESS)}, "
                 f"got {onlooker_fitness!r}"
             )
         self.onlooker_fitness = onlooker_fitness
-        self.sampling = sampling
-
-        self.trials: np.ndarray | None = None
-        self.n_scouts = 0
-        self._phase = EMPLOYED
-        self._parents: np.ndarray | None = None
-        self._scouts: np.ndarray | None = None
-        self._xl: np.ndarray | None = None
-        self._xu: np.ndarray | None = None
-        self._limit: int | None = None
 
     def _setup(self, problem, **kwargs) -> None:
         if problem.n_obj != 1:
             raise ValueError(f"ABC is single-objective, the problem has n_obj={problem.n_obj}")
-        self._xl, self._xu = check_bounds(problem)
-        self._limit = self.limit if self.limit is not None else self.n_sources * problem.n_var
+        super()._setup(problem, **kwargs)
 
     # ------------------------------------------------------------------ initialisation
-    def _initialize_infill(self) -> Population:
-        return self.sampling.do(self.problem, self.pop_size, random_state=self.random_state)
-
     def _initialize_advance(self, infills=None, **kwargs) -> None:
         F, CV = infills.get("F")[:, 0], infills.get("CV")[:, 0]
         self._start_colony(infills, np.lexsort((F, CV)))
@@ -181,12 +160,6 @@ class ABC(BeeColony):
                 self.trials[i] = 0
             else:
                 self.trials[i] += 1
-
-    def _end_cycle(self, n_scouts: int) -> None:
-        self.n_scouts = n_scouts
-        self._phase = EMPLOYED
-        self._parents = None
-        self._scouts = None
 
     def _set_optimum(self) -> None:
         # keep the best ever seen: scouts may abandon the current best source

@@ -426,6 +426,11 @@ class GoldenRatioNSGA2(NSGA2):
         """Eq. 9: per-variable mutation probability for individuals of fitness ``f``."""
         return adaptive_probability(f, f_avg, f_max, self.pm_max, self.pm_min, GOLDEN_LONG)
 
+    def run_counters(self) -> dict[str, int]:
+        """Totals of the run so far, stored with each study record: local-search points
+        evaluated and accepted."""
+        return {"n_local_evals": int(self.n_local_evals), "n_accepted_total": int(self.n_accepted_total)}
+
     # -- life cycle ---------------------------------------------------------------------------
 
     def _reset_state(self) -> None:

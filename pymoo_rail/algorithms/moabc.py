@@ -17,12 +17,8 @@ from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
 from pymoo_rail.algorithms._bees import (
-    EMPLOYED,
     BeeColony,
     ScoutColumn,
-    check_bounds,
-    check_colony_size,
-    check_limit,
     constraint_dominates,
     one_variable_move,
 )
@@ -153,9 +149,7 @@ class MOABC(BeeColony):
         output=MOABCOutput(),
         **kwargs,
     ) -> None:
-        super().__init__(output=output, **kwargs)
-        self.n_sources = check_colony_size(pop_size, minimum=2)
-        self.pop_size = int(pop_size)
+        super().__init__(pop_size, limit, sampling, min_pop_size=2, output=output, **kwargs)
         if (
             isinstance(archive_size, bool)
             or not isinstance(archive_size, (int, np.integer))
@@ -169,27 +163,9 @@ class MOABC(BeeColony):
         if not np.isfinite(w) or w <= 0:
             raise ValueError(f"w must be a positive finite number, got {w!r}")
         self.w = float(w)
-        self.limit = check_limit(limit)
-        self.sampling = sampling
-
         self.pareto_archive: Population | None = None
-        self.trials: np.ndarray | None = None
-        self.n_scouts = 0
-        self._phase = EMPLOYED
-        self._parents: np.ndarray | None = None
-        self._scouts: np.ndarray | None = None
-        self._xl: np.ndarray | None = None
-        self._xu: np.ndarray | None = None
-        self._limit: int | None = None
-
-    def _setup(self, problem, **kwargs) -> None:
-        self._xl, self._xu = check_bounds(problem)
-        self._limit = self.limit if self.limit is not None else self.n_sources * problem.n_var
 
     # ------------------------------------------------------------------ initialisation
-    def _initialize_infill(self) -> Population:
-        return self.sampling.do(self.problem, self.pop_size, random_state=self.random_state)
-
     def _initialize_advance(self, infills=None, **kwargs) -> None:
         dom = domination_counts(infills.get("F"), infills.get("CV")[:, 0])
         self.pareto_archive = Population.empty()
@@ -237,12 +213,6 @@ class MOABC(BeeColony):
     def _update_archive(self, infills: Population) -> None:
         merged = Population.merge(self.pareto_archive, infills)
         self.pareto_archive = truncate_by_crowding(nondominated(merged), self.archive_size)
-
-    def _end_cycle(self, n_scouts: int) -> None:
-        self.n_scouts = n_scouts
-        self._phase = EMPLOYED
-        self._parents = None
-        self._scouts = None
 
     def _set_optimum(self) -> None:
         self.opt = self.pareto_archive

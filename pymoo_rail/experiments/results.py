@@ -11,7 +11,7 @@ from pymoo_rail.experiments.spec import Study
 from pymoo_rail.experiments.store import STUDY_FILE, ResultStore
 
 BASE_COLUMNS = ("run_id", "problem", "algorithm", "seed", "budget", "n_var", "n_obj", "n_eval", "n_gen",
-                "wall_time_s", "feasible")
+                "wall_time_s", "cpu_time_s", "feasible")
 
 
 def _study_of(directory: Path, study: Study | None) -> Study | None:
@@ -54,7 +54,8 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
 
 
 def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
-    """One row per run: ids, labels, budget, evaluations, wall time, one column per indicator.
+    """One row per run: ids, labels, budget, evaluations, times, one column per indicator and
+    one per run counter.
 
     ``problem_spec`` and ``algorithm_spec`` hold the specs (dicts) the run was built from.
     With ``fronts``, the columns ``F`` and ``X`` hold the final front as arrays, ``extras`` a
@@ -68,8 +69,10 @@ def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
         row = {"run_id": r["run_id"], "problem": r["problem_label"], "algorithm": r["algorithm_label"],
                "seed": r["seed"], "budget": f"{budget_kind}={budget_value}", "n_var": r["n_var"],
                "n_obj": r["n_obj"], "n_eval": r["n_eval"], "n_gen": r["n_gen"], "wall_time_s": r["wall_time_s"],
+               "cpu_time_s": r.get("cpu_time_s", np.nan),  # records before cpu_time_s existed
                "feasible": r["feasible"], "problem_spec": r["problem"], "algorithm_spec": r["algorithm"]}
         row.update(r["indicators"])
+        row.update({k: v for k, v in r.get("counters", {}).items() if k not in row})
         if fronts:
             n_obj, n_var = r["n_obj"], r["n_var"]
             row["F"] = np.asarray(r["front"]["F"], dtype=float).reshape(-1, n_obj)

@@ -79,12 +79,32 @@ class _History:
         return {k: [row.get(k) for row in self.rows] for k in keys}
 
 
+def run_counters(algorithm) -> dict[str, float]:
+    """What the algorithm counts over a run (``algorithm.run_counters()``, if it has one).
+
+    Any algorithm can report totals that are not indicators of its front, such as the
+    local-search points GR-NSGA-II accepted or the scouts a bee colony sent; the study keeps
+    them with the run. Values must be numbers.
+    """
+    method = getattr(algorithm, "run_counters", None)
+    if not callable(method):
+        return {}
+    counters = {}
+    for key, value in method().items():
+        number = float(value)
+        if not np.isfinite(number):
+            raise ValueError(f"run counter {key!r} = {value!r} is not a finite number")
+        counters[str(key)] = int(number) if number.is_integer() else number
+    return counters
+
+
 def execute_run(run: RunSpec) -> dict[str, Any]:
     """Run one study run and return its record (a JSON-ready dict).
 
     The record holds the final front (``F``, ``X``, constraint violation and, for rail problems,
     energy, running time and stop error of each member), its indicators, the evaluations used,
-    the wall time, the per-generation history and the versions of pymoo and pymoo-rail.
+    the wall and CPU time (CPU time of this process, all its threads), the algorithm's
+    :func:`run_counters`, the per-generation history and the versions of pymoo and pymoo-rail.
     """
     from pymoo.optimize import minimize
 
@@ -92,10 +112,11 @@ def execute_run(run: RunSpec) -> dict[str, Any]:
     algorithm = build_algorithm(run.algorithm, problem)
     pf = true_front(problem)
     history = _History(pf) if run.history else None
-    start = time.perf_counter()
+    start, start_cpu = time.perf_counter(), time.process_time()
     res = minimize(problem, algorithm, run.budget.termination, seed=run.seed, verbose=False,
                    callback=history, copy_algorithm=False)
     wall_time_s = time.perf_counter() - start
+    cpu_time_s = time.process_time() - start_cpu
 
     opt = res.algorithm.opt
     X = np.asarray(opt.get("X"), dtype=float) if opt is not None else np.empty((0, problem.n_var))
@@ -117,8 +138,10 @@ def execute_run(run: RunSpec) -> dict[str, Any]:
         "n_eval": int(res.algorithm.evaluator.n_eval),
         "n_gen": int(res.algorithm.n_iter - 1),
         "wall_time_s": wall_time_s,
+        "cpu_time_s": cpu_time_s,
         "feasible": bool(feasible.any()),
         "indicators": indicators,
+        "counters": run_counters(res.algorithm),
         "front": {"F": F.tolist(), "X": X.tolist(), "CV": CV.tolist(),
                   "extras": _extras(problem, opt, X) if len(X) else {}},
         "history": history.columns() if history is not None else None,

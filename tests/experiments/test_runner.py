@@ -85,11 +85,42 @@ def test_record_holds_front_indicators_budget_and_versions(pool_study_dir):
     assert F.shape[1] == 2 and len(record["front"]["X"]) == len(F) and len(record["front"]["X"][0]) == 8
     assert set(record["indicators"]) >= {"igd", "gd", "gd_vv", "hv", "spacing", "n_front"}
     assert record["versions"]["pymoo"] == pymoo.__version__ and "pymoo_rail" in record["versions"]
-    assert record["wall_time_s"] > 0
+    assert record["wall_time_s"] > 0 and record["cpu_time_s"] > 0
+    assert record["counters"] == {}  # NSGA-II reports no run counters
     history = record["history"]
     assert history["n_gen"] == [float(g) for g in range(1, 9)]
     assert history["n_eval"] == [12.0 * g for g in range(1, 9)]
     assert history["igd"][-1] == pytest.approx(record["indicators"]["igd"])
+
+
+def test_record_keeps_the_run_counters_an_algorithm_reports():
+    """GR-NSGA-II's local-search totals and ABC's scouts reach the record and the DataFrame, and
+    equal what the same seeded run reports (scouts counted independently, cycle by cycle)."""
+    from pymoo.optimize import minimize
+    from pymoo.problems import get_problem
+
+    from pymoo_rail.algorithms import ABC, GoldenRatioNSGA2
+    from pymoo_rail.experiments import Budget, RunSpec, records_frame
+    from pymoo_rail.experiments.functions import Sphere
+
+    gr = execute_run(RunSpec(problem("zdt1", n_var=6), algorithm("grnsga2", pop_size=20, local_size=8), 3,
+                             Budget("n_gen", 10)))
+    res = minimize(get_problem("zdt1", n_var=6), GoldenRatioNSGA2(pop_size=20, local_size=8), ("n_gen", 10), seed=3)
+    assert gr["counters"] == {"n_local_evals": res.algorithm.n_local_evals,
+                              "n_accepted_total": res.algorithm.n_accepted_total}
+    assert 0 < gr["counters"]["n_accepted_total"] <= gr["counters"]["n_local_evals"]
+
+    scouts: list[int] = []
+    minimize(Sphere(3), ABC(pop_size=10, limit=2), ("n_gen", 30), seed=4,
+             callback=lambda algorithm: scouts.append(algorithm.n_scouts))
+    abc = execute_run(RunSpec(problem("sphere", n_var=3), algorithm("abc", pop_size=10, limit=2), 4,
+                              Budget("n_gen", 30)))
+    assert abc["counters"] == {"n_scouts_total": sum(scouts[1:])} and sum(scouts) > 0  # [0]: the initial colony
+
+    frame = records_frame([gr, abc], fronts=False).set_index("algorithm")
+    assert frame.loc["grnsga2", "n_accepted_total"] == gr["counters"]["n_accepted_total"]
+    assert np.isnan(frame.loc["abc", "n_accepted_total"]) and frame.loc["abc", "cpu_time_s"] > 0
+    assert frame.loc["abc", "n_scouts_total"] == sum(scouts[1:])
 
 
 def test_killed_study_resumes_without_losing_or_duplicating_runs(pool_study_dir, tmp_path):
