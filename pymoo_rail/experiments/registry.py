@@ -216,6 +216,68 @@ ALIASES = {"smsemoa": "sms-emoa", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-i
            "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
            "cooperative-trains": "cooperative_trains"}
 
+# -------------------------------------------------------------------------------- operators
+
+# Variation operators a spec may name: ``crossover = {operator = "sbx", prob = 0.9, eta = 15}``
+# (or just ``crossover = "sbx"``). Values are (module, class) of pymoo; "module:Class" works too.
+OPERATORS: dict[str, dict[str, tuple[str, str]]] = {
+    "crossover": {
+        "sbx": ("pymoo.operators.crossover.sbx", "SBX"),
+        "ux": ("pymoo.operators.crossover.ux", "UX"),
+        "hux": ("pymoo.operators.crossover.hux", "HUX"),
+        "one_point": ("pymoo.operators.crossover.pntx", "SinglePointCrossover"),
+        "two_point": ("pymoo.operators.crossover.pntx", "TwoPointCrossover"),
+        "de": ("pymoo.operators.crossover.dex", "DEX"),
+    },
+    "mutation": {
+        "pm": ("pymoo.operators.mutation.pm", "PM"),
+        "gauss": ("pymoo.operators.mutation.gauss", "GaussianMutation"),
+        "bitflip": ("pymoo.operators.mutation.bitflip", "BitflipMutation"),
+    },
+    "sampling": {
+        "random": ("pymoo.operators.sampling.rnd", "FloatRandomSampling"),
+        "lhs": ("pymoo.operators.sampling.lhs", "LHS"),
+    },
+}
+
+
+def _operator(kind: str, value: Any, where: str) -> Any:
+    """A pymoo operator from ``"name"`` or ``{operator = "name", ...keyword arguments}``."""
+    if isinstance(value, str):
+        name, params = value, {}
+    elif isinstance(value, dict):
+        if "operator" not in value:
+            raise StudyError(f"{where}.operator", None, f"names the {kind} (one of {', '.join(OPERATORS[kind])})")
+        name = value["operator"]
+        params = {k: v for k, v in value.items() if k != "operator"}
+    else:
+        raise StudyError(where, value, f"must be a {kind} name or a table {{operator = \"name\", ...}}")
+    if not isinstance(name, str):
+        raise StudyError(f"{where}.operator", name, "must be a name")
+    if ":" in name:
+        factory = _import_path(name, f"{where}.operator")
+    else:
+        key = name.strip().lower().replace("-", "_")
+        if key not in OPERATORS[kind]:
+            raise StudyError(f"{where}.operator", name,
+                             f"unknown {kind} (built-in: {', '.join(OPERATORS[kind])}; or 'module:Class')")
+        module, attribute = OPERATORS[kind][key]
+        factory = getattr(importlib.import_module(module), attribute)
+    try:
+        return factory(**params)
+    except TypeError as err:
+        raise StudyError(where, value, f"bad parameters: {err}") from None
+
+
+def _with_operators(params: dict, where: str) -> dict:
+    """``params`` with its crossover / mutation / sampling tables made into pymoo operators."""
+    out = dict(params)
+    for kind in OPERATORS:
+        if kind in out:
+            out[kind] = _operator(kind, out[kind], f"{where}.{kind}")
+    return out
+
+
 # ------------------------------------------------------------------------------ resolving
 
 
@@ -263,8 +325,9 @@ def check_algorithm_name(name: str) -> None:
 
 
 def _call(factory: Callable[..., Any], kind: str, spec, *args) -> Any:
+    params = _with_operators(spec.params, f"{kind} '{spec.display}'") if kind == "algorithm" else spec.params
     try:
-        return factory(*args, **spec.params)
+        return factory(*args, **params)
     except TypeError as err:
         # an unknown or missing keyword argument: say which spec it came from
         raise StudyError(f"{kind} '{spec.display}'", spec.params, f"bad parameters: {err}") from None

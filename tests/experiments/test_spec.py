@@ -142,6 +142,46 @@ def test_registry_errors_name_the_spec():
         build_problem(problem("no_such_module:Thing"))
 
 
+def test_operators_are_named_in_a_spec_and_survive_the_toml_file(tmp_path):
+    """``crossover = {operator = "sbx", prob = 0.9, eta = 15}`` builds the same algorithm as the
+    pymoo objects: the same seeded run gives the same front."""
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.operators.crossover.sbx import SBX
+    from pymoo.operators.mutation.pm import PM
+    from pymoo.optimize import minimize
+
+    spec = algorithm("nsga2", pop_size=16, crossover={"operator": "sbx", "prob": 0.9, "eta": 15},
+                     mutation={"operator": "PM", "prob": 1.0, "prob_var": 0.01, "eta": 20}, sampling="lhs")
+    study = Study("ops", problems=[problem("zdt2", n_var=5)], algorithms=[spec], budget={"n_gen": 12})
+    write_study(study, tmp_path / "ops.toml")
+    again = read_study(tmp_path / "ops.toml").algorithms[0]
+    assert again == spec
+    zdt2 = build_problem(problem("zdt2", n_var=5))
+    built = build_algorithm(again, zdt2)
+    assert isinstance(built.mating.crossover, SBX) and built.mating.crossover.eta.value == 15
+    assert built.mating.mutation.prob_var.value == 0.01 and type(built.initialization.sampling).__name__ == "LHS"
+
+    from pymoo.operators.sampling.lhs import LHS
+
+    direct = NSGA2(pop_size=16, crossover=SBX(prob=0.9, eta=15), mutation=PM(prob=1.0, prob_var=0.01, eta=20),
+                   sampling=LHS())
+    a = minimize(zdt2, built, ("n_gen", 12), seed=7).F
+    b = minimize(zdt2, direct, ("n_gen", 12), seed=7).F
+    np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("crossover, match", [
+    ({"operator": "blend"}, r"crossover.operator' = 'blend': unknown crossover"),
+    ({"prob": 0.9}, r"crossover.operator' = None"),
+    ({"operator": "sbx", "etta": 3}, r"'nsga2'.crossover' .*bad parameters.*etta"),
+    (3, r"crossover' = 3: must be a crossover name"),
+])
+def test_bad_operator_names_spec_field_and_value(crossover, match):
+    zdt1 = build_problem(problem("zdt1"))
+    with pytest.raises(StudyError, match=match):
+        build_algorithm(algorithm("nsga2", crossover=crossover), zdt1)
+
+
 def test_rail_algorithms_are_registered_and_built_lazily():
     zdt1 = build_problem(problem("zdt1"))
     try:
