@@ -23,67 +23,88 @@ Usage::
 
     nice -n 10 python benchmarks/abc_functions.py --runs 30 --out benchmarks/reports
 
-Results are appended to ``<out>/abc_functions.csv`` (one row per finished run) and
-convergence curves to ``<out>/abc_functions_curves/``; finished runs are skipped when the
-script is run again, so an interrupted study loses nothing.
+Runs go through ``pymoo_rail.experiments.run_study``: one study per (dimension, iterations)
+setting (its budget), each in ``--work/d<D>-it<iterations>`` (default ``out/abc_functions``, not
+committed), one JSON record per finished run with its best-so-far history, seed by seed. An
+interrupted study loses nothing; a re-run starts only the missing runs. ``abc_functions.csv``
+(one row per run) is exported from the records; ``--report-only`` rewrites the report.
+
+The functions are the study registry's ``sphere`` (seed eq. 3-6 on [-100, 100]), ``griewank`` and
+``rosenbrock`` (pymoo's classes, which use the seed's domains).
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import os
-import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
-from pymoo.algorithms.soo.nonconvex.de import DE
-from pymoo.algorithms.soo.nonconvex.pso import PSO
-from pymoo.core.problem import Problem
-from pymoo.optimize import minimize
-
-from pymoo_rail.algorithms import ABC
 
 POP = 30
+FIRST_SEED = 1000
 SETTINGS = [(10, 500), (20, 1000), (30, 1000), (50, 5000)]
 EXTRA = [("sphere", 30, 3000)]  # table 3-5
+FUNCTIONS = ("sphere", "griewank", "rosenbrock")
 ALGORITHMS = ("ABC", "PSO", "DE", "ABC-inverse")
 FIELDS = ["function", "dim", "iterations", "algorithm", "run", "seed", "best", "n_eval", "n_gen", "time_s"]
 
 
-class Sphere(Problem):
-    """Seed 000, eq. 3-6, on [-100, 100]^D; minimum 0 at the origin."""
+def algorithm_specs() -> dict:
+    """The four algorithms with the seed's parameters, as study specs by label."""
+    from pymoo_rail.experiments import algorithm
 
-    def __init__(self, n_var: int) -> None:
-        super().__init__(n_var=n_var, n_obj=1, xl=-100.0, xu=100.0)
-
-    def _evaluate(self, x, out, *args, **kwargs):
-        out["F"] = np.sum(x**2, axis=1)
-
-
-class Griewank(Problem):
-    """Seed 000, eq. 3-7, on [-600, 600]^D; minimum 0 at the origin."""
-
-    def __init__(self, n_var: int) -> None:
-        super().__init__(n_var=n_var, n_obj=1, xl=-600.0, xu=600.0)
-
-    def _evaluate(self, x, out, *args, **kwargs):
-        i = np.arange(1, self.n_var + 1)
-        out["F"] = np.sum(x**2, axis=1) / 4000.0 - np.prod(np.cos(x / np.sqrt(i)), axis=1) + 1.0
+    return {
+        "ABC": algorithm("abc", label="ABC", pop_size=POP, limit=50),
+        "PSO": algorithm("pso", label="PSO", pop_size=POP, w=0.8, c1=1.5, c2=1.5, adaptive=False,
+                         pertube_best=False),
+        "DE": algorithm("de", label="DE", pop_size=POP, variant="DE/rand/1/bin", CR=0.5, F=0.6, prob_mut=0.0),
+        "ABC-inverse": algorithm("abc", label="ABC-inverse", pop_size=POP, limit=50, onlooker_fitness="inverse"),
+    }
 
 
-class Rosenbrock(Problem):
-    """Seed 000, eq. 3-8, on [-2.048, 2.048]^D; minimum 0 at (1, ..., 1)."""
+def build_studies(runs: int, settings=None, extra=EXTRA) -> dict:
+    """One study per (dimension, iterations): ``{(dim, iterations): Study}``, equal budgets
+    ``30 (iterations + 1)`` evaluations, seeds 1000 .. 1000 + runs - 1. ``settings`` defaults
+    to the seed's; ``extra`` adds (function, dimension, iterations) cells run by ABC alone."""
+    from pymoo_rail.experiments import Study, problem
 
-    def __init__(self, n_var: int) -> None:
-        super().__init__(n_var=n_var, n_obj=1, xl=-2.048, xu=2.048)
+    specs = algorithm_specs()
+    seeds = [FIRST_SEED + run for run in range(runs)]
+    studies = {}
+    for dim, iterations in list(SETTINGS if settings is None else settings) + [(d, it) for _, d, it in extra]:
+        extras = [f for f, d, it in extra if (d, it) == (dim, iterations)]
+        functions = extras or FUNCTIONS
+        algorithms = [a for a in ALGORITHMS if not extras or a.startswith("ABC")]
+        studies[(dim, iterations)] = Study(
+            f"abc-functions-d{dim}-it{iterations}", problems=[problem(f, n_var=dim) for f in functions],
+            algorithms=[specs[a] for a in algorithms], seeds=seeds, budget={"n_eval": POP * (iterations + 1)})
+    return studies
 
-    def _evaluate(self, x, out, *args, **kwargs):
-        out["F"] = np.sum(100.0 * (x[:, 1:] - x[:, :-1] ** 2) ** 2 + (x[:, :-1] - 1.0) ** 2, axis=1)
+
+def study_directory(work: Path, dim: int, iterations: int) -> Path:
+    return Path(work) / f"d{dim}-it{iterations}"
 
 
-PROBLEMS = {"sphere": Sphere, "griewank": Griewank, "rosenbrock": Rosenbrock}
+def load_runs(work: Path, runs: int, settings=None, extra=EXTRA):
+    """Every stored run as ``(table, curves)``: one row per run (the CSV's columns) and
+    ``curves[(function, dim, iterations, algorithm)]`` = list of (n_eval, best-so-far) arrays."""
+    import pandas as pd
+
+    from pymoo_rail.experiments import load_results
+
+    rows, curves = [], {}
+    for (dim, iterations), study in build_studies(runs, settings, extra).items():
+        results = load_results(study_directory(work, dim, iterations), study=study)
+        for r in results.itertuples():
+            rows.append(dict(function=r.problem, dim=dim, iterations=iterations, algorithm=r.algorithm,
+                             run=int(r.seed) - FIRST_SEED, seed=int(r.seed), best=float(r.f_best),
+                             n_eval=int(r.n_eval), n_gen=int(r.n_gen), time_s=round(float(r.wall_time_s), 4)))
+            history = r.history
+            curves.setdefault((r.problem, dim, iterations, r.algorithm), []).append(
+                np.column_stack([history["n_eval"], history["f0_min"]]))
+    return pd.DataFrame(rows, columns=FIELDS), curves
+
 
 # Seed 000 tables 3-2 to 3-4: (min, mean, max, time_s). The extracted tables have garbled
 # row labels; rows are read in order as (10, 500), (20, 1000), (30, 1000), (50, 5000), which
@@ -129,99 +150,22 @@ SEED = {
 SEED_TABLE_3_5 = {("sphere", 30, 3000, "ABC"): (6.551810e-16, 8.063285e-16, 1.08883e-15)}
 
 
-def make_algorithm(name: str):
-    if name == "ABC":
-        return ABC(pop_size=POP, limit=50)
-    if name == "ABC-inverse":
-        return ABC(pop_size=POP, limit=50, onlooker_fitness="inverse")
-    if name == "PSO":
-        return PSO(pop_size=POP, w=0.8, c1=1.5, c2=1.5, adaptive=False, pertube_best=False)
-    if name == "DE":
-        return DE(pop_size=POP, variant="DE/rand/1/bin", CR=0.5, F=0.6, prob_mut=0.0)
-    raise ValueError(f"unknown algorithm {name!r}")
-
-
-def run_one(task: tuple) -> tuple[dict, np.ndarray]:
-    """One run; returns the CSV row and the best-so-far curve (n_eval, best)."""
-    function, dim, iterations, algorithm, run, seed = task
-    curve: list[tuple[int, float]] = []
-
-    def record(alg):
-        curve.append((alg.evaluator.n_eval, float(alg.opt[0].F[0])))
-
-    start = time.perf_counter()
-    res = minimize(
-        PROBLEMS[function](dim),
-        make_algorithm(algorithm),
-        ("n_eval", POP * (iterations + 1)),
-        seed=seed,
-        callback=record,
-    )
-    elapsed = time.perf_counter() - start
-    row = dict(
-        function=function, dim=dim, iterations=iterations, algorithm=algorithm, run=run,
-        seed=seed, best=repr(float(res.F[0])), n_eval=res.algorithm.evaluator.n_eval,
-        n_gen=res.algorithm.n_gen - 1, time_s=f"{elapsed:.4f}",
-    )
-    return row, np.asarray(curve)
-
-
-def tasks(runs: int) -> list[tuple]:
-    settings = [(f, d, it) for f in PROBLEMS for d, it in SETTINGS] + EXTRA
-    out = []
-    for run in range(runs):
-        for function, dim, iterations in settings:
-            for algorithm in ALGORITHMS:
-                if (function, dim, iterations) in EXTRA and not algorithm.startswith("ABC"):
-                    continue
-                out.append((function, dim, iterations, algorithm, run, 1000 + run))
-    return out
-
-
-def key(row) -> tuple:
-    return (row["function"], int(row["dim"]), int(row["iterations"]), row["algorithm"], int(row["run"]))
-
-
-def run_study(runs: int, out: Path, workers: int) -> None:
-    out.mkdir(parents=True, exist_ok=True)
-    curves = out / "abc_functions_curves"
-    curves.mkdir(exist_ok=True)
-    path = out / "abc_functions.csv"
-    done = set()
-    if path.exists():
-        with path.open() as fh:
-            done = {key(r) for r in csv.DictReader(fh)}
-    todo = [t for t in tasks(runs) if t[:5] not in done]
-    print(f"{len(done)} runs already done, {len(todo)} to do", flush=True)
-    new_file = not path.exists()
-    with path.open("a", newline="") as fh, ProcessPoolExecutor(max_workers=workers) as pool:
-        writer = csv.DictWriter(fh, fieldnames=FIELDS)
-        if new_file:
-            writer.writeheader()
-        futures = [pool.submit(run_one, t) for t in todo]
-        for n, future in enumerate(as_completed(futures), 1):
-            row, curve = future.result()
-            np.save(curves / "{function}_{dim}_{iterations}_{algorithm}_{run}.npy".format(**row), curve)
-            writer.writerow(row)
-            fh.flush()
-            if n % 20 == 0:
-                print(f"{n}/{len(todo)} done", flush=True)
-
-
-def report(out: Path) -> None:
+def report(out: Path, df, curves: dict) -> None:
+    """Report, per-run CSV and figures from :func:`load_runs`."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import pandas as pd
 
-    df = pd.read_csv(out / "abc_functions.csv")
-    df["best"] = df["best"].astype(float)
+    exported = df.assign(best=df.best.map(lambda v: repr(float(v))))  # every digit of the best value
+    exported.sort_values(["run", "function", "dim", "iterations", "algorithm"], kind="stable").to_csv(
+        out / "abc_functions.csv", index=False)
     n_runs = df.groupby(["function", "dim", "iterations", "algorithm"]).size()
     lines = [
         "# ABC vs PSO vs DE on the seed 000 benchmark functions (section 3.5)",
         "",
-        "Generated by `benchmarks/abc_functions.py`. "
+        "Generated by `benchmarks/abc_functions.py` (runs by `pymoo_rail.experiments.run_study`, one "
+        "study per dimension and iteration count). "
         f"Runs per cell: {n_runs.min()}" + (f" to {n_runs.max()}" if n_runs.max() != n_runs.min() else "")
         + " (the seed used 30). Seeds 1000 + run, the same for every algorithm.",
         "",
@@ -231,7 +175,8 @@ def report(out: Path) -> None:
         "pymoo PSO swarm 30, w = 0.8, c1 = c2 = 1.5, `adaptive=False`, `pertube_best=False`, "
         "pymoo's default velocity clamp 0.2 (xu - xl); pymoo DE population 30, DE/rand/1/bin, "
         "CR = 0.5, F = 0.6, `prob_mut=0`. Domains: Sphere [-100, 100], Griewank [-600, 600], "
-        "Rosenbrock [-2.048, 2.048] (defined in the script, not pymoo's).",
+        "Rosenbrock [-2.048, 2.048] (Sphere from `pymoo_rail.experiments.functions`, Griewank and "
+        "Rosenbrock pymoo's classes, which use these domains).",
         "",
         "Equal budgets: every algorithm stops on `n_eval = 30 (iterations + 1)`. ABC spends one "
         "extra evaluation per scout, so it runs slightly fewer cycles than the nominal number; "
@@ -246,7 +191,7 @@ def report(out: Path) -> None:
         "Sphere rows.",
         "",
     ]
-    for function in PROBLEMS:
+    for function in FUNCTIONS:
         lines += [f"## {function.capitalize()}", "",
                   "| D | iter | alg | min | mean | median | max | time s | n_eval | seed min | seed mean | seed max | seed time s |",
                   "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -269,19 +214,17 @@ def report(out: Path) -> None:
         lines.append("")
     lines += _observations(df)
 
-    curves = out / "abc_functions_curves"
     figures = []
 
     def median_curve(function, dim, iterations, algorithm):
-        files = sorted(curves.glob(f"{function}_{dim}_{iterations}_{algorithm}_*.npy"))
-        if not files:
+        arrays = curves.get((function, dim, iterations, algorithm))
+        if not arrays:
             return None
-        arrays = [np.load(f) for f in files]
         grid = np.linspace(POP, POP * (iterations + 1), 400)
         ys = [np.interp(grid, c[:, 0], c[:, 1]) for c in arrays]
         return grid / POP - 1, np.median(ys, axis=0)
 
-    for function in PROBLEMS:  # like figs. 3-5, 3-7, 3-9: algorithms compared per function
+    for function in FUNCTIONS:  # like figs. 3-5, 3-7, 3-9: algorithms compared per function
         fig, axes = plt.subplots(1, 4, figsize=(16, 3.6))
         for ax, (dim, iterations) in zip(axes, SETTINGS):
             for algorithm in ALGORITHMS:
@@ -292,7 +235,8 @@ def report(out: Path) -> None:
             ax.set_xlabel("iteration (evaluations / 30 - 1)")
             ax.grid(True, which="both", alpha=0.3)
         axes[0].set_ylabel("median best-so-far f")
-        axes[0].legend()
+        if axes[0].get_legend_handles_labels()[0]:
+            axes[0].legend()
         fig.tight_layout()
         name = f"abc_functions_{function}.png"
         fig.savefig(out / name, dpi=110)
@@ -308,7 +252,8 @@ def report(out: Path) -> None:
         ax.set_title(f"{algorithm} on Sphere [-100, 100]")
         ax.set_xlabel("iteration")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend()
     axes[0].set_ylabel("median best-so-far f")
     fig.tight_layout()
     fig.savefig(out / "abc_functions_sphere_dims.png", dpi=110)
@@ -340,13 +285,21 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=30)
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "reports")
     parser.add_argument("--workers", type=int, default=2, help="process pool size (at most 2)")
+    parser.add_argument("--work", type=Path, default=Path(__file__).resolve().parents[1] / "out" / "abc_functions",
+                        help="study directories: one JSON record per run (not committed)")
     parser.add_argument("--report-only", action="store_true")
     args = parser.parse_args()
     workers = max(1, min(args.workers, 2))
     if not args.report_only:
+        from pymoo_rail.experiments import run_study
+
         os.nice(max(0, 10 - os.nice(0)))  # be gentle on the shared 2-core machine
-        run_study(args.runs, args.out, workers)
-    report(args.out)
+        for (dim, iterations), study in build_studies(args.runs).items():
+            # seed by seed: a study stopped early still compares every algorithm on the same seeds
+            print(run_study(study, study_directory(args.work, dim, iterations), workers=workers,
+                            seed_major=True), flush=True)
+    args.out.mkdir(parents=True, exist_ok=True)
+    report(args.out, *load_runs(args.work, args.runs))
 
 
 if __name__ == "__main__":

@@ -124,18 +124,6 @@ def make_study(name: str, encodings, seeds, budget: int, pop_size: int = POP_SIZ
                  budget={"n_eval": int(budget)}, baseline=NSGA2_LABEL)
 
 
-def run_seed_major(study, directory: Path, workers: int, progress: bool = True):
-    """``run_study`` one seed at a time (same run ids), then once for the whole study."""
-    from dataclasses import replace
-
-    from pymoo_rail.experiments import run_study
-
-    for seed in study.seeds:
-        report = run_study(replace(study, seeds=(seed,)), directory, workers=workers, progress=progress)
-        print(f"{study.name} seed {seed}: {report}", flush=True)
-    return run_study(study, directory, workers=workers, progress=False)
-
-
 # ------------------------------------------------------------------------------ analysis
 
 
@@ -815,7 +803,7 @@ def main(argv=None) -> int:
     if args.encodings[0] != MAIN_ENCODING:
         parser.error(f"--encodings: the first encoding must be {MAIN_ENCODING!r} (figs. 10-12 are drawn on it)")
 
-    from pymoo_rail.experiments import load_results
+    from pymoo_rail.experiments import load_results, run_study
 
     enc_study = make_study("emu_wuguang_encodings", list(ENCODINGS), range(1, args.encoding_seeds + 1),
                            args.encoding_budget, args.pop_size, args.local_size) if args.encoding_seeds > 0 else None
@@ -824,9 +812,10 @@ def main(argv=None) -> int:
     enc_dir, main_dir = args.work / "encodings", args.work / "main"
     if not args.report_only:
         t0 = time.perf_counter()
-        if enc_study is not None:
-            print(run_seed_major(enc_study, enc_dir, args.workers, not args.no_progress), flush=True)
-        print(run_seed_major(main_study, main_dir, args.workers, not args.no_progress), flush=True)
+        for study, directory in ((enc_study, enc_dir), (main_study, main_dir)):
+            if study is not None:  # seed by seed: a study stopped early still compares like with like
+                print(run_study(study, directory, workers=args.workers, progress=not args.no_progress,
+                                seed_major=True), flush=True)
         print(f"studies done in {time.perf_counter() - t0:.0f} s", flush=True)
     results_enc = load_results(enc_dir, study=enc_study) if enc_study is not None else None
     results_main = load_results(main_dir, study=main_study)

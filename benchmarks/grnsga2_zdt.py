@@ -17,9 +17,12 @@ Usage::
 
     nice -n 10 python benchmarks/grnsga2_zdt.py --runs 30 --out benchmarks/reports
 
-Each finished run is appended to ``OUT/grnsga2_zdt_runs.csv`` at once; a re-run skips the
-runs already there, so an interrupted study loses nothing. Final fronts go to
-``--work`` (default ``out/grnsga2_zdt``) for the plots. At most 2 worker processes.
+Runs go through ``pymoo_rail.experiments.run_study`` (study ``grnsga2-zdt``, seed by seed): one
+JSON record per finished run in ``--work`` (default ``out/grnsga2_zdt``, not committed), written
+as it finishes, so an interrupted study loses nothing and a re-run starts only the missing runs.
+The report's indicators are computed from the stored final fronts against 500 points of the
+true front (``grnsga2_zdt_runs.csv``, one row per run, is exported from the records).
+``--report-only`` rewrites the report from the stored records.
 """
 
 from __future__ import annotations
@@ -27,14 +30,9 @@ from __future__ import annotations
 import argparse
 import csv
 import os
-import sys
-import time
-from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 BUDGET = 60_000
 POP_SIZE = 200
@@ -60,6 +58,34 @@ DEB_2002 = {  # Deb et al. 2002, real-coded NSGA-II: (Delta, Upsilon)
     "zdt3": (0.575606, 0.114500), "zdt4": (0.479475, 0.513053),
 }
 
+SBX_SEED = {"operator": "sbx", "prob": 0.9, "eta": 15}
+
+
+def algorithm_specs() -> dict:
+    """The four algorithms as study specs, by label."""
+    from pymoo_rail.experiments import algorithm
+
+    return {
+        "NSGA-II": algorithm("nsga2", label="NSGA-II", pop_size=POP_SIZE, crossover=SBX_SEED,
+                             mutation={"operator": "pm", "prob": 1.0, "prob_var": 0.01, "eta": 20}),
+        "GR-NSGA-II": algorithm("grnsga2", label="GR-NSGA-II", pop_size=POP_SIZE, local_size=40, pc_max=0.9,
+                                pm_max=0.1),
+        "GR-NSGA-II no LS": algorithm("grnsga2", label="GR-NSGA-II no LS", pop_size=POP_SIZE, local_size=0,
+                                      pc_max=0.9, pm_max=0.1),
+        "NSGA-II pm=1/n": algorithm("nsga2", label="NSGA-II pm=1/n", pop_size=POP_SIZE, crossover=SBX_SEED,
+                                    mutation={"operator": "pm", "prob": 1.0, "eta": 20}),
+    }
+
+
+def build_study(runs: int, problems=PROBLEMS, algorithms=ALGORITHMS, budget: int = BUDGET):
+    """Problems x algorithms x seeds 1..runs at ``budget`` evaluations, NSGA-II the baseline."""
+    from pymoo_rail.experiments import Study, problem
+
+    specs = algorithm_specs()
+    return Study("grnsga2-zdt", problems=[problem(p) for p in problems],
+                 algorithms=[specs[a] for a in algorithms], seeds=runs, budget={"n_eval": int(budget)},
+                 baseline="NSGA-II" if "NSGA-II" in algorithms else None)
+
 
 def make_problem(name: str):
     from pymoo.problems import get_problem
@@ -67,70 +93,44 @@ def make_problem(name: str):
     return get_problem(name)
 
 
-def make_algorithm(name: str):
-    from pymoo.algorithms.moo.nsga2 import NSGA2
-    from pymoo.operators.crossover.sbx import SBX
-    from pymoo.operators.mutation.pm import PM
-
-    from pymoo_rail.algorithms.golden_ratio_nsga2 import GoldenRatioNSGA2
-
-    if name == "NSGA-II":
-        return NSGA2(pop_size=POP_SIZE, crossover=SBX(prob=0.9, eta=15),
-                     mutation=PM(prob=1.0, prob_var=0.01, eta=20))
-    if name == "NSGA-II pm=1/n":
-        return NSGA2(pop_size=POP_SIZE, crossover=SBX(prob=0.9, eta=15),
-                     mutation=PM(prob=1.0, eta=20))
-    if name == "GR-NSGA-II":
-        return GoldenRatioNSGA2(pop_size=POP_SIZE, local_size=40, pc_max=0.9, pm_max=0.1)
-    if name == "GR-NSGA-II no LS":
-        return GoldenRatioNSGA2(pop_size=POP_SIZE, local_size=0, pc_max=0.9, pm_max=0.1)
-    raise ValueError(f"unknown algorithm {name!r}")
-
-
 def reference_front(problem) -> np.ndarray:
     return problem.pareto_front(N_PF)
 
 
-def gd_van_veldhuizen(F: np.ndarray, pf: np.ndarray) -> float:
-    """Seed 003 eq. 13: GD = sqrt(sum d_i^2) / n (Van Veldhuizen's form)."""
-    from scipy.spatial.distance import cdist
-
-    d = cdist(F, pf).min(axis=1)
-    return float(np.sqrt(np.sum(d**2)) / len(d))
-
-
-def run_one(task: tuple) -> dict:
-    """One run; returns its CSV row and saves its final front."""
-    problem_name, alg_name, seed, work = task
+def run_row(result) -> dict:
+    """The report's indicators of one stored run (a row of ``load_results``), from its front."""
     from pymoo.indicators.gd import GD
     from pymoo.indicators.hv import HV
     from pymoo.indicators.igd import IGD
-    from pymoo.optimize import minimize
 
+    from pymoo_rail.experiments.metrics import gd_van_veldhuizen
     from pymoo_rail.indicators import Spacing, Spread
 
-    problem = make_problem(problem_name)
-    t0 = time.process_time()
-    res = minimize(problem, make_algorithm(alg_name), ("n_eval", BUDGET), seed=seed)
-    cpu = time.process_time() - t0
-
-    F = res.F
-    pf = reference_front(problem)
-    np.save(front_path(work, problem_name, alg_name, seed), F)
-    alg = res.algorithm
+    F = result["F"]
+    pf = reference_front(make_problem(result["problem"]))
+    accepted = result.get("n_accepted_total", np.nan)
     return {
-        "problem": problem_name, "algorithm": alg_name, "seed": seed,
-        "n_eval": alg.evaluator.n_eval, "n_gen": alg.n_gen, "n_points": len(F),
+        "problem": result["problem"], "algorithm": result["algorithm"], "seed": int(result["seed"]),
+        "n_eval": int(result["n_eval"]), "n_gen": int(result["n_gen"]), "n_points": len(F),
         "sp": Spacing()(F) if len(F) > 1 else float("nan"),
         "delta": Spread(pf)(F) if len(F) > 1 else float("nan"),
         "gd": GD(pf)(F), "gd_vv": gd_van_veldhuizen(F, pf), "igd": IGD(pf)(F),
         "hv": HV(ref_point=HV_REF)(F),
-        "n_accepted": getattr(alg, "n_accepted_total", ""), "cpu_s": round(cpu, 2),
+        "n_accepted": "" if not np.isfinite(accepted) else int(accepted),
+        "cpu_s": round(float(result["cpu_time_s"]), 2),
     }
 
 
-def front_path(work: Path, problem: str, alg: str, seed: int) -> Path:
-    return Path(work) / f"{problem}_{alg.replace(' ', '_').replace('=', '').replace('/', '')}_{seed}.npy"
+def runs_table(results):
+    """One row per stored run with the report's indicators (see :func:`run_row`)."""
+    import pandas as pd
+
+    rows = [run_row(r) for _, r in results.iterrows()]
+    return pd.DataFrame(rows, columns=FIELDS)
+
+
+def write_runs_csv(table, path: Path) -> None:
+    table.sort_values(["seed", "problem", "algorithm"], kind="stable").to_csv(path, index=False)
 
 
 def load_rows(csv_path: Path) -> list[dict]:
@@ -138,31 +138,6 @@ def load_rows(csv_path: Path) -> list[dict]:
         return []
     with open(csv_path, newline="") as fh:
         return list(csv.DictReader(fh))
-
-
-def run_study(runs: int, out: Path, work: Path, workers: int, problems, algorithms) -> None:
-    csv_path = out / "grnsga2_zdt_runs.csv"
-    done = {(r["problem"], r["algorithm"], int(r["seed"])) for r in load_rows(csv_path)}
-    # seed-major order: an interrupted study still has balanced, comparable results
-    tasks = [(p, a, s, str(work)) for s in range(1, runs + 1) for p in problems
-             for a in algorithms if (p, a, s) not in done]
-    print(f"{len(done)} runs already in {csv_path}, {len(tasks)} to do", flush=True)
-    if not tasks:
-        return
-
-    new_file = not csv_path.exists()
-    with open(csv_path, "a", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=FIELDS)
-        if new_file:
-            writer.writeheader()
-            fh.flush()
-        with get_context("fork").Pool(processes=max(1, min(2, workers))) as pool:
-            for k, row in enumerate(pool.imap_unordered(run_one, tasks), 1):
-                writer.writerow(row)
-                fh.flush()
-                os.fsync(fh.fileno())
-                print(f"[{k}/{len(tasks)}] {row['problem']} {row['algorithm']} seed {row['seed']}: "
-                      f"IGD {row['igd']:.5f} ({row['cpu_s']} s)", flush=True)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -186,7 +161,8 @@ def summarise(rows: list[dict]):
     return df
 
 
-def plot_fronts(df, work: Path, out: Path, problems) -> list[str]:
+def plot_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
+    """Median-IGD run of NSGA-II and GR-NSGA-II per problem; ``fronts[(problem, algorithm, seed)]`` = F."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -202,9 +178,8 @@ def plot_fronts(df, work: Path, out: Path, problems) -> list[str]:
             ax.plot(pf[:, 0], pf[:, 1], ".", ms=1.5, color="0.6", label="true Pareto front")
             if len(sub):
                 row = sub.iloc[(len(sub) - 1) // 2]  # median-IGD run
-                path = front_path(work, p, alg, int(row.seed))
-                if path.exists():
-                    F = np.load(path)
+                F = fronts.get((p, alg, int(row.seed)))
+                if F is not None:
                     ax.plot(F[:, 0], F[:, 1], "o", ms=3, mfc="none", color="C0" if alg == "NSGA-II" else "C3",
                             label=f"obtained (seed {int(row.seed)}, median IGD {row.igd:.2e})")
             ax.set_title(f"{p.upper()} {label}")
@@ -290,7 +265,7 @@ not in convergence.**
   it is -17 %.
 - Distribution improves most: Schott spacing -20 % to -38 %, Deb's Delta -10 % to -42 %.
 - Convergence does not: GD is +1.5 % (not significant), +3.4 % and +7.5 % on ZDT1-3, i.e. equal
-  or slightly worse. The local search takes 23 % of the budget (233 instead of 301
+  or slightly worse. The local search takes 23 % of the budget (232 instead of 300
   generations). ZDT4 is the exception: median GD -19 %, every GR run reached the true front.
 - Hypervolume differs by at most 0.05 % on ZDT1-3, which is practically equal (ZDT3 is
   0.01 % lower); on ZDT4 it is +0.9 % in the mean, from the same NSGA-II outlier.
@@ -354,21 +329,26 @@ def pd_mean(frame, column: str) -> float:
     return float(v.mean()) if len(v) else float("nan")
 
 
-def write_report(out: Path, work: Path, problems, algorithms) -> None:
+def write_report(out: Path, results, problems, algorithms) -> None:
+    """The report, the per-run CSV and the front plots from the stored runs (``load_results``)."""
     from scipy.stats import ranksums
 
-    rows = load_rows(out / "grnsga2_zdt_runs.csv")
-    if not rows:
+    if not len(results):
         print("no runs to report")
         return
-    df = summarise(rows)
+    table = runs_table(results)
+    write_runs_csv(table, out / "grnsga2_zdt_runs.csv")
+    df = summarise(table.to_dict("records"))
     df = df[df.problem.isin(problems) & df.algorithm.isin(algorithms)]
-    pngs = plot_fronts(df, work, out, problems)
+    fronts = {(r.problem, r.algorithm, int(r.seed)): r.F for r in results.itertuples()}
+    pngs = plot_fronts(df, fronts, out, problems)
     n_runs = df.groupby(["problem", "algorithm"]).size()
 
     L = []
     L.append("# Golden-ratio NSGA-II vs NSGA-II on ZDT1-4 (seed 003, section 4.1)\n")
-    L.append("Generated by `benchmarks/grnsga2_zdt.py`; raw rows in `grnsga2_zdt_runs.csv`.\n")
+    L.append("Generated by `benchmarks/grnsga2_zdt.py`: runs by `pymoo_rail.experiments.run_study` "
+             "(study `grnsga2-zdt`, one record per run), indicators computed here from the stored "
+             "final fronts; one row per run in `grnsga2_zdt_runs.csv`.\n")
     L.append(f"Runs per problem and algorithm: {n_runs.min()}" +
              (f" to {n_runs.max()}" if n_runs.max() != n_runs.min() else "") +
              " (seeds 1, 2, ...; the same seeds for every algorithm).\n")
@@ -441,7 +421,8 @@ def write_report(out: Path, work: Path, problems, algorithms) -> None:
                 verdict.append((p, m, better, rel, pval))
         L.append("")
 
-    L.append("### Budget actually used (means per run: evaluations, pymoo n_gen counter, front size, CPU s)\n")
+    L.append("### Budget actually used (means per run: evaluations, generations after the initial "
+             "population, front size, CPU s)\n")
     L.append("| problem | algorithm | n_eval | n_gen | points | cpu s |")
     L.append("|---|---|---|---|---|---|")
     for p in problems:
@@ -483,8 +464,8 @@ def main(argv=None) -> None:
     parser.add_argument("--runs", type=int, default=30, help="runs per problem and algorithm")
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "reports",
                         help="directory of the CSV, report and PNGs")
-    parser.add_argument("--work", type=Path, default=Path("out/grnsga2_zdt"),
-                        help="directory of the saved final fronts (not committed)")
+    parser.add_argument("--work", type=Path, default=Path(__file__).resolve().parents[1] / "out" / "grnsga2_zdt",
+                        help="study directory: one JSON record per run (not committed)")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (at most 2)")
     parser.add_argument("--problems", default=",".join(PROBLEMS))
     parser.add_argument("--algorithms", default=",".join(ALGORITHMS))
@@ -506,10 +487,13 @@ def main(argv=None) -> None:
         if a not in ALGORITHMS:
             parser.error(f"unknown algorithm {a!r}; choose from {ALGORITHMS}")
     args.out.mkdir(parents=True, exist_ok=True)
-    args.work.mkdir(parents=True, exist_ok=True)
+    from pymoo_rail.experiments import load_results, run_study
+
+    study = build_study(args.runs, problems, algorithms)
     if not args.report_only:
-        run_study(args.runs, args.out, args.work, args.workers, problems, algorithms)
-    write_report(args.out, args.work, problems, algorithms)
+        # seed by seed: a study stopped early still compares every algorithm on the same seeds
+        print(run_study(study, args.work, workers=max(1, min(args.workers, 2)), seed_major=True), flush=True)
+    write_report(args.out, load_results(args.work, study=study), problems, algorithms)
 
 
 if __name__ == "__main__":

@@ -229,8 +229,16 @@ def _dask_executor(stack: ExitStack, scheduler: Any, workers: int) -> Executor:
     return client.get_executor(pure=False)
 
 
+def pending_runs(study: Study, done_ids: set[str], seed_major: bool = False) -> list[RunSpec]:
+    """The runs of ``study`` not in ``done_ids``, in the order :func:`run_study` starts them."""
+    pending = [r for r in study.runs() if r.run_id not in done_ids]
+    if seed_major:
+        pending.sort(key=lambda r: study.seeds.index(r.seed))  # stable: problem, algorithm order kept
+    return pending
+
+
 def run_study(study: Study, directory: str | Path, workers: int | None = None, scheduler: Any = None,
-              progress: bool = True, check: bool = True) -> StudyReport:
+              progress: bool = True, check: bool = True, seed_major: bool = False) -> StudyReport:
     """Run every run of ``study`` that is not yet stored in ``directory``.
 
     Parameters
@@ -249,6 +257,10 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
         Show a progress bar (tqdm, on stderr).
     check : bool
         Build every problem and algorithm once before starting, so a typo fails at once.
+    seed_major : bool
+        Start the runs seed by seed (every problem and algorithm of the first seed, then of the
+        second, ...) instead of problem by problem, so a study stopped early still compares
+        every algorithm on every problem over the same seeds. Results do not depend on it.
 
     Returns
     -------
@@ -272,7 +284,7 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
     write_study(study, store.directory / STUDY_FILE)
     runs = study.runs()
     done = store.done_ids()
-    pending = [r for r in runs if r.run_id not in done]
+    pending = pending_runs(study, done, seed_major)
     report = StudyReport(store.directory, len(runs), len(runs) - len(pending), 0)
     if not pending:
         return report

@@ -123,6 +123,19 @@ def test_record_keeps_the_run_counters_an_algorithm_reports():
     assert frame.loc["abc", "n_scouts_total"] == sum(scouts[1:])
 
 
+def test_seed_major_order_starts_every_cell_of_a_seed_before_the_next_seed():
+    from pymoo_rail.experiments.runner import pending_runs
+
+    study = small_study()
+    done = {r.run_id for r in study.runs() if r.seed == 1 or (r.seed == 2 and r.problem.name == "zdt1")}
+    by_seed = pending_runs(study, done, seed_major=True)
+    assert [r.seed for r in by_seed] == [2] * 6 + [3] * 9 + [4] * 9 + [5] * 9
+    assert [(r.problem.name, r.algorithm.name) for r in by_seed[6:15]] == \
+        [(p.name, a.name) for p in study.problems for a in study.algorithms]
+    default = pending_runs(study, done)
+    assert {r.run_id for r in default} == {r.run_id for r in by_seed} and default[0].problem.name == "zdt1"
+
+
 def test_killed_study_resumes_without_losing_or_duplicating_runs(pool_study_dir, tmp_path):
     """Kill a study (driver and pool workers) mid-way; the rerun keeps every stored run untouched,
     runs only the missing ones, ends with each run exactly once, and equals an uninterrupted run."""
