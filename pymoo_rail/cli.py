@@ -401,7 +401,7 @@ def cmd_optimize(args) -> int:
     front.to_csv(written[0], index=False)
     trajectory.to_frame().to_csv(written[1], index=False)
     label = f"{args.algorithm}, seed {args.seed}"
-    if F.shape[1] >= 2 and F.shape[1] <= 3:
+    if F.shape[1] >= 2:  # 4 or more objectives: a scatter matrix
         written.append(save_figure(plot_front(F, objectives, highlight=F[chosen], label=label,
                                               title=f"{case.name}: front after {res.algorithm.evaluator.n_eval} "
                                                     "evaluations"), out / "front.png"))

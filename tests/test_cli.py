@@ -167,3 +167,15 @@ def test_reference_writes_the_optimal_front(capsys, tmp_path):
     front = pd.read_csv(tmp_path / "optimal_front.csv")
     assert len(front) == 3 and np.all(np.diff(front["energy_kwh"]) < 0)  # more time, less energy
     assert (tmp_path / "optimal_profile.png").is_file()
+
+
+def test_four_objectives_give_a_scatter_matrix_front(capsys, tmp_path):
+    code, _, err = run(capsys, "optimize", "yizhuang", "--objectives", "energy", "time_error", "jerk", "stop_error",
+                       "--pop-size", 12, "--n-gen", 3, "--out", tmp_path, "-q")
+    assert code == 0, err
+    assert list(pd.read_csv(tmp_path / "front.csv").columns[1:5]) == [
+        "f_energy", "f_time_error", "f_jerk", "f_stop_error"]
+    from PIL import Image
+
+    with Image.open(tmp_path / "front.png") as image:
+        assert min(image.size) > 600  # a 4 x 4 grid, not an empty canvas

@@ -24,7 +24,7 @@ def _as_front(F, name: str = "F") -> np.ndarray:
 def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | None = None,
                 reference=None, reference_label: str = "optimal front", highlight=None,
                 highlight_label: str = "chosen", title: str | None = None, ax=None):
-    """Several fronts on one set of axes (2 or 3 objectives).
+    """Several fronts on one set of axes (2 or 3 objectives), or as a scatter matrix (4 or more).
 
     Parameters
     ----------
@@ -37,10 +37,17 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
     highlight : (m,) array, optional
         One point to mark, e.g. the solution chosen for the speed profile.
     ax : matplotlib Axes, optional
+        Only for 2 or 3 objectives; a scatter matrix needs a figure of its own.
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Notes
+    -----
+    With four or more objectives (e.g. energy, time error, jerk and stop error) every pair of
+    objectives gets a panel below the diagonal; the diagonal names the objective and shows the
+    range of each front as a histogram.
     """
     if not fronts:
         raise ValueError("fronts is empty: give at least one front")
@@ -49,9 +56,18 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
     for label, F in fronts.items():
         if F.shape[1] != n_obj:
             raise ValueError(f"fronts[{label!r}] has {F.shape[1]} objectives, the first front {n_obj}")
-    if n_obj > 3:
-        raise ValueError(f"{n_obj} objectives: plot_fronts draws 2 or 3 (use pymoo.visualization.pcp for more)")
     labels = objective_labels(objectives, n_obj)
+    ref = None
+    if reference is not None:
+        ref = np.asarray(reference.to_numpy() if isinstance(reference, pd.DataFrame) else reference, dtype=float)
+        ref = _as_front(ref, "reference")
+        if ref.shape[1] != n_obj:
+            raise ValueError(f"reference has {ref.shape[1]} objectives, the fronts {n_obj}")
+    if n_obj > 3:
+        if ax is not None:
+            raise ValueError(f"{n_obj} objectives are drawn as a scatter matrix, which needs its own figure: "
+                             "leave ax out")
+        return _scatter_matrix(fronts, labels, ref, reference_label, highlight, highlight_label, title)
     if ax is None:
         if n_obj == 3:
             import matplotlib.pyplot as plt
@@ -63,9 +79,7 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
             ax = axes[0, 0]
     fig = ax.figure
 
-    if reference is not None:
-        ref = np.asarray(reference.to_numpy() if isinstance(reference, pd.DataFrame) else reference, dtype=float)
-        ref = _as_front(ref, "reference")
+    if ref is not None:
         if n_obj == 2 and len(ref) < 200:
             order = np.argsort(ref[:, 0])
             ax.plot(ref[order, 0], ref[order, 1], "-", marker=".", ms=4, color="0.35", lw=1.2,
@@ -92,6 +106,49 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
     ax.legend(fontsize="small")
     if title:
         ax.set_title(title)
+    return fig
+
+
+def _scatter_matrix(fronts: dict[str, np.ndarray], labels: list[str], ref, reference_label: str, highlight,
+                    highlight_label: str, title: str | None):
+    """Objective pairs below the diagonal, per-objective histograms on it."""
+    from pymoo_rail.plotting.style import new_figure
+
+    m = len(labels)
+    fig, axes = new_figure(m, m, figsize=(2.3 * m, 2.1 * m))
+    point = None if highlight is None else np.asarray(highlight, dtype=float).reshape(-1)
+    markers = "os^Dvp<>h*"
+    for r in range(m):
+        for c in range(m):
+            ax = axes[r, c]
+            if c > r:
+                ax.set_axis_off()
+                continue
+            if c == r:
+                for i, (label, F) in enumerate(fronts.items()):
+                    ax.hist(F[:, c], bins=15, alpha=0.55, color=f"C{i}")
+                ax.set_title(labels[c], fontsize="small")
+                ax.set_yticks([])
+            else:
+                if ref is not None:
+                    ax.scatter(ref[:, c], ref[:, r], s=2, color="0.6", zorder=1,
+                               label=reference_label)
+                for i, (label, F) in enumerate(fronts.items()):
+                    ax.scatter(F[:, c], F[:, r], s=10, marker=markers[i % len(markers)], color=f"C{i}",
+                               alpha=0.8, zorder=3, label=f"{label} ({len(F)})")
+                if point is not None:
+                    ax.scatter(point[c], point[r], s=90, facecolors="none", edgecolors="black", linewidths=1.5,
+                               zorder=4, label=highlight_label)
+                ax.grid(True, alpha=0.3)
+            if r == m - 1:
+                ax.set_xlabel(labels[c], fontsize="small")
+            if c == 0 and r > 0:
+                ax.set_ylabel(labels[r], fontsize="small")
+            ax.tick_params(labelsize="x-small")
+    handles, names = axes[1, 0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="upper right", fontsize="small")
+    if title:
+        fig.suptitle(title)
     return fig
 
 

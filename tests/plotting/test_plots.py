@@ -112,10 +112,28 @@ def test_front_plots_label_objectives_with_units(tmp_path):
     fig = plot_fronts({"a": np.random.default_rng(1).random((20, 3))})
     assert fig.axes[0].get_zlabel() == "f3"
     plt.close(fig)
-    with pytest.raises(ValueError, match="4 objectives"):
-        plot_front(np.ones((3, 4)))
+    with pytest.raises(ValueError, match="4 objectives are drawn as a scatter matrix"):
+        plot_front(np.ones((3, 4)), ax=fig.axes[0])
+    with pytest.raises(ValueError, match="reference has 2 objectives"):
+        plot_front(np.ones((3, 4)), reference=reference)
     with pytest.raises(ValueError, match="NaN"):
         plot_front(np.array([[1.0, np.nan]]))
+
+
+def test_four_objectives_make_a_scatter_matrix_with_every_pair(tmp_path):
+    rng = np.random.default_rng(2)
+    F = rng.random((25, 4))
+    names = ["energy", "time_error", "jerk", "stop_error"]
+    fig = plot_fronts({"nsga2": F, "moabc": rng.random((10, 4))}, names, reference=rng.random((40, 4)),
+                      highlight=F[3], title="four objectives")
+    panels = [ax for ax in fig.axes if ax.axison]
+    assert len(panels) == 4 * 5 // 2  # 6 pairs below the diagonal and 4 histograms on it
+    pair = fig.axes[1 * 4 + 0]  # row 1 (time_error) against column 0 (energy)
+    np.testing.assert_allclose(pair.collections[1].get_offsets(), F[:, [0, 1]])
+    assert pair.get_ylabel().endswith("(s)") and fig.axes[3 * 4 + 0].get_xlabel() == "energy (kWh)"
+    assert [t.get_text() for t in fig.legends[0].get_texts()] == ["optimal front", "nsga2 (25)", "moabc (10)",
+                                                                  "chosen"]
+    _png_ok(save_figure(fig, tmp_path / "front4.png"))
 
 
 def test_convergence_frame_by_hand():
