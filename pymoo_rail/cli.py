@@ -175,6 +175,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--baseline", default=None, metavar="ALGORITHM",
                    help="algorithm the others are tested against (default: the file's baseline)")
     p.add_argument("--no-plots", action="store_true", help="write the tables only")
+    p.add_argument("--seed-major", action="store_true",
+                   help="start the runs seed by seed, so a study stopped early has every algorithm on every "
+                        "problem for the same seeds (results are the same)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
 
     p = sub.add_parser("plot", help="redraw figures from stored results or CSV files", formatter_class=_Formatter,
@@ -496,7 +499,8 @@ def cmd_study(args) -> int:
     _say(f"study {study.name}: {len(study.problems)} problems x {len(study.algorithms)} algorithms x "
          f"{len(study.seeds)} seeds = {len(study.runs())} runs on {where}; results in {out}")
     try:
-        report = run_study(study, out, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet)
+        report = run_study(study, out, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
+                           seed_major=args.seed_major)
     except StudyError as err:
         raise UsageError("--scheduler" if err.field == "scheduler" else "FILE", str(err)) from None
     _say(str(report))
