@@ -83,7 +83,8 @@ def run_row(result) -> dict:
     return dict(problem=result["problem"], algorithm=result["algorithm"], run=int(result["seed"]) - FIRST_SEED,
                 seed=int(result["seed"]), n_points=len(F), n_eval=int(result["n_eval"]),
                 IGD=float(IGD(pf)(F)), GD=float(GD(pf)(F)), HV=float(HV(ref_point=REF_POINT)(F)),
-                SP=float(Spacing()(F)), time_s=round(float(result["wall_time_s"]), 3))
+                SP=float(Spacing()(F)) if len(F) >= 2 else 0.0,  # one point: nothing to space
+                time_s=round(float(result["wall_time_s"]), 3))
 
 
 def runs_table(results):
