@@ -15,10 +15,19 @@ from __future__ import annotations
 import numpy as np
 
 from pymoo_rail.model import CaseError, Line
-from pymoo_rail.sim.kernel import MODE_BRAKE, MODE_COAST, MODE_HOLD, MODE_NAMES, MODE_TOWARD, MODE_TRACTION
+from pymoo_rail.sim.kernel import (
+    MODE_BRAKE,
+    MODE_COAST,
+    MODE_HOLD,
+    MODE_HOLD_BRAKE,
+    MODE_NAMES,
+    MODE_TOWARD,
+    MODE_TRACTION,
+)
 
+# "hold" coasts where coasting accelerates; "hold_brake" brakes there to keep the speed
 REGIME_MODES = {"traction": MODE_TRACTION, "hold": MODE_HOLD, "cruise": MODE_HOLD, "coast": MODE_COAST,
-                "brake": MODE_BRAKE}
+                "brake": MODE_BRAKE, "hold_brake": MODE_HOLD_BRAKE}
 
 
 def gradient_limit_partition(line: Line, min_length_m: float = 0.0) -> np.ndarray:

@@ -9,11 +9,17 @@ A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applie
 cell midpoint passes ``end_m``. Modes:
 
 - ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
-  (the speed-code connection strategy of seed 000 fig. 4-5);
+  by partial traction (the speed-code connection strategy of seed 000 fig. 4-5). It never brakes:
+  where coasting accelerates (a steep descent) the train runs above the target until a limit's
+  braking envelope stops it;
 - ``MODE_TRACTION``: maximum traction (speed limits still hold);
-- ``MODE_HOLD``: hold the speed the train had on entering the row (partial traction or braking);
+- ``MODE_HOLD``: ``MODE_TOWARD`` with the speed the train had on entering the row as its target:
+  partial traction holds it, and on a steep descent the train coasts faster (no braking);
 - ``MODE_COAST``: no force;
-- ``MODE_BRAKE``: maximum service braking until standstill.
+- ``MODE_BRAKE``: maximum service braking until standstill;
+- ``MODE_HOLD_BRAKE``: hold the entry speed by partial traction or, where coasting would
+  accelerate, by partial braking (electric first, so it regenerates); maximum braking where even
+  that cannot hold it. The cruise control of an ATO on a descent.
 
 Whatever the program says, the train never rises above the braking envelope: it brakes onto every
 lower limit ahead and onto the platform at the latest moment the braking curve allows.
@@ -33,8 +39,8 @@ from pymoo_rail.sim.physics import (
     max_traction,
 )
 
-MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE = 0, 1, 2, 3, 4
-MODE_NAMES = ("toward", "traction", "hold", "coast", "brake")
+MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
+MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake")
 REGIME_TRACTION, REGIME_CRUISE, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
 REGIME_NAMES = ("traction", "cruise", "coast", "brake")
 
@@ -289,7 +295,8 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
         target = program[row, 2]
 
         # what the program asks for
-        if mode == MODE_HOLD:
+        brake_to_hold = mode == MODE_HOLD_BRAKE
+        if mode == MODE_HOLD or brake_to_hold:
             if hold_speed < 0.0:
                 hold_speed = v
             if hold_speed <= 0.0:
@@ -306,12 +313,15 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
             else:
                 u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
                 regime = REGIME_COAST
-                landed = u1 < target * target
+                landed = u1 < target * target or brake_to_hold  # the second: brake down onto it
             if landed:
                 fl, w0l, ok = _landing_force(m, v, target, i)
                 if ok:
                     u1, f, w0 = target * target, fl, w0l
                     regime = REGIME_CRUISE
+                elif brake_to_hold and u1 >= target * target:
+                    u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)  # the descent is too steep to hold
+                    regime = REGIME_BRAKE
         elif mode == MODE_TRACTION:
             u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
             regime = REGIME_TRACTION

@@ -189,3 +189,27 @@ def test_de_constrained_other_cases(name, planned_s):
         inside = (tr.position_m >= start) & (tr.position_m < end)
         assert inside.any() and np.all(tr.force_n[inside] <= 0.0)
     assert tr.summary["neutral_traction_j"] == 0.0
+
+
+def test_switching_points_with_hold_brake_hold_the_speed_down_a_descent():
+    """``regimes`` may use "hold_brake": the problem's F, the trajectory and the simulator agree,
+    and down the descent the held run brakes (regenerating) where "hold" coasts faster."""
+    case = make_case(
+        train={"regen_efficiency": 0.8, "braking": {"max_force_kn": 100.0, "regen_max_force_kn": 60.0}},
+        line={"length_m": 5000.0, "speed_limits": [[0.0, 5000.0, 100.0]],
+              "gradients": [[0.0, 2000.0, 0.0], [2000.0, 4000.0, -20.0], [4000.0, 5000.0, 0.0]]},
+        run={"planned_time_s": 300.0})
+    x = np.array([[180.0, 5000.0]])
+    runs = {}
+    for hold in ("hold", "hold_brake"):
+        problem = SpeedProfileProblem(case, objectives=("energy", "running_time"), encoding="switching_points",
+                                      regimes=("traction", hold, "brake"))
+        out = problem.evaluate(x, return_as_dictionary=True)
+        runs[hold] = problem.trajectory(x[0])
+        assert out["F"][0, 0] == pytest.approx(runs[hold].energy.net_kwh)
+        assert out["F"][0, 1] == pytest.approx(runs[hold].running_time_s)
+        assert np.all(out["G"][0] <= 0.0)  # stopped at the platform, under every limit
+    down = (runs["hold_brake"].position_m > 2200.0) & (runs["hold_brake"].position_m < 3900.0)
+    assert np.ptp(runs["hold_brake"].speed_ms[down]) < 1e-9 and np.all(runs["hold_brake"].force_n[down] < 0.0)
+    assert runs["hold"].speed_ms[down].max() > runs["hold_brake"].speed_ms[down].max() + 5.0
+    assert runs["hold_brake"].energy.regen_kwh > runs["hold"].energy.regen_kwh

@@ -137,3 +137,47 @@ def test_stall_is_reported_not_nan():
     tr = Simulator(case).flat_out()
     assert not tr.reached and 500.0 < tr.summary["stop_position_m"] < 2000.0
     assert np.isfinite(tr.running_time_s) and np.isfinite(tr.energy.net_kwh)
+
+
+def _descent_case(descent_permille: float):
+    """2 km flat, 2 km of descent, 1 km flat; Davis resistance and regeneration."""
+    return make_case(
+        train={"regen_efficiency": 0.8, "regen_min_speed_kmh": 5.0,
+               "resistance": {"a": 2.0, "b": 0.0, "c": 0.0005, "unit": "kN", "speed_unit": "kmh"},
+               "braking": {"max_force_kn": 100.0, "regen_max_force_kn": 60.0}},
+        line={"length_m": 5000.0, "speed_limits": [[0.0, 5000.0, 100.0]],
+              "gradients": [[0.0, 2000.0, 0.0], [2000.0, 4000.0, descent_permille], [4000.0, 5000.0, 0.0]]})
+
+
+@pytest.mark.parametrize("descent_permille, holds", [(-20.0, True), (-120.0, False)])
+def test_hold_brake_keeps_the_speed_down_a_descent_where_hold_runs_away(descent_permille, holds):
+    # -120 permille pulls harder (1.18 m/s^2) than the brakes (1 m/s^2 at 100 t) can hold
+    case = _descent_case(descent_permille)
+    sim = Simulator(case, dx_m=1.0)
+    regimes = ("traction", "coast", "hold", "brake")
+    points = [180.0, 1500.0, 5000.0]  # hold to the end: the braking envelope stops it at the platform
+    hold = sim.run(switching_programs(points, regimes, 5000.0)[0])
+    brake_hold = sim.run(switching_programs(points, regimes[:2] + ("hold_brake", "brake"), 5000.0)[0])
+    for tr in (hold, brake_hold):
+        _check_run(case, tr)
+        assert tr.reached and tr.stop_error_m < 1e-6
+    entry = np.searchsorted(brake_hold.position_m, 1500.0)
+    v_hold = brake_hold.speed_ms[entry]
+    assert 10.0 < v_hold < 100 / 3.6 - 5.0  # the held speed is well under the limit
+    # flat before the descent: both modes are the same run, node for node
+    flat = brake_hold.position_m < 2000.0 - case.train.length_m
+    np.testing.assert_array_equal(hold.speed_ms[flat], brake_hold.speed_ms[flat])
+    down = (brake_hold.position_m > 2100.0) & (brake_hold.position_m < 3900.0)
+    if holds:
+        # partial braking holds the entry speed to rounding, with a braking force below the maximum
+        np.testing.assert_allclose(brake_hold.speed_ms[down], v_hold, rtol=1e-9)
+        force = brake_hold.force_n[down]
+        assert np.all(force < 0.0) and np.all(-force < 100e3)
+        assert brake_hold.energy.regen_kwh > 0.5  # the held descent regenerates
+        # "hold" coasts instead: it runs up to the limit, where the braking envelope holds it
+        assert hold.speed_ms[down].max() > 100 / 3.6 - 0.1
+        assert brake_hold.running_time_s > hold.running_time_s
+    else:
+        # too steep: maximum braking, and the speed still rises until the limit's envelope
+        assert np.any(brake_hold.force_n[down] == pytest.approx(-100e3))
+        assert brake_hold.speed_ms[down].max() > v_hold + 1.0
