@@ -29,6 +29,19 @@ ENCODINGS = {
     "speed codes, 12 equal sections": dict(encoding="speed_codes", partition="equal", n_sections=12),
     "switching points": dict(encoding="switching_points"),
 }
+
+
+def _hold_brake_regimes(case) -> tuple[str, ...]:
+    """The default switching-point sequence with every "hold" braking to hold down descents."""
+    from pymoo_rail.problems.encodings import SwitchingPoints
+
+    return tuple("hold_brake" if r == "hold" else r for r in SwitchingPoints.build(case).regimes)
+
+
+def encodings(case) -> dict:
+    """The encodings compared on ``case``: :data:`ENCODINGS` and switching points with hold_brake."""
+    return {**ENCODINGS, "switching points, hold_brake": dict(encoding="switching_points",
+                                                             regimes=_hold_brake_regimes(case))}
 CASES = ("yizhuang", "metro-a", "wuguang-crh3")
 
 
@@ -54,7 +67,7 @@ def main() -> None:
     print(header)
     for name in CASES:
         case = load_case(name)
-        for label, kwargs in ENCODINGS.items():
+        for label, kwargs in encodings(case).items():
             problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=1.0, **kwargs)
             rate = throughput(problem)
             res = minimize(problem, DE(pop_size=40), ("n_evals", args.evals), seed=1)
