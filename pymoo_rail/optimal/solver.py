@@ -26,6 +26,7 @@ from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim.kernel import (
     MODE_COAST,
     MODE_HOLD,
+    MODE_HOLD_BRAKE,
     MODE_TOWARD,
     MODE_TRACTION,
     OUT_NET_KWH,
@@ -171,13 +172,14 @@ class OptimalSolver:
         """
         program = solution.program
         modes = program[:, 1]
-        powered = np.flatnonzero((modes == MODE_TRACTION) | (modes == MODE_HOLD) | (modes == MODE_TOWARD))
+        powered = np.flatnonzero((modes == MODE_TRACTION) | (modes == MODE_HOLD) | (modes == MODE_HOLD_BRAKE)
+                                 | (modes == MODE_TOWARD))
         if powered.size == 0:
             return None
         last = int(powered[-1])
         n_cells = program.shape[0]
         if solution.time_s > target:  # extend: hold the speed reached (or keep pulling)
-            mode = MODE_TRACTION if modes[last] == MODE_TRACTION else MODE_HOLD
+            mode = MODE_TRACTION if modes[last] == MODE_TRACTION else MODE_HOLD_BRAKE
             slow_end, fast_end = 0, n_cells - 1 - last
 
             def moved(j):
