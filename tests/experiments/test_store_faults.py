@@ -209,3 +209,40 @@ def test_killed_study_process_its_workers_exit_and_keep_every_run_they_finished(
                   algorithms=[algorithm("nsga2", pop_size=8)], seeds=10, budget={"n_gen": 3})
     report = run_study(again, out, workers=2, progress=False, check=False)
     assert (report.n_skipped, report.n_finished, report.failures) == (len(stored), 10 - len(stored), [])
+
+
+def test_tables_leave_out_a_record_whose_case_changed_and_say_so(tmp_path):
+    case_file = tmp_path / "my-case.toml"
+    original = case_path("metro-a").read_text(encoding="utf-8")
+    case_file.write_text(original, encoding="utf-8")
+    study = Study("case", problems=[problem(f"{STUDIES}:case_sphere", case=str(case_file))],
+                  algorithms=[algorithm("nsga2", pop_size=8)], seeds=1, budget={"n_gen": 2})
+    run_study(study, tmp_path / "out", workers=1, progress=False)
+    case_file.write_text(original.replace("mass_t = 332.0", "mass_t = 300.0"), encoding="utf-8")
+    with pytest.warns(UserWarning, match="problem.case .* changed"):
+        assert load_results(tmp_path / "out").empty
+
+
+def test_written_files_get_the_mode_open_gives_them(tmp_path, monkeypatch):
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    from pymoo_rail.atomic import atomic_path, atomic_write_text
+    from pymoo_rail.plotting.style import new_figure, save_figure
+
+    old = os.umask(0o022)
+    try:
+        record = atomic_write_text(tmp_path / "a.json", "{}")
+        fig, _ = new_figure()
+        figure = save_figure(fig, tmp_path / "f.png")
+        with open(tmp_path / "plain.txt", "w") as handle:
+            handle.write("x")
+        os.umask(0o077)
+        private = atomic_write_text(tmp_path / "b.json", "{}")
+        os.chmod(record, 0o640)
+        with atomic_path(record) as tmp:  # overwriting keeps the file's mode, as open() does
+            tmp.write_text("[]")
+    finally:
+        os.umask(old)
+    mode = lambda p: os.stat(p).st_mode & 0o777  # noqa: E731
+    assert mode(tmp_path / "plain.txt") == 0o644
+    assert (mode(figure), mode(private), mode(record)) == (0o644, 0o600, 0o640)
+    assert record.read_text() == "[]" and not list(tmp_path.glob(".tmp-*"))
