@@ -172,11 +172,11 @@ class DavisResistance:
 
     def __post_init__(self) -> None:
         for name in ("a", "b", "c"):
-            check_number(f"resistance.{name}", getattr(self, name), nonneg=True)
+            check_number(f"train.resistance.{name}", getattr(self, name), nonneg=True)
         if self.unit not in ("kN", "N/kN"):
-            raise CaseError("resistance.unit", self.unit, "must be 'kN' or 'N/kN'")
+            raise CaseError("train.resistance.unit", self.unit, "must be 'kN' or 'N/kN'")
         if self.speed_unit not in ("kmh", "ms"):
-            raise CaseError("resistance.speed_unit", self.speed_unit, "must be 'kmh' or 'ms'")
+            raise CaseError("train.resistance.speed_unit", self.speed_unit, "must be 'kmh' or 'ms'")
 
     def coefficients_si(self, mass_kg: float, g_ms2: float = 9.81) -> tuple[float, float, float]:
         """(A [N], B [N s/m], C [N s^2/m^2]) with v in m/s."""
