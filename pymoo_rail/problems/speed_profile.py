@@ -12,7 +12,16 @@ from pymoo_rail.problems.encodings import ENCODINGS, SpeedCodes, SwitchingPoints
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 
-OBJECTIVES = ("energy", "running_time", "time_error", "jerk", "stop_error")
+OBJECTIVES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
+# "jerk" is the name Meng et al. (2017) give their comfort figure, sum |a_i - a_(i-1)| (m/s^2): a total
+# variation of acceleration, not a rate of change (m/s^3). "accel_variation" says what it is; "jerk"
+# stays as an alias of the same objective.
+OBJECTIVE_ALIASES = {"jerk": "accel_variation"}
+
+
+def canonical_objective(name: str) -> str:
+    """The objective a name stands for (``"jerk"`` -> ``"accel_variation"``; others unchanged)."""
+    return OBJECTIVE_ALIASES.get(name, name)
 SEED_002_WEIGHTS = {"energy": 0.1, "jerk": 0.2, "stop_error": 0.4, "time_error": 0.3}
 
 
@@ -26,7 +35,7 @@ def objective_values(summaries: np.ndarray, names: Sequence[str], planned_time_s
             columns.append(summaries[:, k.OUT_RUNNING_TIME_S])
         elif name == "time_error":
             columns.append(np.abs(summaries[:, k.OUT_RUNNING_TIME_S] - planned_time_s))
-        elif name == "jerk":
+        elif canonical_objective(name) == "accel_variation":
             columns.append(summaries[:, k.OUT_JERK_MS2])
         elif name == "stop_error":
             columns.append(summaries[:, k.OUT_STOP_ERROR_M])
@@ -44,7 +53,9 @@ class SpeedProfileProblem(Problem):
         Train, line and planned time (``load_case("yizhuang")``).
     objectives : sequence of str
         Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (|T - T_plan| s,
-        seed 000 eq. 4-21), ``"jerk"`` (comfort: sum of |a_i - a_(i-1)|, seed 002 eq. 5, in m/s^2),
+        seed 000 eq. 4-21), ``"accel_variation"`` (comfort: total variation of the
+        acceleration, sum of |a_i - a_(i-1)| over the grid cells, m/s^2; Meng et al. (2017) eq. 5,
+        where it is called jerk: ``"jerk"`` is an alias of it, not a rate in m/s^3),
         ``"stop_error"`` (m, seed 002 eq. 6). Several give the Pareto form; one with
         ``time_tolerance_s`` gives the constrained form of seed 000 4.4; ``weights`` give the
         weighted sum of seed 002 eq. 9.
@@ -102,8 +113,8 @@ class SpeedProfileProblem(Problem):
         for name in objectives:
             if name not in OBJECTIVES:
                 raise ValueError(f"objective {name!r} is unknown (known: {', '.join(OBJECTIVES)})")
-        if len(set(objectives)) != len(objectives):
-            raise ValueError(f"objectives = {objectives!r} repeats a name")
+        if len({canonical_objective(name) for name in objectives}) != len(objectives):
+            raise ValueError(f"objectives = {objectives!r} repeats an objective (jerk is an alias of accel_variation)")
         if encoding == "speed_codes":
             self.encoding = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh)
         elif encoding == "switching_points":
@@ -139,9 +150,10 @@ class SpeedProfileProblem(Problem):
                                  f"one per objective {objectives}")
             if scales is None:
                 default = {"energy": fastest.energy.net_kwh, "time_error": 0.05 * case.planned_time_s,
-                           "running_time": case.planned_time_s, "jerk": max(fastest.jerk_ms2, 1e-9),
+                           "running_time": case.planned_time_s,
+                           "accel_variation": max(fastest.accel_variation_ms2, 1e-9),
                            "stop_error": 0.25}
-                scales = [default[name] for name in objectives]
+                scales = [default[canonical_objective(name)] for name in objectives]
             scales = np.asarray(scales, dtype=float)
             if scales.shape != weights.shape or not np.all(scales > 0):
                 raise ValueError(f"scales = {scales.tolist()!r}: need {len(objectives)} positive values")

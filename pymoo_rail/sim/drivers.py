@@ -87,7 +87,8 @@ def switching_programs(positions_m: np.ndarray, regimes: tuple[str, ...], length
     positions_m : (n_switch,) or (N, n_switch)
         Where regime k gives way to regime k + 1; sorted along each row before use.
     regimes : sequence of str
-        ``n_switch + 1`` names among traction, hold (or cruise), coast, brake.
+        ``n_switch + 1`` names among traction, hold, coast, brake, hold_brake
+        ("cruise" is accepted as an older name of hold).
     length_m : float
         The line length (the last regime runs to the end).
     """
