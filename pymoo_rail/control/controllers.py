@@ -61,7 +61,7 @@ def symmetric_rules(rules: np.ndarray) -> np.ndarray:
 
     The printed tables are (nearly) anti-symmetric, dK(-e, -ec) = -dK(e, ec): they schedule the
     gains on the sign of the error, as for a step response from below. A tracking error takes
-    both signs, so the default rule base makes the increments depend only on |e| and on whether
+    both signs, so the default rule base makes the increments depend only on ``|e|`` and on whether
     the error grows or shrinks: rule(e, ec) = rule(-e, -ec).
     """
     out = np.array(rules, dtype=float)

@@ -52,9 +52,9 @@ class SpeedProfileProblem(Problem):
     case : Case
         Train, line and planned time (``load_case("yizhuang")``).
     objectives : sequence of str
-        Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (|T - T_plan| s,
+        Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (``|T - T_plan|`` s,
         seed 000 eq. 4-21), ``"accel_variation"`` (comfort: total variation of the
-        acceleration, sum of |a_i - a_(i-1)| over the grid cells, m/s^2; Meng et al. (2017) eq. 5,
+        acceleration, sum of ``|a_i - a_(i-1)|`` over the grid cells, m/s^2; Meng et al. (2017) eq. 5,
         where it is called jerk: ``"jerk"`` is an alias of it, not a rate in m/s^3),
         ``"stop_error"`` (m, seed 002 eq. 6). Several give the Pareto form; one with
         ``time_tolerance_s`` gives the constrained form of seed 000 4.4; ``weights`` give the

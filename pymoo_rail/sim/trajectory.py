@@ -48,10 +48,10 @@ class Trajectory:
 
     @property
     def accel_variation_ms2(self) -> float:
-        """Comfort figure: total variation of the acceleration, sum of |a_i - a_(i-1)| (m/s^2).
+        """Comfort figure: total variation of the acceleration, sum of ``|a_i - a_(i-1)|`` (m/s^2).
 
         Includes the steps from rest at the start and to rest at the end. Meng et al. (2017) call
-        it jerk; it is the time integral of |jerk|, not a jerk (m/s^3).
+        it jerk; it is the time integral of ``|jerk|``, not a jerk (m/s^3).
         """
         return self.summary["jerk_ms2"]
 
