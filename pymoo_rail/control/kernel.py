@@ -1,6 +1,6 @@
 """The tracking kernel: a train driven by a controller along a reference speed-distance curve.
 
-The run has the three phases of seed 000 section 5.1.3:
+The run has the three phases of Liu (2019) section 5.1.3:
 
 1. start: maximum traction until the head reaches ``x_start_m``, where the reference leaves its
    first traction phase (the reference itself is maximum traction there);

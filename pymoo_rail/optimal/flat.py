@@ -2,7 +2,7 @@
 
 On level track without binding speed limits the minimum-energy run for a given time is
 maximum traction to a hold speed ``V``, holding ``V``, coasting down to ``W``, maximum braking
-(seed 000 section 2.2.5; Howlett and Pudney). With time priced at ``lambda`` and the Hamiltonian
+(Liu (2019) section 2.2.5; Howlett and Pudney). With time priced at ``lambda`` and the Hamiltonian
 over distance ``H = f+/eta + lambda/v + p (f - R(v)) / (m_eff v)``:
 
 - on the hold arc the traction coefficient vanishes, ``p = -m_eff V / eta``, and ``dp/dx = 0`` gives

@@ -1,4 +1,4 @@
-"""pymoo problems: the single-train speed profile and two cooperating trains (seed 001)."""
+"""pymoo problems: the single-train speed profile and two cooperating trains (Chen et al. (2017))."""
 
 from pymoo_rail.problems.cooperative import CooperativeTrainsProblem
 from pymoo_rail.problems.encodings import SpeedCodes, SwitchingPoints

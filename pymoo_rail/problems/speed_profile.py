@@ -1,4 +1,4 @@
-"""The single-train speed-profile problem (seed 000 chapter 4, seed 002 section 1, seed 003 section 2)."""
+"""The single-train speed-profile problem (Liu (2019) chapter 4, Meng et al. (2017) section 1, Tang et al. (2020) section 2)."""
 
 from __future__ import annotations
 
@@ -53,17 +53,17 @@ class SpeedProfileProblem(Problem):
         Train, line and planned time (``load_case("yizhuang")``).
     objectives : sequence of str
         Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (``|T - T_plan|`` s,
-        seed 000 eq. 4-21), ``"accel_variation"`` (comfort: total variation of the
+        Liu (2019) eq. 4-21), ``"accel_variation"`` (comfort: total variation of the
         acceleration, sum of ``|a_i - a_(i-1)|`` over the grid cells, m/s^2; Meng et al. (2017) eq. 5,
         where it is called jerk: ``"jerk"`` is an alias of it, not a rate in m/s^3),
-        ``"stop_error"`` (m, seed 002 eq. 6). Several give the Pareto form; one with
-        ``time_tolerance_s`` gives the constrained form of seed 000 4.4; ``weights`` give the
-        weighted sum of seed 002 eq. 9.
+        ``"stop_error"`` (m, Meng et al. (2017) eq. 6). Several give the Pareto form; one with
+        ``time_tolerance_s`` gives the constrained form of Liu (2019) 4.4; ``weights`` give the
+        weighted sum of Meng et al. (2017) eq. 9.
     encoding : {"speed_codes", "switching_points"}
         Speed codes per section (km/h) or regime switching positions (m); see
         :mod:`pymoo_rail.problems.encodings`.
     partition : {"gradient_limit", "equal"}
-        Sections of the speed-code encoding (seed 000 figs. 4-4 and 4-3).
+        Sections of the speed-code encoding (Liu (2019) figs. 4-4 and 4-3).
     n_sections : int, optional
         Number of equal sections (``partition="equal"``, default 10).
     max_section_m : float, optional
@@ -74,8 +74,8 @@ class SpeedProfileProblem(Problem):
         One weight per objective: minimise ``sum w_i f_i / scale_i`` (a single objective).
     scales : sequence of float, optional
         Normalisation of the weighted sum; by default the flat-out run's energy, 5 % of the planned
-        time (time error, seed 002's punctuality tolerance), the planned time (running time), the
-        flat-out run's jerk, and 0.25 m (stop error, seed 002's tolerance).
+        time (time error, Meng et al.'s (2017) punctuality tolerance), the planned time (running time), the
+        flat-out run's jerk, and 0.25 m (stop error, Meng et al.'s (2017) tolerance).
     stop_tolerance_m : float or None
         Constraint ``stop_error <= stop_tolerance_m`` (default 0.25 m); ``None`` drops it.
     regimes : sequence of str, optional
@@ -85,7 +85,7 @@ class SpeedProfileProblem(Problem):
     dx_m : float, optional
         Simulation grid step.
     tracking : Hysteresis, PID or FuzzyPID, optional
-        Score each decision by the run of this ATO controller tracking its ideal curve (seed 000
+        Score each decision by the run of this ATO controller tracking its ideal curve (Liu (2019)
         optimises the tracked curve, section 5.1.3) instead of the ideal run itself; see
         :mod:`pymoo_rail.control`. ``trajectory(x)`` then returns the tracked run.
     control_period_s : float

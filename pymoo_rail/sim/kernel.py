@@ -9,7 +9,7 @@ A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applie
 cell midpoint passes ``end_m``. Modes:
 
 - ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
-  by partial traction (the speed-code connection strategy of seed 000 fig. 4-5). It never brakes:
+  by partial traction (the speed-code connection strategy of Liu (2019) fig. 4-5). It never brakes:
   where coasting accelerates (a steep descent) the train runs above the target until a limit's
   braking envelope stops it;
 - ``MODE_TRACTION``: maximum traction (speed limits still hold);
