@@ -40,6 +40,8 @@ def test_every_key_the_loader_accepts_is_documented_and_no_other():
 def _attribute(case, key: str):
     """The loaded value a key sets."""
     parts = key.replace("[]", "").split(".")
+    if parts[0] == "run" and parts[1].endswith("_speed_kmh"):  # stored in m/s
+        return getattr(case, parts[1].replace("_kmh", "_ms")) * 3.6
     if parts[0] == "run":
         return getattr(case.legs[0], parts[2]) if parts[1] == "legs" and len(parts) > 2 else getattr(case, parts[1])
     if parts[:2] == ["train", "braking"] and parts[2].startswith("regen_"):
