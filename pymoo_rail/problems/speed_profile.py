@@ -1,4 +1,4 @@
-"""The single-train speed-profile problem (seed 000 chapter 4, seed 002 section 1, seed 003 section 2)."""
+"""The single-train speed-profile problem (Liu (2019) chapter 4, Meng et al. (2017) section 1, Tang et al. (2020) section 2)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,16 @@ from pymoo_rail.problems.encodings import ENCODINGS, SpeedCodes, SwitchingPoints
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 
-OBJECTIVES = ("energy", "running_time", "time_error", "jerk", "stop_error")
+OBJECTIVES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
+# "jerk" is the name Meng et al. (2017) give their comfort figure, sum |a_i - a_(i-1)| (m/s^2): a total
+# variation of acceleration, not a rate of change (m/s^3). "accel_variation" says what it is; "jerk"
+# stays as an alias of the same objective.
+OBJECTIVE_ALIASES = {"jerk": "accel_variation"}
+
+
+def canonical_objective(name: str) -> str:
+    """The objective a name stands for (``"jerk"`` -> ``"accel_variation"``; others unchanged)."""
+    return OBJECTIVE_ALIASES.get(name, name)
 DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m"}
 
 
@@ -54,7 +63,7 @@ def objective_values(summaries: np.ndarray, names: Sequence[str], planned_time_s
             columns.append(summaries[:, k.OUT_RUNNING_TIME_S])
         elif name == "time_error":
             columns.append(np.abs(summaries[:, k.OUT_RUNNING_TIME_S] - planned_time_s))
-        elif name == "jerk":
+        elif canonical_objective(name) == "accel_variation":
             columns.append(summaries[:, k.OUT_JERK_MS2])
         elif name == "stop_error":
             columns.append(summaries[:, k.OUT_STOP_ERROR_M])
@@ -71,16 +80,18 @@ class SpeedProfileProblem(Problem):
     case : Case
         Train, line and planned time (``load_case("yizhuang")``).
     objectives : sequence of str
-        Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (|T - T_plan| s,
-        seed 000 eq. 4-21), ``"jerk"`` (comfort: sum of |a_i - a_(i-1)|, seed 002 eq. 5, in m/s^2),
-        ``"stop_error"`` (m, seed 002 eq. 6). Several give the Pareto form; one with
-        ``time_tolerance_s`` gives the constrained form of seed 000 4.4; ``weights`` give the
-        weighted sum of seed 002 eq. 9.
+        Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (``|T - T_plan|`` s,
+        Liu (2019) eq. 4-21), ``"accel_variation"`` (comfort: total variation of the
+        acceleration, sum of ``|a_i - a_(i-1)|`` over the grid cells, m/s^2; Meng et al. (2017) eq. 5,
+        where it is called jerk: ``"jerk"`` is an alias of it, not a rate in m/s^3),
+        ``"stop_error"`` (m, Meng et al. (2017) eq. 6). Several give the Pareto form; one with
+        ``time_tolerance_s`` gives the constrained form of Liu (2019) 4.4; ``weights`` give the
+        weighted sum of Meng et al. (2017) eq. 9.
     encoding : {"speed_codes", "switching_points"}
         Speed codes per section (km/h) or regime switching positions (m); see
         :mod:`pymoo_rail.problems.encodings`.
     partition : {"gradient_limit", "equal"}
-        Sections of the speed-code encoding (seed 000 figs. 4-4 and 4-3).
+        Sections of the speed-code encoding (Liu (2019) figs. 4-4 and 4-3).
     n_sections : int, optional
         Number of equal sections (``partition="equal"``, default 10).
     max_section_m : float, optional
@@ -91,8 +102,8 @@ class SpeedProfileProblem(Problem):
         One weight per objective: minimise ``sum w_i f_i / scale_i`` (a single objective).
     scales : sequence of float, optional
         Normalisation of the weighted sum; by default the flat-out run's energy, 5 % of the planned
-        time (time error, seed 002's punctuality tolerance), the planned time (running time), the
-        flat-out run's jerk, and 0.25 m (stop error, seed 002's tolerance).
+        time (time error, Meng et al.'s (2017) punctuality tolerance), the planned time (running time), the
+        flat-out run's jerk, and 0.25 m (stop error, Meng et al.'s (2017) tolerance).
     stop_tolerance_m : float or None
         Constraint ``stop_error <= stop_tolerance_m`` (default 0.25 m); ``None`` drops it.
     regimes : sequence of str, optional
@@ -102,7 +113,7 @@ class SpeedProfileProblem(Problem):
     dx_m : float, optional
         Simulation grid step.
     tracking : Hysteresis, PID or FuzzyPID, optional
-        Score each decision by the run of this ATO controller tracking its ideal curve (seed 000
+        Score each decision by the run of this ATO controller tracking its ideal curve (Liu (2019)
         optimises the tracked curve, section 5.1.3) instead of the ideal run itself; see
         :mod:`pymoo_rail.control`. ``trajectory(x)`` then returns the tracked run.
     control_period_s : float
@@ -137,8 +148,8 @@ class SpeedProfileProblem(Problem):
         for name in objectives:
             if name not in OBJECTIVES:
                 raise ValueError(f"objective {name!r} is unknown (known: {', '.join(OBJECTIVES)})")
-        if len(set(objectives)) != len(objectives):
-            raise ValueError(f"objectives = {objectives!r} repeats a name")
+        if len({canonical_objective(name) for name in objectives}) != len(objectives):
+            raise ValueError(f"objectives = {objectives!r} repeats an objective (jerk is an alias of accel_variation)")
         if encoding == "speed_codes":
             self.encoding = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh)
         elif encoding == "switching_points":
@@ -174,9 +185,10 @@ class SpeedProfileProblem(Problem):
                                  f"one per objective {objectives}")
             if scales is None:
                 default = {"energy": fastest.energy.net_kwh, "time_error": 0.05 * case.planned_time_s,
-                           "running_time": case.planned_time_s, "jerk": max(fastest.jerk_ms2, 1e-9),
+                           "running_time": case.planned_time_s,
+                           "accel_variation": max(fastest.accel_variation_ms2, 1e-9),
                            "stop_error": 0.25}
-                scales = [default[name] for name in objectives]
+                scales = [default[canonical_objective(name)] for name in objectives]
             scales = np.asarray(scales, dtype=float)
             if scales.shape != weights.shape or not np.all(scales > 0):
                 raise ValueError(f"scales = {scales.tolist()!r}: need {len(objectives)} positive values")

@@ -9,7 +9,7 @@ A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applie
 cell midpoint passes ``end_m``. Modes:
 
 - ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
-  by partial traction (the speed-code connection strategy of seed 000 fig. 4-5). It never brakes:
+  by partial traction (the speed-code connection strategy of Liu (2019) fig. 4-5). It never brakes:
   where coasting accelerates (a steep descent) the train runs above the target until a limit's
   braking envelope stops it;
 - ``MODE_TRACTION``: maximum traction (speed limits still hold);
@@ -42,8 +42,10 @@ from pymoo_rail.sim.physics import (
 
 MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
 MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake")
-REGIME_TRACTION, REGIME_CRUISE, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
-REGIME_NAMES = ("traction", "cruise", "coast", "brake")
+REGIME_TRACTION, REGIME_HOLD, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
+REGIME_CRUISE = REGIME_HOLD  # the older name of the same regime
+# "hold": the speed is held (partial traction or braking); one word in every output and doc
+REGIME_NAMES = ("traction", "hold", "coast", "brake")
 
 # Columns of a run summary.
 OUT_TRACTION_KWH = 0
@@ -336,8 +338,11 @@ def simulate_batch(m, programs):
     out = np.empty((n_runs, N_OUT))
     empty = np.empty(0)
     empty_r = np.empty(0, dtype=np.int8)
+    # a run-time False, not the literal: with a literal Numba compiles run_program a second time
+    # (once per value of ``record``), which doubles the first-run compile time
+    record = n_runs < 0
     for j in prange(n_runs):
-        run_program(m, programs[j], out[j], False, empty, empty, empty, empty, empty, empty_r)
+        run_program(m, programs[j], out[j], record, empty, empty, empty, empty, empty, empty_r)
     return out
 
 
@@ -352,5 +357,6 @@ def simulate_trace(m, program):
     a = np.empty(n)
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
-    count = run_program(m, program, out, True, x, v, t, a, f, r)
+    record = n >= 0  # a run-time True: one compiled run_program for both callers (see simulate_batch)
+    count = run_program(m, program, out, record, x, v, t, a, f, r)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]
