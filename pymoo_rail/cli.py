@@ -180,6 +180,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "problem for the same seeds (results are the same)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
 
+    _add_suite_parser(sub)
+
     p = sub.add_parser("plot", help="redraw figures from stored results or CSV files", formatter_class=_Formatter,
                        description="Redraw figures without recomputing anything.",
                        epilog=textwrap.dedent("""\
@@ -572,6 +574,47 @@ def _objective_of_column(column: str) -> str:
     return column
 
 
+def _add_suite_parser(sub) -> None:
+    p = sub.add_parser(
+        "suite", help="the benchmark suite: list its problems, verify its shipped fronts", formatter_class=_Formatter,
+        description="The benchmark suite (pymoo_rail.suite, docs/suite.md): rail problems with certified exact "
+                    "fronts. 'list' prints the problems; 'verify' solves every shipped front again and exits 1 "
+                    "if any node drifts beyond its certificate (minutes per long line).",
+        epilog="examples:\n  pymoo-rail suite list\n  pymoo-rail suite verify metro-a yizhuang")
+    p.add_argument("action", choices=["list", "verify"], help="what to do")
+    p.add_argument("cases", nargs="*", metavar="CASE", help="suite cases to verify (default: all)")
+
+
+def cmd_suite(args) -> int:
+    from pymoo_rail.problems.reference import find_front
+    from pymoo_rail.suite import CASES, list_problems, suite_case, verify
+    from pymoo_rail.suite.problems import split
+
+    if args.action == "list":
+        for name in list_problems():
+            entry, form = split(name)
+            case = suite_case(entry.name)
+            if form == "4obj":
+                front = "best-known front (no exact front for four objectives)"
+            else:
+                path = find_front(case)
+                front = f"certified front {path.name}" if path is not None else "front computed on first use"
+            _say(f"{name:42s} {form:6s} {case.line.length_m:8.0f} m  {case.planned_time_s:6.0f} s  {front}")
+        return 0
+    known = [c.name for c in CASES]
+    for name in args.cases:
+        if name not in known:
+            raise UsageError("CASE", f"unknown suite case {name!r} (known: {', '.join(known)})")
+    report = verify(args.cases or None)
+    for case_name, rows in report.groupby("case", sort=False):
+        if "drift_kwh" in rows and rows["drift_kwh"].notna().any():
+            _say(f"{case_name:32s} {'ok' if rows['ok'].all() else 'DRIFT'}: largest drift "
+                 f"{rows['drift_kwh'].max():.4g} kWh, smallest certificate {rows['certificate_kwh'].min():.4g} kWh")
+        else:
+            _say(f"{case_name:32s} FAILED: {rows['problem'].iloc[0]}")
+    return 0 if bool(report["ok"].all()) else 1
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``pymoo-rail``; returns the exit code (0 ok, 1 failure, 2 bad arguments)."""
     parser = build_parser()
@@ -583,7 +626,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 2
     commands = {"cases": cmd_cases, "optimize": cmd_optimize, "optimise": cmd_optimize, "reference": cmd_reference,
-                "study": cmd_study}
+                "study": cmd_study, "suite": cmd_suite}
     subparser = parser._subparsers._group_actions[0].choices[args.command]  # for its usage line
     try:
         if args.command == "plot":

@@ -246,7 +246,8 @@ def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = N
                           f"pymoo_rail {__version__} / front {FRONT_VERSION}")
 
 
-def _atomic_write(path: Path, text: str) -> None:
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write a file so that readers never see half of it (temporary file, fsync, rename)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".tmp-" + path.name + ".", dir=path.parent)
     try:
@@ -306,7 +307,7 @@ def certified_front(case: Case, dx_m: float | None = None, n_times: int | None =
     else:
         front = compute_front(case, step, n_times)
         safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in case.name)
-        _atomic_write(cache_dir() / f"{safe}-{key}.csv", front.to_csv_text())
+        write_text_atomic(cache_dir() / f"{safe}-{key}.csv", front.to_csv_text())
     _MEMORY[key] = front
     return front
 
