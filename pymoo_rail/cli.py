@@ -136,6 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="constraint |T - T_plan| <= S seconds (the single-objective form of seed 000)")
     p.add_argument("--weights", type=float, nargs="+", default=None, metavar="W",
                    help="one weight per objective: minimise the weighted sum (seed 002)")
+    _add_window_arguments(p)
     p.add_argument("--out", default="out", metavar="DIR", help="output directory")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
 
@@ -355,6 +356,7 @@ def cmd_optimize(args) -> int:
         kwargs["n_sections"] = args.n_sections
     if args.weights is not None:
         kwargs["weights"] = args.weights
+    kwargs["time_window_s"] = _time_window(args, objectives)
     try:
         problem = SpeedProfileProblem(case, **kwargs)
     except ValueError as err:  # e.g. a planned time below the minimum running time
@@ -406,11 +408,16 @@ def cmd_optimize(args) -> int:
     front.to_csv(written[0], index=False)
     trajectory.to_frame().to_csv(written[1], index=False)
     label = f"{args.algorithm}, seed {args.seed}"
+    optimum = _optimum_for(problem, trajectory, args)
     if F.shape[1] >= 2:  # 4 or more objectives: a scatter matrix
         written.append(save_figure(plot_front(F, objectives, highlight=F[chosen], label=label,
+                                              reference=optimum.get("front"),
                                               title=f"{case.name}: front after {res.algorithm.evaluator.n_eval} "
                                                     "evaluations"), out / "front.png"))
-    written.append(save_figure(plot_speed_profile(trajectory, case, label=args.algorithm), out / "profile.png"))
+    others = [optimum["profile"]] if "profile" in optimum else []
+    written.append(save_figure(plot_speed_profile(trajectory, case, label=args.algorithm, others=others,
+                                                  other_labels=["optimal run at the same time"],
+                                                  other_linestyle="--"), out / "profile.png"))
     written.append(save_figure(plot_speed_time(trajectory, case), out / "speed_time.png"))
 
     n_feasible = int((CV <= 0).sum())
@@ -418,9 +425,69 @@ def cmd_optimize(args) -> int:
     _say(f"chosen: running time {trajectory.running_time_s:.2f} s (planned {case.planned_time_s:g} s), "
          f"energy {trajectory.energy.net_kwh:.3f} kWh, stop error {trajectory.stop_error_m:.3f} m"
          + ("" if CV[chosen] <= 0 else "  [INFEASIBLE: no feasible solution found]"))
+    _say(optimum["message"])
     for path in written:
         _say(f"wrote {path}")
     return 0
+
+
+def _add_window_arguments(p) -> None:
+    p.add_argument("--time-window", nargs="+", default=["default"], metavar="S",
+                   help="running-time window constraint LO HI in seconds; 'default' (the minimum running time "
+                        "to 1.3 x planned, where the certified optimal front is known: the times a timetable "
+                        "planner uses) or 'none'; applies to running_time / time_error fronts")
+    p.add_argument("--no-reference", action="store_true",
+                   help="skip the certified optimal front, the optimal profile and the gap to the optimum")
+
+
+def _time_window(args, objectives):
+    values = [v.lower() for v in args.time_window]
+    if values == ["none"]:
+        return None
+    if values == ["default"]:
+        if args.weights is None and {"running_time", "time_error"} & set(objectives) and len(objectives) > 1:
+            return "default"
+        return None
+    try:
+        lo, hi = (float(v) for v in values)
+    except ValueError:
+        raise UsageError("--time-window", f"{' '.join(args.time_window)!r}: give LO HI seconds, 'default' or "
+                                          "'none'") from None
+    if not 0 <= lo < hi < float("inf"):
+        raise UsageError("--time-window", f"{lo:g} {hi:g}: need 0 <= LO < HI seconds")
+    return (lo, hi)
+
+
+def _optimum_for(problem, trajectory, args) -> dict:
+    """The certified front in objective space, the optimal run at the chosen member's time, and the gap."""
+    from pymoo_rail.problems import reference
+
+    if args.no_reference:
+        return {"message": "optimum: skipped (--no-reference)"}
+    try:
+        front = problem.certified_front()
+    except reference.NoExactFrontError as err:
+        return {"message": f"optimum: none certified for this form ({str(err).split('no exact front: ')[-1]})"}
+    result = {}
+    if problem.n_obj == 2:
+        result["front"], _ = reference.mirrored(front, problem.objectives, 200, problem.time_window_s)
+    lo, hi = front.time_range_s
+    t = trajectory.running_time_s
+    if not lo <= t <= hi:
+        result["message"] = (f"optimum: the chosen run's {t:.2f} s lies outside the certified front's "
+                             f"{lo:.2f}-{hi:.2f} s; no gap reported")
+        return result
+    (energy,), (bound,) = front.energy_at(t)
+    gap = trajectory.energy.net_kwh - energy
+    result["message"] = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / energy:+.2f} %); "
+                         f"optimum {energy:.3f} kWh (certified within {bound:.3f} kWh, {front.certificate})")
+    try:
+        from pymoo_rail.optimal import optimal_profile
+
+        result["profile"] = optimal_profile(problem.case, t)
+    except ValueError as err:  # a time the solver's grid cannot hit closely: the figure goes without it
+        result["message"] += f"; no optimal profile drawn ({err})"
+    return result
 
 
 def _default_times(case, n_points: int):
