@@ -82,14 +82,14 @@ def _cooperative_trains(case: Any = "cooperative-pair", **params):
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
 
 
-def _rail_suite(name: str, **params):
+def _rail_suite(suite_problem: str, **params):
     """A problem of the rail benchmark suite by name (``pymoo_rail.suite.get_problem``)."""
     from pymoo_rail.suite import get_problem
 
     try:
-        return get_problem(name, **_tuples(params))
+        return get_problem(suite_problem, **_tuples(params))
     except ValueError as err:
-        raise StudyError("problem rail_suite name", name, str(err)) from None
+        raise StudyError("problem rail_suite suite_problem", suite_problem, str(err)) from None
 
 
 PROBLEMS: dict[str, Callable[..., Any]] = {
