@@ -14,6 +14,7 @@ Usage::
     nice -n 10 python benchmarks/suite.py --workers 2               # the full study (1500 runs)
     python benchmarks/suite.py --quick --workers 2                  # 3 problems x 3 seeds
     python benchmarks/suite.py --report-only                        # report from stored records
+    python benchmarks/suite.py --fronts                             # fronts, certificates, call times
 
 Records go to ``--work`` (default ``out/suite``, not committed); an interrupted study resumes.
 """
@@ -137,6 +138,41 @@ def write_report(results: pd.DataFrame, study, out: Path, note: str) -> Path:
     return path
 
 
+def front_table() -> pd.DataFrame:
+    """Per suite problem: its front (nodes, time range, certificate) and the CPU time of pareto_front().
+
+    The first call reads the shipped file (or solves, if none is shipped); the second is pymoo's
+    in-memory cache. CPU times (``time.process_time``) of one run; the machine may be loaded.
+    """
+    import time
+
+    from pymoo_rail.problems import reference
+    from pymoo_rail.suite import get_problem, list_problems
+
+    rows = []
+    for name in list_problems():
+        problem = get_problem(name)
+        try:
+            start = time.process_time()
+            pf = problem.pareto_front()
+            first = time.process_time() - start
+            start = time.process_time()
+            problem.pareto_front()
+            second = time.process_time() - start
+        except reference.NoExactFrontError:
+            rows.append({"problem": name, "front": "none (best-known only)"})
+            continue
+        front = problem.certified_front()
+        lo, hi = front.time_range_s
+        dense_bound = front.dense(200)["energy_bound_kwh"]
+        rows.append({"problem": name, "front": f"{len(pf)} points" if len(pf) > 1 else f"optimum {pf[0, 0]:.4f} kWh",
+                     "nodes": len(front.table), "time_range_s": f"{lo:.1f}-{hi:.1f}",
+                     "node_bound_max_pct": 100 * float((front.table["energy_bound_kwh"] / front.table["energy_kwh"]).max()),
+                     "dense_bound_max_kwh": float(dense_bound.max()), "certificate": front.certificate,
+                     "first_call_cpu_s": first, "second_call_cpu_s": second})
+    return pd.DataFrame(rows)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help=f"{len(QUICK_PROBLEMS)} problems x {QUICK_SEEDS} seeds")
@@ -146,7 +182,14 @@ def main(argv=None) -> int:
     parser.add_argument("--work", default=str(ROOT / "out" / "suite"), help="study directory (records)")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "reports"), help="report directory")
     parser.add_argument("--report-only", action="store_true", help="write the report from stored records")
+    parser.add_argument("--fronts", action="store_true",
+                        help="print each problem's front, certificate and pareto_front() CPU times, and stop")
     args = parser.parse_args(argv)
+    if args.fronts:
+        from pymoo_rail.experiments.stats import to_markdown
+
+        print(to_markdown(front_table().round(4)))
+        return 0
 
     from pymoo_rail.experiments import run_study
     from pymoo_rail.experiments.results import load_results
