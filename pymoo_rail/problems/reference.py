@@ -31,7 +31,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail import __version__
+from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.model import Case, case_to_dict
 
 FRONT_VERSION = "2"
@@ -246,21 +246,6 @@ def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = N
                           f"pymoo_rail {__version__} / front {FRONT_VERSION}")
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write a file so that readers never see half of it (temporary file, fsync, rename)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-" + path.name + ".", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def default_dx_m(case: Case) -> float:
     """The simulator's default step for a case (the step the solver uses when none is given)."""
     from pymoo_rail.sim import Simulator
@@ -307,7 +292,7 @@ def certified_front(case: Case, dx_m: float | None = None, n_times: int | None =
     else:
         front = compute_front(case, step, n_times)
         safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in case.name)
-        write_text_atomic(cache_dir() / f"{safe}-{key}.csv", front.to_csv_text())
+        atomic_write_text(cache_dir() / f"{safe}-{key}.csv", front.to_csv_text())
     _MEMORY[key] = front
     return front
 

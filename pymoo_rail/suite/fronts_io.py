@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.problems import reference
 from pymoo_rail.suite.problems import CASES, METRO_4OBJ, METRO_4OBJ_OBJECTIVES, get_problem
 
@@ -124,5 +125,5 @@ def compute_best_known_front(name: str = METRO_4OBJ, seeds=range(1, 6), pop_size
     table.attrs.update(label=label, version=BEST_KNOWN_VERSION, case_hash=reference.case_hash(problem.case))
     if write:
         header = "".join(f"# {k}: {v}\n" for k, v in table.attrs.items())
-        reference.write_text_atomic(best_known_path(name), header + table.to_csv(index=False, float_format="%.9g"))
+        atomic_write_text(best_known_path(name), header + table.to_csv(index=False, float_format="%.9g"))
     return table
