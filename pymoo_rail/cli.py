@@ -151,6 +151,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "default: 1 s for one objective without running_time or time_error, else none")
     p.add_argument("--weights", type=float, nargs="+", default=None, metavar="W",
                    help="one weight per objective: minimise the weighted sum (Meng et al. (2017))")
+    _add_window_arguments(p)
     p.add_argument("--out", default="out", metavar="DIR", help="output directory")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
 
@@ -205,6 +206,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  NUMBA_CACHE_DIR=/shared/numba pymoo-rail warmup --all")
     p.add_argument("--all", action="store_true",
                    help="also the exact reference solver ('reference') and the ATO tracking controllers")
+    _add_suite_parser(sub)
 
     p = sub.add_parser("plot", help="redraw figures from stored results or CSV files", formatter_class=_Formatter,
                        description="Redraw figures without recomputing anything.",
@@ -379,6 +381,7 @@ def cmd_optimize(args) -> int:
         kwargs["n_sections"] = args.n_sections
     if args.weights is not None:
         kwargs["weights"] = args.weights
+    kwargs["time_window_s"] = _time_window(args, objectives)
     try:
         problem = SpeedProfileProblem(case, **kwargs)
     except CaseError as err:  # the case cannot be run (e.g. a planned time below the minimum): not an option's fault
@@ -430,11 +433,16 @@ def cmd_optimize(args) -> int:
     front.to_csv(written[0], index=False)
     trajectory.to_frame().to_csv(written[1], index=False)
     label = f"{args.algorithm}, seed {args.seed}"
+    optimum = _optimum_for(problem, trajectory, args)
     if F.shape[1] >= 2:  # 4 or more objectives: a scatter matrix
         written.append(save_figure(plot_front(F, objectives, highlight=F[chosen], label=label,
+                                              reference=optimum.get("front"),
                                               title=f"{case.name}: front after {res.algorithm.evaluator.n_eval} "
                                                     "evaluations"), out / "front.png"))
-    written.append(save_figure(plot_speed_profile(trajectory, case, label=args.algorithm), out / "profile.png"))
+    others = [optimum["profile"]] if "profile" in optimum else []
+    written.append(save_figure(plot_speed_profile(trajectory, case, label=args.algorithm, others=others,
+                                                  other_labels=["optimal run at the same time"],
+                                                  other_linestyle="--"), out / "profile.png"))
     written.append(save_figure(plot_speed_time(trajectory, case), out / "speed_time.png"))
 
     n_feasible = int((CV <= 0).sum())
@@ -443,9 +451,69 @@ def cmd_optimize(args) -> int:
     _say(f"chosen: running time {trajectory.running_time_s:.2f} s (planned {case.planned_time_s:g} s), "
          f"energy {trajectory.energy.net_kwh:.3f} kWh, stop error {trajectory.stop_error_m:.3f} m"
          + ("" if CV[chosen] <= 0 else "  [INFEASIBLE: no feasible solution found]"))
+    _say(optimum["message"])
     for path in written:
         _say(f"wrote {path}")
     return 0
+
+
+def _add_window_arguments(p) -> None:
+    p.add_argument("--time-window", nargs="+", default=["default"], metavar="S",
+                   help="running-time window constraint LO HI in seconds; 'default' (the minimum running time "
+                        "to 1.3 x planned, where the certified optimal front is known: the times a timetable "
+                        "planner uses) or 'none'; applies to running_time / time_error fronts")
+    p.add_argument("--no-reference", action="store_true",
+                   help="skip the certified optimal front, the optimal profile and the gap to the optimum")
+
+
+def _time_window(args, objectives):
+    values = [v.lower() for v in args.time_window]
+    if values == ["none"]:
+        return None
+    if values == ["default"]:
+        if args.weights is None and {"running_time", "time_error"} & set(objectives) and len(objectives) > 1:
+            return "default"
+        return None
+    try:
+        lo, hi = (float(v) for v in values)
+    except ValueError:
+        raise UsageError("--time-window", f"{' '.join(args.time_window)!r}: give LO HI seconds, 'default' or "
+                                          "'none'") from None
+    if not 0 <= lo < hi < float("inf"):
+        raise UsageError("--time-window", f"{lo:g} {hi:g}: need 0 <= LO < HI seconds")
+    return (lo, hi)
+
+
+def _optimum_for(problem, trajectory, args) -> dict:
+    """The certified front in objective space, the optimal run at the chosen member's time, and the gap."""
+    from pymoo_rail.problems import reference
+
+    if args.no_reference:
+        return {"message": "optimum: skipped (--no-reference)"}
+    try:
+        front = problem.certified_front()
+    except reference.NoExactFrontError as err:
+        return {"message": f"optimum: none certified for this form ({str(err).split('no exact front: ')[-1]})"}
+    result = {}
+    if problem.n_obj == 2:
+        result["front"], _ = reference.mirrored(front, problem.objectives, 200, problem.time_window_s)
+    lo, hi = front.time_range_s
+    t = trajectory.running_time_s
+    if not lo <= t <= hi:
+        result["message"] = (f"optimum: the chosen run's {t:.2f} s lies outside the certified front's "
+                             f"{lo:.2f}-{hi:.2f} s; no gap reported")
+        return result
+    (energy,), (bound,) = front.energy_at(t)
+    gap = trajectory.energy.net_kwh - energy
+    result["message"] = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / energy:+.2f} %); "
+                         f"optimum {energy:.3f} kWh (certified within {bound:.3f} kWh, {front.certificate})")
+    try:
+        from pymoo_rail.optimal import optimal_profile
+
+        result["profile"] = optimal_profile(problem.case, t)
+    except ValueError as err:  # a time the solver's grid cannot hit closely: the figure goes without it
+        result["message"] += f"; no optimal profile drawn ({err})"
+    return result
 
 
 def _default_times(t_min: float, planned_time_s: float, n_points: int):
@@ -628,7 +696,46 @@ def cmd_warmup(args) -> int:
     return 0
 
 
-COMPILING_COMMANDS = ("optimize", "optimise", "reference", "warmup", "plot")
+COMPILING_COMMANDS = ("optimize", "optimise", "reference", "warmup", "plot", "suite")
+def _add_suite_parser(sub) -> None:
+    p = sub.add_parser(
+        "suite", help="the benchmark suite: list its problems, verify its shipped fronts", formatter_class=_Formatter,
+        description="The benchmark suite (pymoo_rail.suite, docs/suite.md): rail problems with certified exact "
+                    "fronts. 'list' prints the problems; 'verify' solves every shipped front again and exits 1 "
+                    "if any node drifts beyond its certificate (minutes per long line).",
+        epilog="examples:\n  pymoo-rail suite list\n  pymoo-rail suite verify metro-a yizhuang")
+    p.add_argument("action", choices=["list", "verify"], help="what to do")
+    p.add_argument("cases", nargs="*", metavar="CASE", help="suite cases to verify (default: all)")
+
+
+def cmd_suite(args) -> int:
+    from pymoo_rail.problems.reference import find_front
+    from pymoo_rail.suite import CASES, list_problems, suite_case, verify
+    from pymoo_rail.suite.problems import split
+
+    if args.action == "list":
+        for name in list_problems():
+            entry, form = split(name)
+            case = suite_case(entry.name)
+            if form == "4obj":
+                front = "best-known front (no exact front for four objectives)"
+            else:
+                path = find_front(case)
+                front = f"certified front {path.name}" if path is not None else "front computed on first use"
+            _say(f"{name:42s} {form:6s} {case.line.length_m:8.0f} m  {case.planned_time_s:6.0f} s  {front}")
+        return 0
+    known = [c.name for c in CASES]
+    for name in args.cases:
+        if name not in known:
+            raise UsageError("CASE", f"unknown suite case {name!r} (known: {', '.join(known)})")
+    report = verify(args.cases or None)
+    for case_name, rows in report.groupby("case", sort=False):
+        if "drift_kwh" in rows and rows["drift_kwh"].notna().any():
+            _say(f"{case_name:32s} {'ok' if rows['ok'].all() else 'DRIFT'}: largest drift "
+                 f"{rows['drift_kwh'].max():.4g} kWh, smallest certificate {rows['certificate_kwh'].min():.4g} kWh")
+        else:
+            _say(f"{case_name:32s} FAILED: {rows['problem'].iloc[0]}")
+    return 0 if bool(report["ok"].all()) else 1
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -642,7 +749,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 2
     commands = {"cases": cmd_cases, "optimize": cmd_optimize, "optimise": cmd_optimize, "reference": cmd_reference,
-                "study": cmd_study, "warmup": cmd_warmup}
+                "study": cmd_study, "warmup": cmd_warmup, "suite": cmd_suite}
     subparser = parser._subparsers._group_actions[0].choices[args.command]  # for its usage line
     try:
         if args.command not in COMPILING_COMMANDS:

@@ -82,6 +82,16 @@ def _cooperative_trains(case: Any = "cooperative-pair", **params):
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
 
 
+def _rail_suite(suite_problem: str, **params):
+    """A problem of the rail benchmark suite by name (``pymoo_rail.suite.get_problem``)."""
+    from pymoo_rail.suite import get_problem
+
+    try:
+        return get_problem(suite_problem, **_tuples(params))
+    except ValueError as err:
+        raise StudyError("problem rail_suite suite_problem", suite_problem, str(err)) from None
+
+
 PROBLEMS: dict[str, Callable[..., Any]] = {
     **{f"zdt{i}": _pymoo_problem(f"zdt{i}") for i in range(1, 7)},
     **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}") for i in range(1, 8)},
@@ -90,6 +100,7 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "rosenbrock": _rosenbrock,
     "speed_profile": _speed_profile,
     "cooperative_trains": _cooperative_trains,
+    "rail_suite": _rail_suite,
 }
 
 # ------------------------------------------------------------------------------- algorithms
@@ -128,6 +139,12 @@ def _smsemoa(problem, **params):
     from pymoo.algorithms.moo.sms import SMSEMOA
 
     return SMSEMOA(**params)
+
+
+def _agemoea(problem, **params):
+    from pymoo.algorithms.moo.age import AGEMOEA
+
+    return AGEMOEA(**params)
 
 
 def _de(problem, **params):
@@ -204,6 +221,7 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
     "nsga3": AlgorithmEntry(_nsga3, "multi", "NSGA-III with pop_size reference directions (pymoo)"),
     "moead": AlgorithmEntry(_moead, "multi", "MOEA/D with pop_size weight vectors (pymoo)"),
     "sms-emoa": AlgorithmEntry(_smsemoa, "multi", "SMS-EMOA (pymoo)"),
+    "age-moea": AlgorithmEntry(_agemoea, "multi", "AGE-MOEA, adaptive geometry estimation (pymoo)"),
     "de": AlgorithmEntry(_de, "single", "differential evolution (pymoo)"),
     "pso": AlgorithmEntry(_pso, "single", "particle swarm (pymoo)"),
     "ga": AlgorithmEntry(_ga, "single", "genetic algorithm (pymoo)"),
@@ -212,9 +230,9 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
     "grnsga2": AlgorithmEntry(_grnsga2, "any", "golden-ratio NSGA-II (pymoo_rail, Tang et al. (2020))"),
 }
 
-ALIASES = {"smsemoa": "sms-emoa", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
+ALIASES = {"smsemoa": "sms-emoa", "agemoea": "age-moea", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
            "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
-           "cooperative-trains": "cooperative_trains"}
+           "cooperative-trains": "cooperative_trains", "rail-suite": "rail_suite"}
 
 # -------------------------------------------------------------------------------- operators
 

@@ -98,6 +98,11 @@ class SpeedProfileProblem(Problem):
         Split ``gradient_limit`` sections longer than this (finer control on long sections).
     time_tolerance_s : float, optional
         Adds the constraint ``|T - T_plan| <= time_tolerance_s``.
+    time_window_s : (float, float) or "default", optional
+        Adds the constraint ``lo <= T <= hi`` on the running time: keeps a Pareto front on the
+        times a timetable planner would use. ``"default"`` is
+        :func:`pymoo_rail.problems.reference.default_window` (0.5 % above the minimum running
+        time to 1.3 x the planned time), the range the certified front covers.
     weights : sequence of float, optional
         One weight per objective: minimise ``sum w_i f_i / scale_i`` (a single objective).
     scales : sequence of float, optional
@@ -139,7 +144,7 @@ class SpeedProfileProblem(Problem):
                  weights: Sequence[float] | None = None, scales: Sequence[float] | None = None,
                  stop_tolerance_m: float | None = 0.25, regimes: Sequence[str] | None = None,
                  floor_kmh: float = 10.0, dx_m: float | None = None, tracking=None,
-                 control_period_s: float = 0.2, **kwargs):
+                 control_period_s: float = 0.2, time_window_s=None, **kwargs):
         if isinstance(objectives, str):
             objectives = (objectives,)
         objectives = tuple(objectives)
@@ -175,6 +180,7 @@ class SpeedProfileProblem(Problem):
         if "time_error" in objectives or time_tolerance_s is not None:
             self.simulator.check_planned_time()  # raises, naming planned_time_s, when impossible
         self.min_running_time_s = fastest.running_time_s
+        self.time_window_s = self._check_window(time_window_s, case)
 
         self.weights = None
         self.scales = None
@@ -195,7 +201,7 @@ class SpeedProfileProblem(Problem):
             self.weights, self.scales = weights, scales
 
         n_obj = 1 if self.weights is not None else len(objectives)
-        n_ieq = 1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None)
+        n_ieq = 1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None) + (self.time_window_s is not None)
         super().__init__(n_var=self.encoding.n_var, n_obj=n_obj, n_ieq_constr=n_ieq,
                          xl=self.encoding.xl.copy(), xu=self.encoding.xu.copy(), vtype=float, **kwargs)
 
@@ -231,11 +237,78 @@ class SpeedProfileProblem(Problem):
             constraints.append(s[:, k.OUT_STOP_ERROR_M] - self.stop_tolerance_m)
         if self.time_tolerance_s is not None:
             constraints.append(np.abs(s[:, k.OUT_RUNNING_TIME_S] - self.case.planned_time_s) - self.time_tolerance_s)
+        if self.time_window_s is not None:
+            lo, hi = self.time_window_s
+            t = s[:, k.OUT_RUNNING_TIME_S]
+            constraints.append(np.maximum(lo - t, t - hi))
         out["F"] = values
         out["G"] = np.column_stack(constraints)
         out["energy_kwh"] = s[:, k.OUT_NET_KWH]
         out["running_time_s"] = s[:, k.OUT_RUNNING_TIME_S]
         out["stop_error_m"] = s[:, k.OUT_STOP_ERROR_M]
+
+    def _check_window(self, window, case: Case):
+        if window is None:
+            return None
+        if isinstance(window, str):
+            if window != "default":
+                raise ValueError(f"time_window_s = {window!r}: give (lo, hi) in seconds or 'default'")
+            from pymoo_rail.problems.reference import default_window
+
+            return default_window(self.min_running_time_s, case.planned_time_s)
+        try:
+            lo, hi = (float(v) for v in window)
+        except (TypeError, ValueError):
+            raise ValueError(f"time_window_s = {window!r}: give (lo, hi) in seconds or 'default'") from None
+        if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
+            raise ValueError(f"time_window_s = {window!r}: need finite 0 <= lo < hi seconds")
+        if hi < self.min_running_time_s:
+            raise ValueError(f"time_window_s = {window!r}: ends before the minimum running time "
+                             f"{self.min_running_time_s:.2f} s")
+        return lo, hi
+
+    # ------------------------------------------------------------------ known front
+    def certified_front(self):
+        """The case's certified energy / running-time front (:mod:`pymoo_rail.problems.reference`).
+
+        Computed once per case content by the exact solver and cached on disk; raises
+        :class:`~pymoo_rail.problems.reference.NoExactFrontError` for forms that have none.
+        """
+        from pymoo_rail.problems import reference
+
+        reason = self._no_exact_front_reason()
+        if reason:
+            raise reference.NoExactFrontError(f"{self.describe()}: no exact front: {reason}")
+        return reference.certified_front(self.case, self.simulator.grid.dx_m)
+
+    def _no_exact_front_reason(self) -> str:
+        if self.tracker is not None:
+            return "the objectives are those of a tracked run"
+        if self.weights is not None:
+            return "a weighted sum has no certified optimum"
+        names = set(self.objectives)
+        if len(self.objectives) == 1:
+            if self.objectives != ("energy",) or self.time_tolerance_s is None:
+                return "only energy under a running-time tolerance has an exact optimum"
+            return ""
+        if len(self.objectives) > 2 or not (names == {"energy", "running_time"} or names == {"energy", "time_error"}):
+            return (f"objectives {self.objectives} (exact fronts exist for energy with running time or time error; "
+                    "for three or more objectives pymoo_rail.suite offers a best-known front, labelled as such)")
+        if self.time_window_s is None:
+            return ("without a running-time window the front runs on to ever slower, cheaper runs; the certified "
+                    "front covers the planner's times: pass time_window_s='default' (or a (lo, hi) inside it)")
+        return ""
+
+    def _calc_pareto_front(self, n_pareto_points: int = 100, *args, **kwargs):
+        """pymoo's hook: the certified front in this problem's objective space (or the constrained optimum)."""
+        from pymoo_rail.problems import reference
+
+        front = self.certified_front()
+        if len(self.objectives) == 1:
+            energy, _, _ = reference.constrained_optimum(front, self.time_tolerance_s, window_s=self.time_window_s)
+            return np.array([[energy]])
+        F, _ = reference.mirrored(front, self.objectives, n_pareto_points, self.time_window_s)
+        return F
 
     # ------------------------------------------------------------------ inspection
     def trajectory(self, x: np.ndarray) -> Trajectory:
