@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -12,13 +13,13 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 from pymoo_rail.model.case import Case, Leg
-from pymoo_rail.model.curves import DavisResistance, ForceCurve
+from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
 from pymoo_rail.model.errors import CaseError
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
 _TOP = {"name", "source", "description", "run", "train", "line"}
-_RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs"}
+_RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs", "initial_speed_kmh", "final_speed_kmh"}
 _LEG = {"start_m", "end_m", "planned_time_s", "dwell_s"}
 _TRAIN = {"name", "mass_t", "rotary_factor", "length_m", "max_speed_kmh", "max_accel_ms2", "max_decel_ms2",
           "traction_efficiency", "regen_efficiency", "regen_min_speed_kmh", "aux_power_kw",
@@ -71,6 +72,16 @@ def _curve(data: Any, field: str, allowed: set[str], source: str) -> ForceCurve:
         raise CaseError(f"{field}.{err.field}", err.value, err.reason, source) from None
 
 
+def _speed_ms(run: dict, key: str) -> float:
+    """A boundary speed of ``[run]`` (km/h in the file) in m/s; a bad value names the field."""
+    value = run.get(key, 0.0)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise CaseError(f"run.{key}", value, "must be a finite number of km/h")
+    if value < 0.0:
+        raise CaseError(f"run.{key}", value, "must be >= 0")
+    return value / KMH_PER_MS
+
+
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     """Build a :class:`Case` from the parsed TOML structure; every error names the field."""
     data = _table(data, "", _TOP, {"name", "run", "train", "line"}, source)
@@ -108,7 +119,9 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
         )
         return Case(name=data["name"], source=data.get("source", ""), description=data.get("description", ""),
                     train=train, line=line_obj, planned_time_s=run["planned_time_s"],
-                    dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs)
+                    dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs,
+                    initial_speed_ms=_speed_ms(run, "initial_speed_kmh"),
+                    final_speed_ms=_speed_ms(run, "final_speed_kmh"))
     except CaseError as err:
         if err.source is None:
             raise CaseError(err.field, err.value, err.reason, source) from None
@@ -176,6 +189,10 @@ def case_to_dict(case: Case) -> dict:
     ln = case.line
     run: dict[str, Any] = {"planned_time_s": case.planned_time_s, "dwell_s": case.dwell_s,
                            "time_margin_s": case.time_margin_s}
+    if case.initial_speed_ms:
+        run["initial_speed_kmh"] = case.initial_speed_ms * KMH_PER_MS
+    if case.final_speed_ms:
+        run["final_speed_kmh"] = case.final_speed_ms * KMH_PER_MS
     if case.legs:
         run["legs"] = [{"start_m": g.start_m, "end_m": g.end_m, "planned_time_s": g.planned_time_s,
                         "dwell_s": g.dwell_s} for g in case.legs]
