@@ -131,7 +131,7 @@ def read_case(path: str | Path) -> Case:
         with path.open("rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
-        raise CaseError("<file>", str(path), f"is not valid TOML: {err}", str(path)) from None
+        raise CaseError("toml", str(path), f"is not valid TOML: {err}", str(path)) from None
     return case_from_dict(data, source=str(path))
 
 
