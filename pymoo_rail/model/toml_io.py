@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -14,7 +13,7 @@ else:  # pragma: no cover - Python 3.10
 
 from pymoo_rail.model.case import Case, Leg
 from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
@@ -88,12 +87,7 @@ def _curve(data: Any, field: str, allowed: set[str], source: str) -> ForceCurve:
 
 def _speed_ms(run: dict, key: str) -> float:
     """A boundary speed of ``[run]`` (km/h in the file) in m/s; a bad value names the field."""
-    value = run.get(key, 0.0)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise CaseError(f"run.{key}", value, "must be a finite number of km/h")
-    if value < 0.0:
-        raise CaseError(f"run.{key}", value, "must be >= 0")
-    return value / KMH_PER_MS
+    return check_number(f"run.{key}", run.get(key, 0.0), nonneg=True) / KMH_PER_MS
 
 
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
@@ -151,7 +145,7 @@ def read_case(path: str | Path) -> Case:
         with path.open("rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
-        raise CaseError("<file>", str(path), f"is not valid TOML: {err}", str(path)) from None
+        raise CaseError("toml", str(path), f"is not valid TOML: {err}", str(path)) from None
     return case_from_dict(data, source=str(path))
 
 
