@@ -9,7 +9,7 @@ A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applie
 cell midpoint passes ``end_m``. Modes:
 
 - ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
-  by partial traction (the speed-code connection strategy of seed 000 fig. 4-5). It never brakes:
+  by partial traction (the speed-code connection strategy of Liu (2019) fig. 4-5). It never brakes:
   where coasting accelerates (a steep descent) the train runs above the target until a limit's
   braking envelope stops it;
 - ``MODE_TRACTION``: maximum traction (speed limits still hold);
@@ -42,8 +42,10 @@ from pymoo_rail.sim.physics import (
 
 MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
 MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake")
-REGIME_TRACTION, REGIME_CRUISE, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
-REGIME_NAMES = ("traction", "cruise", "coast", "brake")
+REGIME_TRACTION, REGIME_HOLD, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
+REGIME_CRUISE = REGIME_HOLD  # the older name of the same regime
+# "hold": the speed is held (partial traction or braking); one word in every output and doc
+REGIME_NAMES = ("traction", "hold", "coast", "brake")
 
 # Columns of a run summary.
 OUT_TRACTION_KWH = 0
@@ -348,11 +350,11 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
 # core and nearly halve the time per cell (docs/performance.md). Each run does exactly the
 # arithmetic of ``run_program``, so results are bitwise the same.
 @njit(cache=True, _nrt=False)
-def run_two_programs(m, program_a, program_b, out_a, out_b):
-    """Summaries of two runs, simulated side by side (no traces)."""
+def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
+    """Summaries of two runs, simulated side by side (no traces; ``empty``, ``empty_r``: the
+    empty float and int8 trace arrays ``write_summary`` takes)."""
     n = m.position_m.shape[0]
-    empty = m.position_m[:0]
-    empty_r = m.neutral[:0]
+    record = n < 0  # a run-time False: one compiled write_summary for every caller
     totals_a = new_totals()
     totals_b = new_totals()
     v_a = m.initial_speed_ms
@@ -380,20 +382,23 @@ def run_two_programs(m, program_a, program_b, out_a, out_b):
                 stop_b = x1
         if not (moving_a or moving_b):
             break
-    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, 0, False, empty, empty, empty_r)
-    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, 0, False, empty, empty, empty_r)
+    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, 0, record, empty, empty, empty_r)
+    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, 0, record, empty, empty, empty_r)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True)
 def simulate_serial(m, programs, out):
     """Summaries of runs ``programs`` (N, rows, 3) into ``out`` (N, N_OUT), in this thread."""
     n_runs = programs.shape[0]
+    empty = np.empty(0)
+    empty_r = np.empty(0, dtype=np.int8)
     for j in range(n_runs // 2):
-        run_two_programs(m, programs[2 * j], programs[2 * j + 1], out[2 * j], out[2 * j + 1])
+        run_two_programs(m, programs[2 * j], programs[2 * j + 1], out[2 * j], out[2 * j + 1], empty, empty_r)
     if n_runs % 2 == 1:
-        empty = m.position_m[:0]
-        run_program(m, programs[n_runs - 1], out[n_runs - 1], False, empty, empty, empty, empty, empty,
-                    m.neutral[:0])
+        # a run-time False, not the literal: with a literal Numba compiles run_program a second time
+        # (once per value of ``record``), which doubles the first-run compile time
+        record = n_runs < 0
+        run_program(m, programs[n_runs - 1], out[n_runs - 1], record, empty, empty, empty, empty, empty, empty_r)
 
 
 @njit(cache=True, parallel=True)
@@ -429,5 +434,6 @@ def simulate_trace(m, program):
     a = np.empty(n)
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
-    count = run_program(m, program, out, True, x, v, t, a, f, r)
+    record = n >= 0  # a run-time True: one compiled run_program for both callers (see simulate_batch)
+    count = run_program(m, program, out, record, x, v, t, a, f, r)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]
