@@ -1,9 +1,16 @@
 """pymoo problems: the single-train speed profile and two cooperating trains (seed 001)."""
 
 from pymoo_rail.problems.cooperative import CooperativeTrainsProblem
-from pymoo_rail.problems.encodings import SpeedCodes, SwitchingPoints
-from pymoo_rail.problems.speed_profile import OBJECTIVES, SEED_002_WEIGHTS, SpeedProfileProblem, objective_values
+from pymoo_rail.problems.encodings import BrakingOnset, SpeedCodes, SwitchingPoints, overrun_case
+from pymoo_rail.problems.speed_profile import (
+    OBJECTIVES,
+    SEED_002_WEIGHTS,
+    ConstantObjectiveWarning,
+    SpeedProfileProblem,
+    objective_values,
+)
 from pymoo_rail.sim import Trajectory
 
-__all__ = ["SpeedProfileProblem", "CooperativeTrainsProblem", "SpeedCodes", "SwitchingPoints", "OBJECTIVES",
+__all__ = ["SpeedProfileProblem", "CooperativeTrainsProblem", "SpeedCodes", "SwitchingPoints", "BrakingOnset",
+           "overrun_case", "ConstantObjectiveWarning", "OBJECTIVES",
            "SEED_002_WEIGHTS", "objective_values", "Trajectory"]
