@@ -82,6 +82,13 @@ def _cooperative_trains(case: Any = "cooperative-pair", **params):
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
 
 
+def _kinematic_phases(case: Any = "metro-a", **params):
+    """``pymoo_rail.problems.KinematicPhasesProblem`` (the four-phase model of Meng et al. 2017)."""
+    from pymoo_rail.problems import KinematicPhasesProblem
+
+    return KinematicPhasesProblem(_case(case), **_tuples(params))
+
+
 PROBLEMS: dict[str, Callable[..., Any]] = {
     **{f"zdt{i}": _pymoo_problem(f"zdt{i}") for i in range(1, 7)},
     **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}") for i in range(1, 8)},
@@ -90,6 +97,7 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "rosenbrock": _rosenbrock,
     "speed_profile": _speed_profile,
     "cooperative_trains": _cooperative_trains,
+    "kinematic_phases": _kinematic_phases,
 }
 
 # ------------------------------------------------------------------------------- algorithms
@@ -214,7 +222,7 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
 
 ALIASES = {"smsemoa": "sms-emoa", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
            "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
-           "cooperative-trains": "cooperative_trains"}
+           "cooperative-trains": "cooperative_trains", "kinematic-phases": "kinematic_phases"}
 
 # -------------------------------------------------------------------------------- operators
 
@@ -237,6 +245,8 @@ OPERATORS: dict[str, dict[str, tuple[str, str]]] = {
     "sampling": {
         "random": ("pymoo.operators.sampling.rnd", "FloatRandomSampling"),
         "lhs": ("pymoo.operators.sampling.lhs", "LHS"),
+        "binary": ("pymoo.operators.sampling.rnd", "BinaryRandomSampling"),
+        "integer": ("pymoo.operators.sampling.rnd", "IntegerRandomSampling"),
     },
 }
 

@@ -2,6 +2,7 @@
 
 from pymoo_rail.problems.cooperative import CooperativeTrainsProblem
 from pymoo_rail.problems.encodings import BrakingOnset, SpeedCodes, SwitchingPoints, overrun_case
+from pymoo_rail.problems.phases import KinematicPhasesProblem, phase_runs
 from pymoo_rail.problems.speed_profile import (
     OBJECTIVES,
     SEED_002_WEIGHTS,
@@ -12,5 +13,5 @@ from pymoo_rail.problems.speed_profile import (
 from pymoo_rail.sim import Trajectory
 
 __all__ = ["SpeedProfileProblem", "CooperativeTrainsProblem", "SpeedCodes", "SwitchingPoints", "BrakingOnset",
-           "overrun_case", "ConstantObjectiveWarning", "OBJECTIVES",
+           "overrun_case", "ConstantObjectiveWarning", "KinematicPhasesProblem", "phase_runs", "OBJECTIVES",
            "SEED_002_WEIGHTS", "objective_values", "Trajectory"]
