@@ -124,6 +124,24 @@ def phase_runs(lengths_m: np.ndarray, accelerations_ms2: Sequence[float], mass_k
                      comfort_ms2=comfort)
 
 
+def phase_profile(lengths_m: np.ndarray, accelerations_ms2: Sequence[float], points_per_phase: int = 50
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position (m), speed (m/s) and time (s) along one kinematic run, for plots (fig. 3 and 5)."""
+    r = phase_runs(np.asarray(lengths_m, dtype=float)[None, :3], accelerations_ms2, 1.0)
+    a = np.asarray(accelerations_ms2, dtype=float)
+    xs, vs, ts = [np.zeros(1)], [np.zeros(1)], [np.zeros(1)]
+    x0 = v0 = t0 = 0.0
+    for i in range(4):
+        d = np.linspace(0.0, r.length_m[0, i], points_per_phase)[1:]
+        v = np.sqrt(np.maximum(v0 * v0 + 2.0 * a[i] * d, 0.0))
+        t = d / v0 if a[i] == 0.0 and v0 > 0 else (v - v0) / a[i] if a[i] != 0.0 else np.zeros_like(d)
+        xs.append(x0 + d)
+        vs.append(v)
+        ts.append(t0 + t)
+        x0, v0, t0 = x0 + r.length_m[0, i], r.speed_end_ms[0, i], t0 + r.duration_s[0, i]
+    return np.concatenate(xs), np.concatenate(vs), np.concatenate(ts)
+
+
 def decode_bits(bits: np.ndarray, n_genes: int, upper: float) -> np.ndarray:
     """Unsigned binary genes (most significant bit first) scaled to [0, upper]: (N, n_genes)."""
     bits = np.atleast_2d(np.asarray(bits))
