@@ -52,15 +52,15 @@ def _rosenbrock(n_var: int = 10):
     return Rosenbrock(n_var)
 
 
-def _case(case: Any):
-    from pymoo_rail.cases import load_case
+def _case(case: Any, load: str | None = None):
+    from pymoo_rail.cases import load_case, with_load
     from pymoo_rail.model import Case
 
     if isinstance(case, Case):
-        return case
+        return case if load is None else with_load(case, load)
     if not isinstance(case, str):
         raise StudyError("case", case, "must be a built-in case name or the path of a case file")
-    return load_case(case)
+    return load_case(case, load=load)
 
 
 def _tuples(params: dict) -> dict:
@@ -68,11 +68,12 @@ def _tuples(params: dict) -> dict:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
 
 
-def _speed_profile(case: Any = "yizhuang", **params):
-    """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path)."""
+def _speed_profile(case: Any = "yizhuang", load: str | None = None, **params):
+    """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path; ``load``:
+    a passenger load state such as ``"AW3"``)."""
     from pymoo_rail.problems import SpeedProfileProblem
 
-    return SpeedProfileProblem(_case(case), **_tuples(params))
+    return SpeedProfileProblem(_case(case, load), **_tuples(params))
 
 
 def _cooperative_trains(case: Any = "cooperative-pair", **params):
