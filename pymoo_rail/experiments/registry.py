@@ -90,6 +90,13 @@ def _kinematic_phases(case: Any = "metro-a", **params):
     return KinematicPhasesProblem(_case(case), **_tuples(params))
 
 
+def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
+    """``pymoo_rail.control.tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
+    from pymoo_rail.control.tuning import ControllerTuningProblem
+
+    return ControllerTuningProblem(_case(case, load), **params)
+
+
 PROBLEMS: dict[str, Callable[..., Any]] = {
     **{f"zdt{i}": _pymoo_problem(f"zdt{i}") for i in range(1, 7)},
     **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}") for i in range(1, 8)},
@@ -99,6 +106,7 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "speed_profile": _speed_profile,
     "cooperative_trains": _cooperative_trains,
     "kinematic_phases": _kinematic_phases,
+    "controller_tuning": _controller_tuning,
 }
 
 # ------------------------------------------------------------------------------- algorithms
