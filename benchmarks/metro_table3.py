@@ -60,7 +60,9 @@ def run_table(problem, lengths: np.ndarray) -> dict:
     """One row of the table from traction, cruise and coast lengths (kinematic model)."""
     runs = problem.runs(problem.encode(lengths[None, :]) if problem.binary else lengths[None, :])
     idx = problem.indices(runs)
-    F = np.array([[idx[n][0] for n in problem.objectives]])
+    from pymoo_rail.problems import canonical_objective
+
+    F = np.array([[idx[canonical_objective(n)][0] for n in problem.objectives]])
     G = np.concatenate([problem.min_phase_s - runs.duration_s[0], problem.limit_excess_ms(runs)[0]])
     return {"traction_m": runs.length_m[0, 0], "cruise_m": runs.length_m[0, 1], "coast_m": runs.length_m[0, 2],
             "brake_m": runs.length_m[0, 3], "stop_m": runs.stop_position_m[0], "stop_error_m": idx["stop_error"][0],
@@ -74,7 +76,7 @@ def physical_replay(case, lengths: np.ndarray, latest: bool = False):
     coast's end (``latest=False``) or coasting on until the braking curve onto the platform."""
     from pymoo_rail.problems import SpeedProfileProblem
 
-    objectives = ("energy", "jerk", "stop_error", "time_error")
+    objectives = ("energy", "accel_variation", "stop_error", "time_error")
     ends = np.cumsum(lengths[:3])
     if latest:
         p = SpeedProfileProblem(case, objectives=objectives, encoding="switching_points",

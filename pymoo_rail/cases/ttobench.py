@@ -28,7 +28,7 @@ Mapping decisions (the full table is in ``docs/ttobench.md``):
   below 2e-5).
 - Train length: TTOBench's benchmark formulations treat the train as a point mass and the train
   files have an optional ``length``. ``train_length_m=None`` uses that length when the file has one
-  (limits hold over the whole train and gradients are averaged over it, seed 000 eq. 4-14), and a
+  (limits hold over the whole train and gradients are averaged over it, Liu (2019) eq. 4-14), and a
   point mass otherwise; ``0`` forces a point mass. The model needs a positive length, so a point
   mass is a train of :data:`POINT_MASS_LENGTH_M` (1 mm) with ``gradient_model = "point_mass"``.
 - Efficiencies absent (TTOBench allows omitting both) give traction efficiency 1 and no regen,
@@ -65,7 +65,7 @@ TTOBENCH_NOTICE = "TTOBench data, BSD 2-Clause License, Copyright (c) 2022, Dimi
 
 # TTOBench stores positions only. Station names of the Beijing Subway Yizhuang line in the order of
 # the stops in CN_Songjiazhuang_Yizhuang.json (public line map, not part of TTOBench). Stops 9 -> 10
-# are seed 000's Tongjinan Rd -> Jinghai Rd run (2265 m in both sources).
+# are Liu's (2019) Tongjinan Rd -> Jinghai Rd run (2265 m in both sources).
 YIZHUANG_STOP_NAMES = (
     "Songjiazhuang", "Xiaocun", "Xiaohongmen", "Jiugong", "Yizhuangqiao", "Yizhuang Culture Park",
     "Wanyuan St", "Rongjing East St", "Rongchang East St", "Tongjinan Rd", "Jinghai Rd", "Ciqu South",
@@ -441,9 +441,16 @@ _TTOBENCH_FIELD = {
 }
 
 
+def _boundary_speed_ms(field: str, kmh: float) -> float:
+    if isinstance(kmh, bool) or not isinstance(kmh, (int, float)) or not math.isfinite(kmh) or kmh < 0.0:
+        raise CaseError(field, kmh, "must be a finite number of km/h >= 0")
+    return kmh / KMH_PER_MS
+
+
 def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to_stop: StopRef,
                   planned_time_s: float, *, dwell_s: float = 0.0, stop_names: Sequence[str] | None = None,
-                  train_length_m: float | None = None, name: str | None = None) -> Case:
+                  train_length_m: float | None = None, name: str | None = None,
+                  initial_speed_kmh: float = 0.0, final_speed_kmh: float = 0.0) -> Case:
     """The run of a TTOBench train between two stops of a TTOBench track, as a :class:`Case`.
 
     Parameters
@@ -466,6 +473,9 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
         gradients averaged over it.
     name : str, optional
         Case name (default ``"<track id>[<i>-<j>]"``).
+    initial_speed_kmh, final_speed_kmh : float
+        Speeds at ``from_stop`` and ``to_stop`` (default 0: a stop at both); TTOBench benchmark
+        formulations such as the ms-eetc one start and end at a small speed (e.g. 1 m/s).
     """
     track = read_track(track_path)
     tt_train = read_train(train_path, train_length_m=train_length_m)
@@ -485,6 +495,8 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
               f"pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
     return Case(name=name or f"{track.id}[{i}-{j}]", train=tt_train.train, line=line,
                 planned_time_s=planned_time_s, dwell_s=dwell_s, source=source,
+                initial_speed_ms=_boundary_speed_ms("initial_speed_kmh", initial_speed_kmh),
+                final_speed_ms=_boundary_speed_ms("final_speed_kmh", final_speed_kmh),
                 description=f"{track.id} {stop_label(i)} -> {stop_label(j)}, {line.length_m:g} m, "
                             f"train {tt_train.id}")
 

@@ -1,6 +1,6 @@
 """The tracking kernel: a train driven by a controller along a reference speed-distance curve.
 
-The run has the three phases of seed 000 section 5.1.3:
+The run has the three phases of Liu (2019) section 5.1.3:
 
 1. start: maximum traction until the head reaches ``x_start_m``, where the reference leaves its
    first traction phase (the reference itself is maximum traction there);
@@ -316,7 +316,8 @@ def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms,
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
     u = np.empty(n)
-    count = track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, True, x, v, t, a, f, r, u,
+    record = n >= 0  # run-time booleans, not literals: one compiled track_run / run_program each
+    count = track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record, x, v, t, a, f, r, u,
                       noise_ms, lag_s)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count], u[:count]
 
@@ -333,6 +334,9 @@ def track_programs(m, programs, code, params, period_s):
     out = np.empty((n_runs, N_OUT))
     empty = np.empty(0)
     empty_r = np.empty(0, dtype=np.int8)
+    # run-time booleans, not literals: with literals Numba compiles run_program and track_run once
+    # per value (see pymoo_rail.sim.kernel.simulate_batch)
+    record, no_record = n >= 0, n < 0
     for j in prange(n_runs):
         ref_out = np.empty(N_OUT)
         x = np.empty(n)
@@ -341,9 +345,9 @@ def track_programs(m, programs, code, params, period_s):
         a = np.empty(n)
         f = np.empty(n)
         r = np.empty(n, dtype=np.int8)
-        count = run_program(m, programs[j], ref_out, True, x, v, t, a, f, r)
+        count = run_program(m, programs[j], ref_out, record, x, v, t, a, f, r)
         v[count:] = 0.0
         x_start, x_stop = reference_phases(x, r, count)
-        track_run(m, v, x_start, x_stop, code, params, period_s, out[j], False,
+        track_run(m, v, x_start, x_stop, code, params, period_s, out[j], no_record,
                   empty, empty, empty, empty, empty, empty_r, empty, empty, 0.0)
     return out

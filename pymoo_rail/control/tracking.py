@@ -1,4 +1,4 @@
-"""Tracking a reference speed-distance curve with an ATO controller (seed 000 2.1 and 5.1.3)."""
+"""Tracking a reference speed-distance curve with an ATO controller (Liu (2019) 2.1 and 5.1.3)."""
 
 from __future__ import annotations
 

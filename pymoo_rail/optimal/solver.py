@@ -92,11 +92,14 @@ class OptimalSolver:
         Controls within this many joules of the best count as tied, and the forward run then keeps
         its regime: it removes chattering between coasting and partial traction at a measured cost
         below 0.02 % (``docs/optimal.md``).
+    certify : bool
+        Give every run an error bound (``summary["energy_bound_kwh"]``, see :meth:`energy_bound_kwh`);
+        costs a second solve on a speed grid of half the nodes.
     """
 
     def __init__(self, case: Case, dx_m: float | None = None, n_speeds: int = DEFAULT_N_SPEEDS,
                  max_targets: int = DEFAULT_MAX_TARGETS, time_tol_s: float = DEFAULT_TIME_TOL_S,
-                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J):
+                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J, certify: bool = True):
         if isinstance(n_speeds, bool) or not isinstance(n_speeds, (int, np.integer)) or n_speeds < 3:
             raise ValueError(f"n_speeds = {n_speeds!r}: must be an integer >= 3")
         if isinstance(max_targets, bool) or not isinstance(max_targets, (int, np.integer)) or max_targets < 1:
@@ -116,6 +119,8 @@ class OptimalSolver:
         self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
         self._min_time_s: float | None = None
         self.n_solves = 0  # DP solves so far (for benchmarks)
+        self.certify = bool(certify)
+        self._coarse: OptimalSolver | None = None
 
     @property
     def dx_m(self) -> float:
@@ -143,7 +148,10 @@ class OptimalSolver:
             raise InfeasibleCaseError("line", self.case.name,
                                       f"the solver finds no way to the platform beyond {x:.1f} m", self.case.name)
         program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
-        return _Solve(lambda_w, program, speeds, energy, time, float(self._value[0, 0]))
+        model = self.simulator.model
+        value_j = float(dp.interp_value(self._value[0], model.envelope_ms[0] ** 2, model.initial_speed_ms ** 2,
+                                        self.top_bias))
+        return _Solve(lambda_w, program, speeds, energy, time, value_j)
 
     def _adjust(self, solution: _Solve, target: float) -> _Solve | None:
         """Move the run's last switch into the final coast until it takes the requested time.
@@ -277,6 +285,30 @@ class OptimalSolver:
                                  f"({best.time_s:.1f} s at lambda = {best.lambda_w:.3g} W)")
         return best
 
+    def energy_bound_kwh(self, solution: _Solve) -> float:
+        """Bound on the run's energy above the optimum at its running time (kWh, >= 0).
+
+        The two-grid estimate: the same run solved on a speed grid of half the nodes (same position
+        grid, same controls), moved to this run's time along the front's slope ``lambda``, differs
+        from this run by ``delta``. If the error of the DP falls at least linearly with the node
+        spacing (measured: it does, ``docs/optimal.md``), the error of the finer solve is at most
+        ``|delta|``. The optimum meant is that of the simulator's model on this position grid,
+        the model every optimiser's run is evaluated with.
+        """
+        if self._coarse is None:
+            self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
+                                         self.time_tol_s, self.top_bias, self.tie_j, certify=False)
+            self._coarse.simulator = self.simulator  # same grid and model: share them
+            self._coarse._min_time_s = self._min_time_s
+        coarse = self._coarse
+        try:
+            other = coarse._search(solution.time_s, solution.lambda_w)
+        except ValueError:  # the coarse grid cannot reach that time: its closest run at the same price
+            other = coarse.solve_price(solution.lambda_w)
+        slope_w = 0.5 * (solution.lambda_w + other.lambda_w)
+        moved_j = other.energy_j + slope_w * (other.time_s - solution.time_s)
+        return abs(moved_j - solution.energy_j) / _J_PER_KWH
+
     def trajectory(self, solution: _Solve) -> Trajectory:
         """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
         tr = self.simulator.run(solution.program)
@@ -309,9 +341,12 @@ class OptimalSolver:
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
                                    f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
-                                  self.top_bias, self.tie_j)
+                                  self.top_bias, self.tie_j, self.certify)
             return finer.profile(running_time_s, solution.lambda_w)
-        return self.trajectory(solution)
+        tr = self.trajectory(solution)
+        if self.certify:
+            tr = replace(tr, summary=dict(tr.summary, energy_bound_kwh=self.energy_bound_kwh(solution)))
+        return tr
 
 
 def min_running_time(case: Case, dx_m: float | None = None) -> float:
@@ -335,15 +370,16 @@ def optimal_profile(case: Case, running_time_s: float, **settings) -> Trajectory
         Requested running time; at least :func:`min_running_time`.
     **settings
         Grid and search settings of :class:`OptimalSolver` (``dx_m``, ``n_speeds``, ``max_targets``,
-        ``time_tol_s``, ``top_bias``, ``tie_j``); the defaults are within 0.5 % of the exact optimum
-        (``docs/optimal.md``).
+        ``time_tol_s``, ``top_bias``, ``tie_j``, ``certify``); the accuracy the defaults reach is
+        measured in ``docs/optimal.md``, and every run carries its own bound.
 
     Returns
     -------
     Trajectory
         With ``running_time_s`` within ``time_tol_s`` of the request when the discrete optimum allows
         it, never more than 0.5 s off; ``summary["lambda_w"]`` is the price of time (W) at which it
-        is optimal.
+        is optimal; ``summary["energy_bound_kwh"]`` bounds its energy above the optimum at its
+        running time (:meth:`OptimalSolver.energy_bound_kwh`; absent with ``certify=False``).
 
     Raises
     ------
@@ -372,8 +408,10 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
         One row per requested time, sorted by time: ``running_time_s`` (of the run found) and
         ``energy_kwh`` (net) of the simulated optimal run, ``requested_time_s``, ``traction_kwh``,
         ``regen_kwh``, ``aux_kwh``, ``lambda_kwh_per_s`` (the front's slope ``-dE/dT``: the energy
-        one more second saves) and ``energy_at_request_kwh`` (the energy moved along that slope to
-        the requested time, to first order).
+        one more second saves), ``energy_at_request_kwh`` (the energy moved along that slope to
+        the requested time, to first order) and ``energy_bound_kwh``: a bound on ``energy_kwh``
+        minus the optimum at ``running_time_s`` (kWh, >= 0; :meth:`OptimalSolver.energy_bound_kwh`;
+        NaN with ``certify=False``).
     """
     times = np.atleast_1d(np.asarray(running_times, dtype=float))
     if times.ndim != 1 or times.size == 0:
@@ -391,5 +429,6 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
         rows.append({"running_time_s": tr.running_time_s, "energy_kwh": e.net_kwh, "requested_time_s": float(t),
                      "traction_kwh": e.traction_kwh, "regen_kwh": e.regen_kwh, "aux_kwh": e.aux_kwh,
                      "lambda_kwh_per_s": slope,
-                     "energy_at_request_kwh": e.net_kwh + slope * (tr.running_time_s - float(t))})
+                     "energy_at_request_kwh": e.net_kwh + slope * (tr.running_time_s - float(t)),
+                     "energy_bound_kwh": tr.summary.get("energy_bound_kwh", math.nan)})
     return pd.DataFrame(rows)

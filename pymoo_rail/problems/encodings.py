@@ -2,12 +2,12 @@
 
 An encoding turns a population of decision vectors into kernel programs. Two families:
 
-- ``SpeedCodes``: one target speed (km/h) per section of a partition of the line (seed 000
+- ``SpeedCodes``: one target speed (km/h) per section of a partition of the line (Liu (2019)
   4.3.3): ``"gradient_limit"`` cuts at every gradient, limit and neutral-section change (the
   non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``;
   ``"equal"`` cuts ``n_sections`` equal pieces (fig. 4-3). Bounds run from a floor to the highest
   limit in the section; sections inside a neutral section are fixed at the floor (coasting).
-- ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (seeds 002/003),
+- ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (Meng et al. (2017) and Tang et al. (2020)),
   by default ``traction, hold, coast`` per speed-limit zone and a final ``brake``.
 - ``BrakingOnset``: the phases of Meng et al. (2017) (traction, cruise, coast) with the braking
   onset position and the braking deceleration as decisions. The train brakes at that
@@ -111,6 +111,10 @@ class SpeedCodes:
 
     def programs(self, X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=float)
+        negative = np.argwhere(X < 0)
+        if negative.size:  # reported in km/h, the unit it was given in
+            idx = tuple(int(i) for i in negative[0])
+            raise ValueError(f"speed_codes{list(idx)} = {float(X[idx])} km/h: speed codes must be >= 0 km/h")
         if self.integer and np.isfinite(X).all() and np.any(X != np.round(X)):
             idx = tuple(int(i) for i in np.argwhere(X != np.round(X))[0])
             raise ValueError(f"speed_codes{list(idx)} = {float(X[idx])}: integer codes must be whole km/h "

@@ -12,7 +12,8 @@ and the four indices of section 1:
 - energy index, eq. 4: ``K_N = sum_i m a_i s_i`` over the phases with a_i > 0 (the work of the
   fixed accelerations; summed over every phase it is the kinetic energy at the end, 0 for a stop,
   so only the driven phases can be meant). Reported in kWh (m in kg);
-- comfort, eq. 5: ``K_S = sum |a_i - a_(i-1)|`` from rest to rest, m/s^2 (the ``jerk`` objective);
+- comfort, eq. 5: ``K_S = sum |a_i - a_(i-1)|`` from rest to rest, m/s^2 (the ``accel_variation``
+  objective, alias ``jerk``);
 - stop error, eq. 6: ``K_J = |sum s_i - S|`` (m);
 - punctuality, eq. 8: ``K_Z = |sum t_i - T|`` (s).
 
@@ -42,9 +43,10 @@ import numpy as np
 from pymoo.core.problem import Problem
 
 from pymoo_rail.model import Case
+from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning, canonical_objective
 
 PHASE_NAMES = ("traction", "cruise", "coast", "brake")
-PHASE_OBJECTIVES = ("energy", "jerk", "stop_error", "time_error")
+PHASE_OBJECTIVES = ("energy", "accel_variation", "stop_error", "time_error")  # "jerk": alias of accel_variation
 MENG_ACCELERATIONS_MS2 = (1.0, 0.0, -0.033, -1.1)  # Meng et al. (2017) section 3.2, coasting signed
 _J_PER_KWH = 3.6e6
 _KMH_PER_MS = 3.6
@@ -172,7 +174,8 @@ class KinematicPhasesProblem(Problem):
     case : Case
         Line length, planned time, train mass and speed limits (``load_case("metro-a")``).
     objectives : sequence of str
-        Among ``"energy"`` (index of eq. 4, kWh), ``"jerk"`` (eq. 5), ``"stop_error"`` (eq. 6, m),
+        Among ``"energy"`` (index of eq. 4, kWh), ``"accel_variation"`` (alias ``"jerk"``, eq. 5),
+        ``"stop_error"`` (eq. 6, m),
         ``"time_error"`` (eq. 8, s).
     weights : sequence of float, optional
         One per objective: minimise ``sum w_i f_i / scale_i`` (eqs. 9-11; the paper's GA maximises
@@ -203,8 +206,9 @@ class KinematicPhasesProblem(Problem):
                  min_phase_s: float = 2.0, binary: bool = True, **kwargs):
         objectives = (objectives,) if isinstance(objectives, str) else tuple(objectives)
         for name in objectives:
-            if name not in PHASE_OBJECTIVES:
-                raise ValueError(f"objective {name!r} is unknown (known: {', '.join(PHASE_OBJECTIVES)})")
+            if canonical_objective(name) not in PHASE_OBJECTIVES:
+                raise ValueError(f"objective {name!r} is unknown (known: {', '.join(PHASE_OBJECTIVES)}, "
+                                 "jerk = accel_variation)")
         if not objectives or len(set(objectives)) != len(objectives):
             raise ValueError(f"objectives = {objectives!r}: give at least one, without repeats")
         if not isinstance(n_bits, (int, np.integer)) or not 2 <= n_bits <= 52:
@@ -213,6 +217,7 @@ class KinematicPhasesProblem(Problem):
             raise ValueError(f"min_phase_s = {min_phase_s!r} must be a number >= 0")
         self.case = case
         self.objectives = objectives
+        self._keys = tuple(canonical_objective(name) for name in objectives)
         self.accelerations_ms2 = tuple(float(a) for a in accelerations_ms2)
         phase_runs(np.zeros((1, 3)), self.accelerations_ms2, 1.0)  # validates the accelerations
         self.n_bits = int(n_bits)
@@ -233,17 +238,16 @@ class KinematicPhasesProblem(Problem):
                                  f"one per objective {objectives}")
             if scales is None:
                 default = {"energy": self.mass_kg * 0.5 * v_top ** 2 / _J_PER_KWH,
-                           "jerk": sum(abs(np.diff([0.0, *a, 0.0]))),
+                           "accel_variation": sum(abs(np.diff([0.0, *a, 0.0]))),
                            "stop_error": 0.25, "time_error": 0.05 * case.planned_time_s}
-                scales = [default[name] for name in objectives]
+                scales = [default[key] for key in self._keys]
             sc = np.asarray(scales, dtype=float)
             if sc.shape != w.shape or not np.all(sc > 0):
                 raise ValueError(f"scales = {list(sc)!r}: need {len(objectives)} positive values")
             self.weights, self.scales = w, sc
-        if "jerk" in objectives and self.min_phase_s > 0:
-            from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning
-
-            warnings.warn("objective jerk is constant in the kinematic phase model: with fixed accelerations and "
+        if "accel_variation" in self._keys and self.min_phase_s > 0:
+            warnings.warn(f"objective {objectives[self._keys.index('accel_variation')]} (comfort, sum |a_i - a_(i-1)|) "
+                          "is constant in the kinematic phase model: with fixed accelerations and "
                           "every phase held for min_phase_s it is the same sum |a_i - a_(i-1)| for every decision",
                           ConstantObjectiveWarning, stacklevel=2)
 
@@ -277,7 +281,7 @@ class KinematicPhasesProblem(Problem):
 
     def indices(self, runs: PhaseRuns) -> dict[str, np.ndarray]:
         """The four indices of section 1 by objective name."""
-        return {"energy": runs.energy_index_kwh, "jerk": runs.comfort_ms2,
+        return {"energy": runs.energy_index_kwh, "accel_variation": runs.comfort_ms2,
                 "stop_error": np.abs(runs.stop_position_m - self.length_m),
                 "time_error": np.abs(runs.running_time_s - self.case.planned_time_s)}
 
@@ -301,7 +305,7 @@ class KinematicPhasesProblem(Problem):
     def _evaluate(self, x, out, *args, **kwargs):
         runs = self.runs(x)
         idx = self.indices(runs)
-        F = np.column_stack([idx[name] for name in self.objectives])
+        F = np.column_stack([idx[key] for key in self._keys])
         if self.weights is not None:
             F = ((F / self.scales) @ self.weights)[:, None]
         out["F"] = F
@@ -360,7 +364,7 @@ def grid_optimum(problem: KinematicPhasesProblem, step_m: float = 1.0) -> tuple[
         L = np.column_stack([t[keep], c[keep], coast[keep]])
         runs = phase_runs(L, problem.accelerations_ms2, problem.mass_kg)
         idx = problem.indices(runs)
-        F = np.column_stack([idx[name] for name in problem.objectives])
+        F = np.column_stack([idx[canonical_objective(name)] for name in problem.objectives])
         f = (F / problem.scales) @ problem.weights
         G = np.column_stack([problem.min_phase_s - runs.duration_s, problem.limit_excess_ms(runs)])
         f[(G > 0).any(axis=1)] = np.inf

@@ -9,7 +9,7 @@ A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applie
 cell midpoint passes ``end_m``. Modes:
 
 - ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
-  by partial traction (the speed-code connection strategy of seed 000 fig. 4-5). It never brakes:
+  by partial traction (the speed-code connection strategy of Liu (2019) fig. 4-5). It never brakes:
   where coasting accelerates (a steep descent) the train runs above the target until a limit's
   braking envelope stops it;
 - ``MODE_TRACTION``: maximum traction (speed limits still hold);
@@ -39,6 +39,7 @@ from numba import njit, prange
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
+    landing_force,
     max_braking,
     max_traction,
 )
@@ -46,8 +47,10 @@ from pymoo_rail.sim.physics import (
 MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
 MODE_DECEL = 6
 MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake", "decel")
-REGIME_TRACTION, REGIME_CRUISE, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
-REGIME_NAMES = ("traction", "cruise", "coast", "brake")
+REGIME_TRACTION, REGIME_HOLD, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
+REGIME_CRUISE = REGIME_HOLD  # the older name of the same regime
+# "hold": the speed is held (partial traction or braking); one word in every output and doc
+REGIME_NAMES = ("traction", "hold", "coast", "brake")
 
 # Columns of a run summary.
 OUT_TRACTION_KWH = 0
@@ -136,25 +139,8 @@ def _share_above(v0, v1, v_cut):
     return (hi * hi - v_cut * v_cut) / (hi * hi - lo * lo)
 
 
-@njit(cache=True, inline="always")
-def _landing_force(m, v0, v1, cell):
-    """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
-
-    Returns (force, W0, feasible): feasible is False when the force exceeds what the train has.
-    The tolerance is relative (1e-8): the braking envelope is built with the maximum braking force
-    at an iterated mid-speed, and landing on it can need that force plus a rounding residue far
-    above 1e-9 N when the force depends on speed (power caps, no deceleration cap).
-    """
-    v_mid = 0.5 * (v0 + v1)
-    w0 = davis_force(m, v_mid)
-    f = m.effective_mass_kg * (v1 * v1 - v0 * v0) / (2.0 * m.dx_m) + w0 + m.line_force_n[cell]
-    if f > 0.0:
-        f_max = max_traction(m, v_mid, cell)
-        feasible = f <= f_max + 1e-9 + 1e-8 * f_max
-    else:
-        f_max = max_braking(m, v_mid, cell)
-        feasible = -f <= f_max + 1e-9 + 1e-8 * f_max
-    return f, w0, feasible
+# the landing force lives with the braking envelope it must agree with (``physics``)
+_landing_force = landing_force
 
 
 # Slots of the running totals of a run (see ``new_totals``).
@@ -301,7 +287,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     n = m.position_m.shape[0]
     n_rows = program.shape[0]
     totals = new_totals()
-    v = 0.0
+    v = m.initial_speed_ms
     row = 0
     hold_speed = -1.0
     reached = True
@@ -309,7 +295,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     count = 1
     if record:
         tr_x[0] = 0.0
-        tr_v[0] = 0.0
+        tr_v[0] = v
         tr_t[0] = 0.0
     for i in range(n - 1):
         x_mid = m.position_m[i] + 0.5 * m.dx_m
@@ -379,8 +365,11 @@ def simulate_batch(m, programs):
     out = np.empty((n_runs, N_OUT))
     empty = np.empty(0)
     empty_r = np.empty(0, dtype=np.int8)
+    # a run-time False, not the literal: with a literal Numba compiles run_program a second time
+    # (once per value of ``record``), which doubles the first-run compile time
+    record = n_runs < 0
     for j in prange(n_runs):
-        run_program(m, programs[j], out[j], False, empty, empty, empty, empty, empty, empty_r)
+        run_program(m, programs[j], out[j], record, empty, empty, empty, empty, empty, empty_r)
     return out
 
 
@@ -395,5 +384,6 @@ def simulate_trace(m, program):
     a = np.empty(n)
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
-    count = run_program(m, program, out, True, x, v, t, a, f, r)
+    record = n >= 0  # a run-time True: one compiled run_program for both callers (see simulate_batch)
+    count = run_program(m, program, out, record, x, v, t, a, f, r)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]

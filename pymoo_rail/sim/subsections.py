@@ -1,4 +1,4 @@
-"""The subsection driver of seed 001: a run built from per-subsection operating sequences.
+"""The subsection driver of Chen et al. (2017): a run built from per-subsection operating sequences.
 
 Seed 001 (section 1) cuts the run from the station to the braking point P into subsections of one
 gradient and one limit, and gives each subsection an operating sequence (table 1):

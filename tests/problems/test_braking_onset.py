@@ -70,8 +70,12 @@ def test_bad_input():
     with pytest.raises(ValueError, match="decel_range_ms2"):
         _flat(decel_range_ms2=(0.0, 1.0))
     p = _flat()
-    with pytest.raises(ValueError, match="braking_decel_ms2"):
+    with pytest.raises(ValueError, match="-1.0"):
         p.evaluate(np.array([[500.0, -1.0]]))
+    from pymoo_rail.sim import braking_programs
+
+    with pytest.raises(ValueError, match="braking_decel_ms2"):
+        braking_programs(np.array([[500.0]]), ("traction",), np.array([-1.0]), 2000.0)
 
 
 @pytest.mark.slow

@@ -68,8 +68,10 @@ def test_exact_stop_coast_and_constraints():
 
 
 def test_jerk_is_named_constant_and_bad_input():
-    with pytest.warns(ConstantObjectiveWarning, match="jerk"):
+    with pytest.warns(ConstantObjectiveWarning, match="accel_variation"):
         KinematicPhasesProblem(load_case("metro-a"))
+    with pytest.warns(ConstantObjectiveWarning, match="jerk"):  # the paper's name, an alias
+        KinematicPhasesProblem(load_case("metro-a"), objectives=("energy", "jerk"))
     with pytest.raises(ValueError, match="accelerations_ms2"):
         _problem(accelerations_ms2=(1.0, 0.0, -0.033, 0.5))
     with pytest.raises(ValueError, match="weights"):
