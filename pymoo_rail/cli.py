@@ -132,7 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
             examples:
               pymoo-rail optimize yizhuang --out out/
               pymoo-rail optimize yizhuang --algorithm grnsga2 --pop-size 60 --n-gen 80 --out out/gr
-              pymoo-rail optimize metro-a --objectives energy accel_variation stop_error time_error --out out/m4
+              pymoo-rail optimize metro-a --objectives energy accel_variation stop_error time_error --encoding braking_onset --out out/m4
               pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc"""))
     p.add_argument("case", metavar="CASE", help="built-in case name (see 'pymoo-rail cases') or a .toml case file")
     p.add_argument("--algorithm", "-a", default="nsga2", metavar="NAME", help="optimisation algorithm")
@@ -141,8 +141,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--objectives", "-o", nargs="+", default=["energy", "time_error"], metavar="NAME",
                    help="objectives to minimise")
     p.add_argument("--seed", "-s", type=_seed, default=1, help="random seed (same seed, same result)")
-    p.add_argument("--encoding", default="speed_codes", choices=["speed_codes", "switching_points"],
-                   help="decision variables: a speed code per section, or regime switching positions")
+    p.add_argument("--encoding", default="speed_codes", choices=["speed_codes", "switching_points", "braking_onset"],
+                   help="decision variables: a speed code per section, regime switching positions, or "
+                        "phases with the braking onset and deceleration (a live stop error)")
     p.add_argument("--partition", default="gradient_limit", choices=["gradient_limit", "equal"],
                    help="sections of the speed-code encoding")
     p.add_argument("--n-sections", type=_positive_int, default=None, metavar="N",
