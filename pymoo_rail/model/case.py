@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass, replace
 
 from pymoo_rail.model.curves import KMH_PER_MS
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
@@ -26,7 +26,7 @@ class Case:
     """Everything an optimisation needs: the train, the line, the planned running time.
 
     ``legs`` is empty for a single stop-to-stop run; multi-section cases (e.g. the cooperative
-    pair of seed 001) list consecutive legs, and ``leg(k)`` returns each as a case of its own.
+    pair of Chen et al. (2017)) list consecutive legs, and ``leg(k)`` returns each as a case of its own.
 
     ``initial_speed_ms`` and ``final_speed_ms`` are the speeds at the start and at the end of the
     line (default 0: from standstill to a stop at the platform); a run may start and end moving,
@@ -51,13 +51,14 @@ class Case:
             raise CaseError("name", self.name, "must be a non-empty string")
         for field in ("planned_time_s", "dwell_s", "time_margin_s"):
             value = getattr(self, field)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise CaseError(f"run.{field}", value, "must be a finite number")
-            if value < 0 or (field == "planned_time_s" and value <= 0):
-                raise CaseError(f"run.{field}", value, "must be positive" if field == "planned_time_s" else "must be >= 0")
+            check_number(f"run.{field}", value, positive=field == "planned_time_s", nonneg=True)
         self._check_boundary_speeds()
         previous_end = 0.0
         for k, leg in enumerate(self.legs):
+            check_number(f"run.legs[{k}].start_m", leg.start_m, nonneg=True)
+            check_number(f"run.legs[{k}].end_m", leg.end_m, positive=True)
+            check_number(f"run.legs[{k}].planned_time_s", leg.planned_time_s, positive=True)
+            check_number(f"run.legs[{k}].dwell_s", leg.dwell_s, nonneg=True)
             if abs(leg.start_m - previous_end) > 1e-9 or leg.end_m <= leg.start_m:
                 raise CaseError(f"run.legs[{k}]", leg, "legs must be consecutive, positive-length and start at 0")
             if leg.planned_time_s <= 0:

@@ -1,8 +1,7 @@
-"""Reading and writing case files (TOML, DESIGN.md section 5)."""
+"""Reading and writing case files (TOML; the format: ``docs/case-format.md``)."""
 
 from __future__ import annotations
 
-import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -14,7 +13,7 @@ else:  # pragma: no cover - Python 3.10
 
 from pymoo_rail.model.case import Case, Leg
 from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
@@ -31,6 +30,20 @@ _SEGMENT = {"v_max_kmh", "poly"}
 _LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_sections", "gradient_model"}
 
 
+# every table of the format and the keys it may hold ("[]": each table of an array of tables)
+CASE_TABLES = {"": _TOP, "run": _RUN, "run.legs[]": _LEG, "train": _TRAIN, "train.resistance": _RESISTANCE,
+               "train.traction": _CURVE, "train.traction.segments[]": _SEGMENT, "train.braking": _BRAKING,
+               "train.braking.segments[]": _SEGMENT, "line": _LINE}
+
+
+def case_keys() -> list[str]:
+    """Every key a case file may hold, as dotted paths (``train.resistance.unit``, ``run.legs[].end_m``).
+
+    ``docs/case-format.md`` documents each of them; a test keeps the two in step.
+    """
+    return sorted(f"{table}.{key}" if table else key for table, keys in CASE_TABLES.items() for key in keys)
+
+
 def _table(data: Any, field: str, allowed: set[str], required: set[str], source: str) -> dict:
     if not isinstance(data, dict):
         raise CaseError(field, data, "must be a table", source)
@@ -44,18 +57,27 @@ def _table(data: Any, field: str, allowed: set[str], required: set[str], source:
     return data
 
 
+def _list(value: Any, field: str, source: str) -> list:
+    if not isinstance(value, list):
+        raise CaseError(field, value, f"must be an array, not {type(value).__name__}", source)
+    return value
+
+
+def _rows(value: Any, field: str, source: str) -> tuple[tuple, ...]:
+    """An array of arrays (e.g. ``[[start_m, end_m, permille], ...]``), each checked to be an array."""
+    return tuple(tuple(_list(row, f"{field}[{k}]", source)) for k, row in enumerate(_list(value, field, source)))
+
+
 def _curve(data: Any, field: str, allowed: set[str], source: str) -> ForceCurve:
     data = _table(data, field, allowed, set(), source)
     segments = None
     if "segments" in data:
         rows = []
-        for k, seg in enumerate(data["segments"]):
+        for k, seg in enumerate(_list(data["segments"], f"{field}.segments", source)):
             seg = _table(seg, f"{field}.segments[{k}]", _SEGMENT, _SEGMENT, source)
-            rows.append((float(seg["v_max_kmh"]), tuple(float(c) for c in seg["poly"])))
+            rows.append((seg["v_max_kmh"], tuple(_list(seg["poly"], f"{field}.segments[{k}].poly", source))))
         segments = tuple(rows)
-    table = None
-    if "table" in data:
-        table = tuple((float(v), float(f)) for v, f in data["table"])
+    table = _rows(data["table"], f"{field}.table", source) if "table" in data else None
     try:
         return ForceCurve(segments=segments, table=table, max_force_kn=data.get("max_force_kn"),
                           max_power_kw=data.get("max_power_kw"))
@@ -65,12 +87,7 @@ def _curve(data: Any, field: str, allowed: set[str], source: str) -> ForceCurve:
 
 def _speed_ms(run: dict, key: str) -> float:
     """A boundary speed of ``[run]`` (km/h in the file) in m/s; a bad value names the field."""
-    value = run.get(key, 0.0)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise CaseError(f"run.{key}", value, "must be a finite number of km/h")
-    if value < 0.0:
-        raise CaseError(f"run.{key}", value, "must be >= 0")
-    return value / KMH_PER_MS
+    return check_number(f"run.{key}", run.get(key, 0.0), nonneg=True) / KMH_PER_MS
 
 
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
@@ -84,7 +101,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     line = _table(data["line"], "line", _LINE, {"length_m", "gradients", "speed_limits"}, source)
     try:
         legs = tuple(Leg(**_table(leg, f"run.legs[{k}]", _LEG, {"start_m", "end_m", "planned_time_s"}, source))
-                     for k, leg in enumerate(run.get("legs", [])))
+                     for k, leg in enumerate(_list(run.get("legs", []), "run.legs", source)))
         train = Train(
             name=tr.get("name", ""),
             mass_t=tr["mass_t"], length_m=tr["length_m"], max_speed_kmh=tr["max_speed_kmh"],
@@ -101,10 +118,11 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
             regen_max_power_kw=braking.get("regen_max_power_kw"),
         )
         line_obj = Line(
-            length_m=line["length_m"], gradients=tuple(map(tuple, line["gradients"])),
-            speed_limits=tuple(map(tuple, line["speed_limits"])),
-            curves=tuple(map(tuple, line.get("curves", []))), tunnels=tuple(map(tuple, line.get("tunnels", []))),
-            neutral_sections=tuple(map(tuple, line.get("neutral_sections", []))),
+            length_m=line["length_m"], gradients=_rows(line["gradients"], "line.gradients", source),
+            speed_limits=_rows(line["speed_limits"], "line.speed_limits", source),
+            curves=_rows(line.get("curves", []), "line.curves", source),
+            tunnels=_rows(line.get("tunnels", []), "line.tunnels", source),
+            neutral_sections=_rows(line.get("neutral_sections", []), "line.neutral_sections", source),
             gradient_model=line.get("gradient_model", "train_length"),
         )
         return Case(name=data["name"], source=data.get("source", ""), description=data.get("description", ""),
@@ -116,8 +134,8 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
         if err.source is None:
             raise CaseError(err.field, err.value, err.reason, source) from None
         raise
-    except (TypeError, ValueError) as err:  # wrong types inside rows, e.g. a string where a number goes
-        raise CaseError("<entry>", None, f"malformed value: {err}", source) from None
+    except (TypeError, ValueError) as err:  # a last resort: every field above is checked by name
+        raise CaseError("case", type(err).__name__, f"malformed value: {err}", source) from None
 
 
 def read_case(path: str | Path) -> Case:
@@ -127,7 +145,7 @@ def read_case(path: str | Path) -> Case:
         with path.open("rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
-        raise CaseError("<file>", str(path), f"is not valid TOML: {err}", str(path)) from None
+        raise CaseError("toml", str(path), f"is not valid TOML: {err}", str(path)) from None
     return case_from_dict(data, source=str(path))
 
 

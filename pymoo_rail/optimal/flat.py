@@ -2,7 +2,7 @@
 
 On level track without binding speed limits the minimum-energy run for a given time is
 maximum traction to a hold speed ``V``, holding ``V``, coasting down to ``W``, maximum braking
-(seed 000 section 2.2.5; Howlett and Pudney). With time priced at ``lambda`` (plus the auxiliary
+(Liu (2019) section 2.2.5; Howlett and Pudney). With time priced at ``lambda`` (plus the auxiliary
 power ``P_aux``, which costs exactly like time), traction efficiency ``eta`` and regenerative
 braking efficiency ``eta_b``, the Hamiltonian over distance is
 ``H = f+/eta - eta_b f- + (lambda + P_aux)/v + p (f+ - f- - R(v)) / (m_eff v)``:
