@@ -334,6 +334,11 @@ class OptimalSolver:
         return self._closest(slow, fast, target, "")
 
     def _closest(self, slow: _Solve | None, fast: _Solve | None, target: float, missing: str) -> _Solve:
+        if slow is not None and fast is not None:
+            # the slope of the front at the target lies between the bracket's prices: their
+            # geometric mean (any price on a plateau of the discrete optimum gives the same run)
+            lam = math.sqrt(slow.lambda_w * fast.lambda_w)
+            slow, fast = replace(slow, lambda_w=lam), replace(fast, lambda_w=lam)
         found = [s for s in (slow, fast) if s is not None]
         best = min(found, key=lambda s: abs(s.time_s - target))
         if abs(best.time_s - target) > self.time_tol_s:
