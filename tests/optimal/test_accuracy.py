@@ -95,3 +95,22 @@ def test_refining_the_position_grid(yizhuang, yizhuang_solver):
     coarse = yizhuang_solver.profile(150.0)
     fine = OptimalSolver(yizhuang, dx_m=0.5).profile(150.0)
     assert at_time(coarse, 150.0) == pytest.approx(at_time(fine, 150.0), rel=ACCURACY)
+
+
+def test_level_track_closed_form_with_regeneration_and_boundary_speeds():
+    # Pontryagin with regeneration: braking starts at W with lambda / W + eta_b R(W) = R(V) / eta +
+    # lambda / V; the run starts and ends at 1 m/s. Only the closed form's time-energy point is
+    # compared (the DP certifies its own error; its bound must cover the difference).
+    from dataclasses import replace
+
+    case = replace(level_case(traction_efficiency=0.8, regen_efficiency=0.7), initial_speed_ms=1.0,
+                   final_speed_ms=1.0)
+    exact = flat_track_optimum(case, 300.0)
+    no_regen = flat_track_optimum(replace(case, train=replace(case.train, regen_efficiency=0.0)), 300.0)
+    assert exact.brake_speed_ms > no_regen.brake_speed_ms  # regeneration pays: coast less, brake from higher
+    assert exact.energy_kwh < no_regen.energy_kwh
+    tr = OptimalSolver(case, n_speeds=100).profile(300.0)
+    assert tr.speed_ms[0] == pytest.approx(1.0) and tr.speed_ms[-1] == pytest.approx(1.0)
+    bound = tr.summary["energy_bound_kwh"] + tr.summary["lambda_w"] / 3.6e6 * abs(tr.running_time_s - 300.0)
+    assert abs(at_time(tr, 300.0) - exact.energy_kwh) <= bound + 1e-4 * exact.energy_kwh
+    assert at_time(tr, 300.0) == pytest.approx(exact.energy_kwh, rel=1e-3)
