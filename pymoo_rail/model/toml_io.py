@@ -1,4 +1,4 @@
-"""Reading and writing case files (TOML, DESIGN.md section 5)."""
+"""Reading and writing case files (TOML; the format: ``docs/case-format.md``)."""
 
 from __future__ import annotations
 
@@ -28,6 +28,20 @@ _CURVE = {"segments", "table", "max_force_kn", "max_power_kw"}
 _BRAKING = _CURVE | {"regen_max_force_kn", "regen_max_power_kw"}
 _SEGMENT = {"v_max_kmh", "poly"}
 _LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_sections", "gradient_model"}
+
+
+# every table of the format and the keys it may hold ("[]": each table of an array of tables)
+CASE_TABLES = {"": _TOP, "run": _RUN, "run.legs[]": _LEG, "train": _TRAIN, "train.resistance": _RESISTANCE,
+               "train.traction": _CURVE, "train.traction.segments[]": _SEGMENT, "train.braking": _BRAKING,
+               "train.braking.segments[]": _SEGMENT, "line": _LINE}
+
+
+def case_keys() -> list[str]:
+    """Every key a case file may hold, as dotted paths (``train.resistance.unit``, ``run.legs[].end_m``).
+
+    ``docs/case-format.md`` documents each of them; a test keeps the two in step.
+    """
+    return sorted(f"{table}.{key}" if table else key for table, keys in CASE_TABLES.items() for key in keys)
 
 
 def _table(data: Any, field: str, allowed: set[str], required: set[str], source: str) -> dict:
