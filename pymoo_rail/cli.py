@@ -482,7 +482,7 @@ def _optimum_for(problem, trajectory, args) -> dict:
         return result
     (energy,), (bound,) = front.energy_at(t)
     gap = trajectory.energy.net_kwh - energy
-    result["message"] = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / energy:+.2f} %); "
+    result["message"] = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / abs(energy):+.2f} %); "
                          f"optimum {energy:.3f} kWh (certified within {bound:.3f} kWh, {front.certificate})")
     try:
         from pymoo_rail.optimal import optimal_profile
