@@ -1,6 +1,6 @@
 """The line on a distance grid: what the simulator and the exact solver read per step.
 
-Line resistances are per unit weight (N/kN): gradient ``i`` permille gives ``i`` N/kN (seed 000
+Line resistances are per unit weight (N/kN): gradient ``i`` permille gives ``i`` N/kN (Liu (2019)
 eq. 2-10), a curve of radius R gives ``600 / R`` (eq. 2-11), a tunnel of length Ls gives
 ``0.00013 Ls`` (eq. 2-12). With ``gradient_model = "train_length"`` they act on the train as the
 average over its length (eq. 4-14); the stations beyond both ends count as flat. Each grid cell
@@ -19,8 +19,8 @@ from pymoo_rail.model.curves import KMH_PER_MS
 from pymoo_rail.model.errors import CaseError
 from pymoo_rail.model.train import GRAVITY_MS2
 
-CURVE_RESISTANCE_A = 600.0  # seed 000 eq. 2-11, the usual value in [450, 800]
-TUNNEL_RESISTANCE_PER_M = 0.00013  # seed 000 eq. 2-12, N/kN per metre of tunnel
+CURVE_RESISTANCE_A = 600.0  # Liu (2019) eq. 2-11, the usual value in [450, 800]
+TUNNEL_RESISTANCE_PER_M = 0.00013  # Liu (2019) eq. 2-12, N/kN per metre of tunnel
 
 
 @dataclass(frozen=True, eq=False)

@@ -41,6 +41,7 @@ def as_trace(run) -> Trace:
             raise ValueError(f"trajectory table lacks column(s) {missing} (has {list(run.columns)})")
         regime = run["regime"].to_numpy()
         if regime.dtype.kind in "OUS":
+            regime = np.where(regime == "cruise", "hold", regime)  # tables written before "hold"
             unknown = sorted(set(regime) - set(REGIME_NAMES))
             if unknown:
                 raise ValueError(f"trajectory table: regime {unknown[0]!r} is unknown (known: {REGIME_NAMES})")
