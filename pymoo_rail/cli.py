@@ -118,9 +118,14 @@ def build_parser() -> argparse.ArgumentParser:
               trajectory.csv   the chosen run (the least energy within --time-tolerance, default 1 s,
                                of the planned time; else the member closest to it; for a single
                                objective the best one), one row per grid node
-              front.png        the front in objective space, the chosen member circled
-              profile.png      speed against distance over the line (limits, gradients, regimes)
-              speed_time.png   speed against time with the planned time"""),
+              front.png        the front in objective space, the chosen member circled, over the
+                               certified optimal front (energy with running time / time error)
+              profile.png      speed against distance over the line (limits, gradients, regimes),
+                               the optimal run at the chosen member's running time dashed
+              speed_time.png   speed against time with the planned time
+            and print the chosen member's gap to the optimum. Fronts with running time or time
+            error are kept inside a running-time window (--time-window; by default the minimum
+            running time to 1.3 x planned, the times a timetable planner uses)."""),
         epilog=textwrap.dedent("""\
             objectives: energy (net kWh), running_time (s), time_error (|T - T_plan|, s),
                         accel_variation (comfort: sum of |a_i - a_(i-1)|, m/s^2; alias jerk),
@@ -507,7 +512,7 @@ def _optimum_for(problem, trajectory, args) -> dict:
         return result
     (energy,), (bound,) = front.energy_at(t)
     gap = trajectory.energy.net_kwh - energy
-    result["message"] = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / energy:+.2f} %); "
+    result["message"] = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / abs(energy):+.2f} %); "
                          f"optimum {energy:.3f} kWh (certified within {bound:.3f} kWh, {front.certificate})")
     try:
         from pymoo_rail.optimal import optimal_profile
