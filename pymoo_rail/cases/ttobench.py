@@ -660,20 +660,32 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
     if j <= i:
         raise CaseError("to_stop", to_stop, f"must lie after from_stop {from_stop!r} (stop {i} at "
                                             f"{track.stops_m[i]} m) in the track's direction")
-    point_mass = tt_train.length_m is None
-    line = track.line("point_mass" if point_mass else "train_length", curve_model=curve_model,
-                      tunnel_model=tunnel_model).slice(track.stops_m[i], track.stops_m[j])
     stop_label = (lambda k: f"{stop_names[k]} (stop {k}, {track.stops_m[k]:g} m)") if stop_names else \
         (lambda k: f"stop {k} at {track.stops_m[k]:g} m")
+    return case_between(track, tt_train, track.stops_m[i], track.stops_m[j], planned_time_s, dwell_s=dwell_s,
+                        name=name or f"{track.id}[{i}-{j}]", labels=(stop_label(i), stop_label(j)),
+                        curve_model=curve_model, tunnel_model=tunnel_model)
+
+
+def case_between(track: TTOBenchTrack, tt_train: TTOBenchTrain, start_m: float, end_m: float,
+                 planned_time_s: float, *, dwell_s: float = 0.0, name: str | None = None,
+                 labels: tuple[str, str] | None = None, curve_model: str = "tang2020",
+                 tunnel_model: str = "liu2019") -> Case:
+    """The run from ``start_m`` to ``end_m`` on a read track (any positions, e.g. a journey's stops)."""
+    if not 0.0 <= start_m < end_m <= track.length_m:
+        raise CaseError("start_m, end_m", (start_m, end_m), f"must satisfy 0 <= start < end <= {track.length_m}")
+    point_mass = tt_train.length_m is None
+    line = track.line("point_mass" if point_mass else "train_length", curve_model=curve_model,
+                      tunnel_model=tunnel_model).slice(start_m, end_m)
+    a, b = labels or (f"{start_m:g} m", f"{end_m:g} m")
     model = "point mass" if point_mass else f"train of {tt_train.length_m:g} m (limits over its length)"
     source = (f"TTOBench track {track.id} ({track.metadata.get('library version', '?')}), "
-              f"{stop_label(i)} -> {stop_label(j)}; TTOBench train {tt_train.id} "
-              f"({tt_train.metadata.get('library version', '?')}); {model}; converted by "
-              f"pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
-    return Case(name=name or f"{track.id}[{i}-{j}]", train=tt_train.train, line=line,
+              f"{a} -> {b}; TTOBench train {tt_train.id} "
+              f"({tt_train.metadata.get('library version', '?')}); {model}; curves {curve_model}, tunnels "
+              f"{tunnel_model}; converted by pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
+    return Case(name=name or f"{track.id}[{start_m:g}-{end_m:g}]", train=tt_train.train, line=line,
                 planned_time_s=planned_time_s, dwell_s=dwell_s, source=source,
-                description=f"{track.id} {stop_label(i)} -> {stop_label(j)}, {line.length_m:g} m, "
-                            f"train {tt_train.id}")
+                description=f"{track.id} {a} -> {b}, {line.length_m:g} m, train {tt_train.id}")
 
 
 # ----------------------------------------------------------------------------------------- writing
@@ -852,7 +864,7 @@ def write_pair(out_dir: str | Path, track: Mapping, train: Mapping) -> tuple[Pat
     return paths[0], paths[1]
 
 
-__all__ = ["from_ttobench", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
+__all__ = ["from_ttobench", "case_between", "TTOBenchWarning", "TUNNEL_MODELS", "CLOTHOID_PIECE_M", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
            "track_to_json", "train_to_json", "write_pair", "ttobench_id", "braking_curve", "YIZHUANG_TRACK",
            "BEIJING_SUBWAY_TRAIN", "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M", "TTOBENCH_LICENSE",
            "TTOBENCH_NOTICE", "DATA_DIR"]
