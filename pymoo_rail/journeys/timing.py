@@ -269,6 +269,80 @@ def check_windows_reachable(timed: TimedJourney) -> None:
                                       f"{q.latest_s - p.earliest_s:.1f} s")
 
 
+def _passing_times(traj: Trajectory, passing: Sequence[TimingPoint], start_m: float, depart_s: float) -> list[float]:
+    return [depart_s + _time_and_speed_at(traj, p.position_m - start_m)[0] for p in passing]
+
+
+def _violation(times: Sequence[float], passing: Sequence[TimingPoint]) -> tuple[int, float] | None:
+    """The first passing point missed: (index, signed miss in s, + late / - early)."""
+    for j, (t, p) in enumerate(zip(times, passing)):
+        if p.latest_s is not None and t > p.latest_s + TIME_TOL_S:
+            return j, t - p.latest_s
+        if p.earliest_s is not None and t < p.earliest_s - TIME_TOL_S:
+            return j, t - p.earliest_s
+    return None
+
+
+def _meet_passing_windows(solver, case, passing: Sequence[TimingPoint], start_m: float, depart_s: float,
+                          running_time_s: float, n_bisect: int) -> Trajectory:
+    """The least-energy run of one section taking ``running_time_s`` and meeting its passing windows.
+
+    One price of time per stretch between passing points (the Lagrange structure of the windows: a
+    binding latest time raises the price of every stretch before the point, a binding earliest time
+    lowers it). Starting from one price everywhere, each missed window in turn gets the ratio of
+    the prices before and after its point that puts the run on the window's bound (bisection on
+    the log of the ratio; the ``lambda`` search keeps the running time); two sweeps over the points.
+    """
+    cells_mid = 0.5 * (solver.simulator.grid.position_m[:-1] + solver.simulator.grid.position_m[1:])
+    point_x = np.array([p.position_m - start_m for p in passing])
+    log_ratio = np.zeros(len(passing))
+
+    def run(ratios):
+        # stretch before point j is priced exp(sum of log ratios of the points at or after it)
+        after = np.searchsorted(point_x, cells_mid)  # index of the first point after each cell
+        cum = np.concatenate([np.cumsum(ratios[::-1])[::-1], [0.0]])
+        solver.price_shape = np.exp(cum[after])
+        traj = solver.profile(running_time_s)
+        return traj, _passing_times(traj, passing, start_m, depart_s)
+
+    best, times = run(log_ratio)
+    for _ in range(2 * len(passing)):
+        missed = _violation(times, passing)
+        if missed is None:
+            return best
+        j, miss = missed
+        # late (miss > 0): a higher price before point j; early: a lower one
+        lo, hi = (log_ratio[j], log_ratio[j] + 8.0) if miss > 0 else (log_ratio[j] - 8.0, log_ratio[j])
+        bound = passing[j].latest_s if miss > 0 else passing[j].earliest_s
+        found = None
+        for _ in range(n_bisect):  # keep the feasible ratio closest to the window's bound
+            mid = 0.5 * (lo + hi)
+            trial = log_ratio.copy()
+            trial[j] = mid
+            traj, t = run(trial)
+            still_late, still_early = t[j] > bound + TIME_TOL_S, t[j] < bound - TIME_TOL_S
+            if miss > 0:
+                if still_late:
+                    lo = mid
+                else:
+                    found, hi = (trial, traj, t), mid
+            else:
+                if still_early:
+                    hi = mid
+                else:
+                    found, lo = (trial, traj, t), mid
+            if found is not None and abs(found[2][j] - bound) <= TIME_TOL_S:
+                break
+        if found is None:
+            raise TimingError(f"timing point at {passing[j].position_m} m", bound,
+                              "no price of time before it meets the window at this section's running time")
+        log_ratio, best, times = found
+    if _violation(times, passing) is not None:
+        j, _ = _violation(times, passing)
+        raise TimingError(f"timing point at {passing[j].position_m} m", times[j], "missed after the price search")
+    return best
+
+
 def solve_timed_journey(timed: TimedJourney, *, n_bisect: int = 12, **settings) -> TimedRun:
     """The least-energy run of the journey that meets every timing point (exact solver per section).
 
@@ -298,35 +372,7 @@ def solve_timed_journey(timed: TimedJourney, *, n_bisect: int = 12, **settings) 
         if t_hi < t_lo:
             raise TimingError(f"section {k} arrival", arr_point, f"needs a running time <= {t_hi:.1f} s; the "
                                                                  f"minimum is {t_min:.1f} s")
-        # Energy falls as the running time grows: take the longest running time whose run meets the
-        # passing windows; a run passing too early needs a longer time, one passing too late a shorter.
-        def run(time_s):
-            traj = solver.profile(time_s)
-            late = early = None
-            for p in passing:
-                tau, _ = _time_and_speed_at(traj, p.position_m - timed.journey.stops_m[k])
-                t = depart + tau
-                if p.latest_s is not None and t > p.latest_s + TIME_TOL_S:
-                    late = p
-                if p.earliest_s is not None and t < p.earliest_s - TIME_TOL_S:
-                    early = p
-            return traj, late, early
-
-        best, late, early = run(t_hi)
-        if late is not None:
-            lo, hi = t_lo, t_hi
-            best_lo, late_lo, early_lo = run(lo)
-            if late_lo is not None:
-                raise TimingError(f"timing point at {late_lo.position_m} m", late_lo.latest_s,
-                                  "is passed too late even by the fastest run inside the arrival window")
-            best = best_lo
-            for _ in range(n_bisect):
-                mid = 0.5 * (lo + hi)
-                traj, late_mid, _ = run(mid)
-                if late_mid is None:
-                    lo, best = mid, traj
-                else:
-                    hi = mid
+        best = _meet_passing_windows(solver, case, passing, timed.journey.stops_m[k], depart, t_hi, n_bisect)
         trajectories.append(best)
         departures.append(depart)
         arrival_prev = depart + best.running_time_s

@@ -92,11 +92,15 @@ class OptimalSolver:
         Controls within this many joules of the best count as tied, and the forward run then keeps
         its regime: it removes chattering between coasting and partial traction at a measured cost
         below 0.02 % (``docs/optimal.md``).
+    price_shape : array (n_cells,), optional
+        Relative price of time per grid cell, scaled by the ``lambda`` search: a journey's timing
+        points give each stretch between them its own price (``pymoo_rail.journeys.timing``).
     """
 
     def __init__(self, case: Case, dx_m: float | None = None, n_speeds: int = DEFAULT_N_SPEEDS,
                  max_targets: int = DEFAULT_MAX_TARGETS, time_tol_s: float = DEFAULT_TIME_TOL_S,
-                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J):
+                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J,
+                 price_shape: np.ndarray | None = None):
         if isinstance(n_speeds, bool) or not isinstance(n_speeds, (int, np.integer)) or n_speeds < 3:
             raise ValueError(f"n_speeds = {n_speeds!r}: must be an integer >= 3")
         if isinstance(max_targets, bool) or not isinstance(max_targets, (int, np.integer)) or max_targets < 1:
@@ -116,6 +120,14 @@ class OptimalSolver:
         self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
         self._min_time_s: float | None = None
         self.n_solves = 0  # DP solves so far (for benchmarks)
+        # Relative price of time per cell (timing points give each stretch its own price); the
+        # lambda search scales it. None: one price everywhere.
+        self.price_shape = None
+        if price_shape is not None:
+            shape = np.asarray(price_shape, dtype=float)
+            if shape.shape != (self.simulator.grid.n_nodes - 1,) or not np.all(np.isfinite(shape) & (shape > 0)):
+                raise ValueError(f"price_shape: needs {self.simulator.grid.n_nodes - 1} finite values > 0, one per cell")
+            self.price_shape = shape
 
     @property
     def dx_m(self) -> float:
@@ -132,7 +144,8 @@ class OptimalSolver:
         if self._tables is None:
             self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
         self.n_solves += 1
-        run = dp.solve(self.simulator.model, self._tables, lambda_w, self.max_targets, self.top_bias, self.tie_j,
+        prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
+        run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, self.tie_j,
                        self._value)
         return self._record(lambda_w, run)
 
@@ -309,7 +322,7 @@ class OptimalSolver:
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
                                    f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
-                                  self.top_bias, self.tie_j)
+                                  self.top_bias, self.tie_j, self.price_shape)
             return finer.profile(running_time_s, solution.lambda_w)
         return self.trajectory(solution)
 
