@@ -475,6 +475,31 @@ def _etcs(entry: Any, required: Sequence[str], source: str) -> None:
                                "braking forces and deceleration cap, not by ETCS braking curves", source)
 
 
+_TIME_S = {"s": (1.0, 1.0), "min": (60.0, 1.0)}
+_JOURNEY_COLUMNS = (("position", _LENGTH), ("lower time constraint", _TIME_S), ("upper time constraint", _TIME_S),
+                    ("lower speed constraint", _SPEED_KMH), ("upper speed constraint", _SPEED_KMH))
+
+
+def read_journey(source: Source) -> tuple[str, str | None, list[tuple[float | None, ...]], dict, str]:
+    """Read a TTOBench journey file: ``(id, associated track id, rows, metadata, label)``.
+
+    Each row is ``(position_m, earliest_s, latest_s, min_kmh, max_kmh)`` in these units, ``None``
+    where the file has ``null``. The timing-point rules are checked by
+    :func:`pymoo_rail.journeys.read_timing_points`.
+    """
+    data, label = _load(source, "journey")
+    _check_keys(data, ("metadata", "timing points"), set(), "journey", label)
+    factors, values = _table_entry(data["timing points"], "timing points", _JOURNEY_COLUMNS, label)
+    rows = []
+    for k, row in enumerate(values):
+        field = f"timing points.values[{k}]"
+        if row[0] is None:
+            raise CaseError(field, row, "a timing point needs a position", label)
+        rows.append(tuple(None if v is None else _convert(_number(field, v, label), f) for v, f in zip(row, factors)))
+    meta = dict(data["metadata"])
+    return meta["id"], meta.get("associated track"), rows, meta, label
+
+
 @dataclass(frozen=True)
 class TTOBenchTrain:
     """A TTOBench train file converted to a :class:`Train`, with what the model does not store."""
@@ -864,7 +889,7 @@ def write_pair(out_dir: str | Path, track: Mapping, train: Mapping) -> tuple[Pat
     return paths[0], paths[1]
 
 
-__all__ = ["from_ttobench", "case_between", "TTOBenchWarning", "TUNNEL_MODELS", "CLOTHOID_PIECE_M", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
+__all__ = ["from_ttobench", "case_between", "read_journey", "TTOBenchWarning", "TUNNEL_MODELS", "CLOTHOID_PIECE_M", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
            "track_to_json", "train_to_json", "write_pair", "ttobench_id", "braking_curve", "YIZHUANG_TRACK",
            "BEIJING_SUBWAY_TRAIN", "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M", "TTOBENCH_LICENSE",
            "TTOBENCH_NOTICE", "DATA_DIR"]

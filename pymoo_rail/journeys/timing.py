@@ -63,28 +63,19 @@ class TimingPoint:
             (self.max_speed_kmh is None or speed_kmh <= self.max_speed_kmh + tol_kmh)
 
 
-_UNITS = {"position": ttobench._LENGTH, "lower time constraint": {"s": (1.0, 1.0), "min": (60.0, 1.0)},
-          "upper time constraint": {"s": (1.0, 1.0), "min": (60.0, 1.0)},
-          "lower speed constraint": ttobench._SPEED_KMH, "upper speed constraint": ttobench._SPEED_KMH}
-
-
 def read_timing_points(source: ttobench.Source) -> tuple[str, str | None, tuple[TimingPoint, ...], dict]:
     """Read a TTOBench journey file: ``(id, associated track id, timing points, metadata)``.
 
     Checks the rules of the TTOBench journey format (ordered positions, equal positions only for an
     arrival/departure pair of stopping points, first and last points stops, lower <= upper bounds).
     """
-    data, label = ttobench._load(source, "journey")
-    ttobench._check_keys(data, ("metadata", "timing points"), set(), "journey", label)
-    meta = data["metadata"]
-    factors, values = ttobench._table_entry(data["timing points"], "timing points", list(_UNITS.items()), label)
+    journey_id, track_id, rows, meta, label = ttobench.read_journey(source)
+    values = [list(r) for r in rows]
     points = []
-    for k, row in enumerate(values):
+    for k, row in enumerate(rows):
         field = f"timing points.values[{k}]"
-        pos = ttobench._convert(ttobench._number(field, row[0], label), factors[0])
-        rest = [None if v is None else ttobench._convert(ttobench._number(field, v, label), f)
-                for v, f in zip(row[1:], factors[1:])]
-        point = TimingPoint(pos, *rest)
+        pos = row[0]
+        point = TimingPoint(*row)
         for lo, hi, what in ((point.earliest_s, point.latest_s, "time"),
                              (point.min_speed_kmh, point.max_speed_kmh, "speed")):
             if lo is not None and hi is not None and lo > hi:
@@ -103,7 +94,7 @@ def read_timing_points(source: ttobench.Source) -> tuple[str, str | None, tuple[
         if not points[k].is_stop:
             raise CaseError(f"timing points.values[{k}]", values[k], "the first and last timing points must be "
                                                                     "stops (both speed constraints 0)", label)
-    return meta["id"], meta.get("associated track"), tuple(points), dict(meta)
+    return journey_id, track_id, tuple(points), meta
 
 
 @dataclass(frozen=True)
@@ -153,7 +144,7 @@ def timed_journey_from_ttobench(journey_path: ttobench.Source, track_path: ttobe
     tt_train = ttobench.read_train(train_path, train_length_m=train_length_m)
     sections, dwell = [], []
     for k, group in enumerate(merged):
-        planned = _latest(group[-1]) - _earliest(group[0])
+        planned = window_end_s(group[-1]) - window_start_s(group[0])
         if not math.isfinite(planned):
             planned = 1.0  # no window: the solver picks the time
         case = ttobench.case_between(track, tt_train, stops[k], stops[k + 1], max(planned, 1.0),
@@ -162,17 +153,19 @@ def timed_journey_from_ttobench(journey_path: ttobench.Source, track_path: ttobe
         sections.append(case)
         if k > 0:
             arrival = merged[k - 1][-1]
-            dwell.append(max(0.0, _earliest(group[0]) - _latest(arrival)))
+            dwell.append(max(0.0, window_start_s(group[0]) - window_end_s(arrival)))
     journey = Journey(name=journey_id, sections=tuple(sections), dwell_s=tuple(dwell),
                       stops_m=tuple(stops), source=sections[0].source)
     return TimedJourney(journey=journey, windows=tuple(tuple(g) for g in merged))
 
 
-def _earliest(point: TimingPoint) -> float:
+def window_start_s(point: TimingPoint) -> float:
+    """The earliest time of a timing point, 0 when it has none."""
     return point.earliest_s if point.earliest_s is not None else 0.0
 
 
-def _latest(point: TimingPoint) -> float:
+def window_end_s(point: TimingPoint) -> float:
+    """The latest time of a timing point, infinity when it has none."""
     return point.latest_s if point.latest_s is not None else math.inf
 
 
@@ -357,16 +350,16 @@ def solve_timed_journey(timed: TimedJourney, *, n_bisect: int = 12, **settings) 
     for k, group in enumerate(timed.windows):
         case = timed.journey.sections[k]
         dep_point, arr_point, passing = group[0], group[-1], group[1:-1]
-        depart = max(_earliest(dep_point), arrival_prev)
-        if depart > _latest(dep_point) + 1e-9:
+        depart = max(window_start_s(dep_point), arrival_prev)
+        if depart > window_end_s(dep_point) + 1e-9:
             raise TimingError(f"section {k} departure", depart, f"the train arrives at {arrival_prev:.1f} s, "
                                                                 f"after the departure window ends ({dep_point.latest_s} s)")
         solver = OptimalSolver(case, **settings)
         t_min = solver.min_running_time_s()
-        t_hi = _latest(arr_point) - depart
+        t_hi = window_end_s(arr_point) - depart
         if k + 1 < len(timed.windows):  # arriving after the next departure window closes is useless
-            t_hi = min(t_hi, _latest(timed.windows[k + 1][0]) - depart)
-        t_lo = max(_earliest(arr_point) - depart, t_min)
+            t_hi = min(t_hi, window_end_s(timed.windows[k + 1][0]) - depart)
+        t_lo = max(window_start_s(arr_point) - depart, t_min)
         if not math.isfinite(t_hi):
             t_hi = 1.5 * t_min
         if t_hi < t_lo:

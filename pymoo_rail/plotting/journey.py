@@ -21,10 +21,14 @@ def plot_timed_run(timed, run):
     t_top = max(c["time_s"] for c in run.checks) * 1.05
     for c in run.checks:
         x = c["position_m"] / 1000
+        if c["earliest_s"] is None and c["latest_s"] is None:
+            continue  # a speed bound only
         lo = c["earliest_s"] if c["earliest_s"] is not None else 0.0
         hi = c["latest_s"] if c["latest_s"] is not None else t_top
         ax_t.plot([x, x], [lo, hi], color="C3", lw=4, alpha=0.5, solid_capstyle="butt")
         ax_t.plot(x, c["time_s"], "o", color="k" if c["time_ok"] else "C3", ms=4)
+    for c in run.checks:
+        x = c["position_m"] / 1000
         if c["min_speed_kmh"] is not None and c["min_speed_kmh"] > 0:
             ax_v.plot(x, c["min_speed_kmh"], "^", color="C3")
         if c["max_speed_kmh"] is not None and c["max_speed_kmh"] > 0:

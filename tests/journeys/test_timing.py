@@ -131,3 +131,20 @@ def test_stgallen_wil_with_a_reachable_window_at_20000_m_is_solved_within_every_
     assert [c["time_ok"] and c["speed_ok"] for c in run.checks] == [True] * 6
     for traj in run.trajectories:
         assert traj.reached and traj.speed_ms[-1] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_metaheuristic_form_meets_the_windows_it_reports_feasible():
+    from pymoo.algorithms.soo.nonconvex.ga import GA
+    from pymoo.optimize import minimize
+
+    from pymoo_rail.journeys.timed_problem import TimedSectionProblem
+
+    t = timed(_yizhuang_journey([[15757, 0, 0, 0, 0], [16857, None, 90, 20, None], [18022, 150, 170, 0, 0]]),
+              YIZHUANG, BEIJING)
+    problem = TimedSectionProblem(t, 0)
+    assert problem.n_ieq_constr == 2 + 4  # limits, stop; latest and min speed at 16857 m, arrival window
+    res = minimize(problem, GA(pop_size=16), ("n_gen", 4), seed=2)
+    assert res.X is not None
+    traj = problem.trajectory(res.X)
+    t_pass = float(np.interp(1100.0, traj.position_m, traj.time_s))
+    assert t_pass <= 90.0 and 150.0 <= traj.running_time_s <= 170.0
