@@ -2,8 +2,8 @@
 
 Usage: python benchmarks/ttobench_release.py [TTOBENCH_ROOT] [--nsga2-gen N] [--only ID ...]
 Prints one row per track (first stop -> last stop): length, minimum running time, the exact
-optimum's energy at 1.15 x that time, NSGA2's best feasible energy within 1 % of that time
-(pop 40, N generations, seed 1), the gap, and the CPU seconds of each step.
+optimum's energy at 1.15 x that time, NSGA2's best feasible energy
+(pop 40, N generations, seed 1) among members within 2 s of the planned time, the gap, and the CPU seconds of each step.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ from pymoo_rail.cases.ttobench_release import release_pairs
 from pymoo_rail.optimal import min_running_time, optimal_profile
 from pymoo_rail.problems import SpeedProfileProblem
 
+TIME_TOL_S = 2.0  # NSGA2 members this close to the planned time count as punctual
 DEFAULT_ROOT = Path(__file__).resolve().parents[1] / "tests" / "data" / "ttobench"
 
 
@@ -30,6 +31,9 @@ def main() -> None:
     parser.add_argument("root", nargs="?", default=DEFAULT_ROOT)
     parser.add_argument("--nsga2-gen", type=int, default=60)
     parser.add_argument("--only", nargs="*")
+    parser.add_argument("--max-section-m", type=float, default=None,
+                        help="speed-code sections no longer than this (default: the encoding's default)")
+    parser.add_argument("--pop-size", type=int, default=40)
     args = parser.parse_args()
     print("| track | train | km | T_min s | optimum kWh @1.15 | CPU s | NSGA2 kWh | gap % | n_var | CPU s |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -44,11 +48,12 @@ def main() -> None:
         case = case.with_planned_time(1.15 * t_min)
         best = optimal_profile(case, case.planned_time_s)
         t1 = time.process_time()
-        problem = SpeedProfileProblem(case, objectives=("energy", "time_error"))
-        res = minimize(problem, NSGA2(pop_size=40), ("n_gen", args.nsga2_gen), seed=1)
+        settings = {} if args.max_section_m is None else {"max_section_m": args.max_section_m}
+        problem = SpeedProfileProblem(case, objectives=("energy", "time_error"), **settings)
+        res = minimize(problem, NSGA2(pop_size=args.pop_size), ("n_gen", args.nsga2_gen), seed=1)
         t2 = time.process_time()
         F = res.F if res.F is not None else np.empty((0, 2))
-        close = F[F[:, 1] <= 0.01 * case.planned_time_s]
+        close = F[F[:, 1] <= TIME_TOL_S]
         nsga = float(close[:, 0].min()) if close.size else float("nan")
         gap = 100.0 * (nsga / best.energy.net_kwh - 1.0)
         print(f"| {track.stem} | {train.stem} | {case.line.length_m / 1000:.1f} | {t_min:.1f} | "

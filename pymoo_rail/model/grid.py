@@ -107,9 +107,18 @@ def curve_resistance_n_per_kn(radius_m: float, model: str = "tang2020") -> float
     raise CaseError("line.curve_model", model, "unknown curve model (known: tang2020, roeckl)")
 
 
+FINE_DX_M, COARSE_DX_M = 1.0, 5.0
+FINE_UP_TO_M, COARSE_FROM_M = 10_000.0, 40_000.0
+
+
 def default_dx_m(case: Case) -> float:
-    """Grid step used when none is given: 1 m for metro sections, 5 m for long main-line runs."""
-    return 1.0 if case.line.length_m <= 10_000 else 5.0
+    """Grid step used when none is given: 1 m up to 10 km, 5 m from 40 km, linear in between.
+
+    The step grows with the line so that the number of cells (the cost of a run) stays between
+    8000 and 10 000 from 10 to 40 km instead of dropping fivefold at one length.
+    """
+    share = (case.line.length_m - FINE_UP_TO_M) / (COARSE_FROM_M - FINE_UP_TO_M)
+    return FINE_DX_M + (COARSE_DX_M - FINE_DX_M) * min(max(share, 0.0), 1.0)
 
 
 def build_grid(case: Case, dx_m: float | None = None) -> TrackGrid:
