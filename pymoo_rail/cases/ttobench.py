@@ -646,9 +646,16 @@ _TTOBENCH_FIELD = {
 }
 
 
+def _boundary_speed_ms(field: str, kmh: float) -> float:
+    if isinstance(kmh, bool) or not isinstance(kmh, (int, float)) or not math.isfinite(kmh) or kmh < 0.0:
+        raise CaseError(field, kmh, "must be a finite number of km/h >= 0")
+    return kmh / KMH_PER_MS
+
+
 def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to_stop: StopRef,
                   planned_time_s: float, *, dwell_s: float = 0.0, stop_names: Sequence[str] | None = None,
                   train_length_m: float | None = None, name: str | None = None,
+                  initial_speed_kmh: float = 0.0, final_speed_kmh: float = 0.0,
                   curve_model: str = "tang2020", tunnel_model: str = "liu2019") -> Case:
     """The run of a TTOBench train between two stops of a TTOBench track, as a :class:`Case`.
 
@@ -672,6 +679,9 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
         gradients averaged over it.
     name : str, optional
         Case name (default ``"<track id>[<i>-<j>]"``).
+    initial_speed_kmh, final_speed_kmh : float
+        Speeds at ``from_stop`` and ``to_stop`` (default 0: a stop at both); TTOBench benchmark
+        formulations such as the ms-eetc one start and end at a small speed (e.g. 1 m/s).
     curve_model : {"tang2020", "roeckl"}
         Curve resistance from the track's ``curvatures``: ``600 / R`` N/kN (Tang et al. (2020)) or
         Roeckl's standard-gauge formula (``docs/ttobench.md`` compares them).
@@ -689,14 +699,19 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
         (lambda k: f"stop {k} at {track.stops_m[k]:g} m")
     return case_between(track, tt_train, track.stops_m[i], track.stops_m[j], planned_time_s, dwell_s=dwell_s,
                         name=name or f"{track.id}[{i}-{j}]", labels=(stop_label(i), stop_label(j)),
-                        curve_model=curve_model, tunnel_model=tunnel_model)
+                        curve_model=curve_model, tunnel_model=tunnel_model, initial_speed_kmh=initial_speed_kmh,
+                        final_speed_kmh=final_speed_kmh)
 
 
 def case_between(track: TTOBenchTrack, tt_train: TTOBenchTrain, start_m: float, end_m: float,
                  planned_time_s: float, *, dwell_s: float = 0.0, name: str | None = None,
                  labels: tuple[str, str] | None = None, curve_model: str = "tang2020",
-                 tunnel_model: str = "liu2019") -> Case:
-    """The run from ``start_m`` to ``end_m`` on a read track (any positions, e.g. a journey's stops)."""
+                 tunnel_model: str = "liu2019", initial_speed_kmh: float = 0.0,
+                 final_speed_kmh: float = 0.0) -> Case:
+    """The run from ``start_m`` to ``end_m`` on a read track (any positions, e.g. a journey's stops).
+
+    Arguments as in :func:`from_ttobench`; ``labels`` name the two ends in the case's source.
+    """
     if not 0.0 <= start_m < end_m <= track.length_m:
         raise CaseError("start_m, end_m", (start_m, end_m), f"must satisfy 0 <= start < end <= {track.length_m}")
     point_mass = tt_train.length_m is None
@@ -710,6 +725,8 @@ def case_between(track: TTOBenchTrack, tt_train: TTOBenchTrain, start_m: float, 
               f"{tunnel_model}; converted by pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
     return Case(name=name or f"{track.id}[{start_m:g}-{end_m:g}]", train=tt_train.train, line=line,
                 planned_time_s=planned_time_s, dwell_s=dwell_s, source=source,
+                initial_speed_ms=_boundary_speed_ms("initial_speed_kmh", initial_speed_kmh),
+                final_speed_ms=_boundary_speed_ms("final_speed_kmh", final_speed_kmh),
                 description=f"{track.id} {a} -> {b}, {line.length_m:g} m, train {tt_train.id}")
 
 
