@@ -49,14 +49,19 @@ def test_the_release_is_complete_and_licensed():
     assert len(release_pairs(RELEASE)) == 16
 
 
+def read_naming_warnings(reader, path):
+    """The reader's result and the TTOBench fields its warnings name."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = reader(path)
+    return result, {str(w.message).split("'")[1] for w in caught if issubclass(w.category, TTOBenchWarning)}
+
+
 @pytest.mark.parametrize("path", TRACKS, ids=lambda p: p.stem)
 def test_every_track_imports_unedited(path):
     raw = json.loads(path.read_text())
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        track = read_track(path)
+    track, named = read_naming_warnings(read_track, path)
     assert track.stops_m == tuple(float(x) for x in raw["stops"]["values"])
-    named = {str(w.message).split("'")[1] for w in caught if issubclass(w.category, TTOBenchWarning)}
     assert named == ({"ETCS braking data"} if "ETCS braking data" in raw else set())
     if "curvatures" in raw:  # every curved stretch is there, no piece longer than a clothoid piece
         curved = [r for r in raw["curvatures"]["values"] if r[1] != "infinity" or r[2] != "infinity"]
@@ -69,10 +74,7 @@ def test_every_track_imports_unedited(path):
 @pytest.mark.parametrize("path", TRAINS, ids=lambda p: p.stem)
 def test_every_train_imports_unedited_and_names_what_is_not_modelled(path):
     raw = json.loads(path.read_text())
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        tt = read_train(path)
-    named = {str(w.message).split("'")[1] for w in caught if issubclass(w.category, TTOBenchWarning)}
+    tt, named = read_naming_warnings(read_train, path)
     assert named == {k for k in ("tunnel resistance", "ETCS braking data") if k in raw}
     assert tt.train.mass_t == pytest.approx(raw["mass"]["value"] / 1000.0)
     assert tt.train.traction_efficiency == pytest.approx(raw["efficiency traction"]["value"] / 100.0)
@@ -179,7 +181,24 @@ def test_yizhuang_one_section_end_to_end():
 @pytest.mark.slow
 @pytest.mark.parametrize("track, train", release_pairs(RELEASE), ids=lambda p: p.stem)
 def test_every_track_with_its_train_first_to_last_stop(track, train):
-    if track.stem == "CN_Songjiazhuang_Yizhuang":
-        pytest.xfail("whole line 0 -> 13: the braking envelope / landing consistency in sim/physics.py "
-                     "(the exact-reference work) is not merged yet")
+    # includes the whole Yizhuang line 0 -> 13 without stopping between (once refused: "no way to
+    # the platform beyond 5799.5 m" on the 5 m grid)
     _solve_line(track, train, n_gen=20)
+
+
+def test_long_sparse_lines_get_one_speed_code_per_km_and_dense_lines_keep_their_partition():
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.problems.encodings import SpeedCodes
+    from pymoo_rail.sim import gradient_limit_partition
+
+    reference = quietly(from_ttobench, RELEASE / "tracks" / "00_reference.json",
+                        RELEASE / "trains" / "NL_Intercity_VIRM6.json", 0, -1, 1600.0)
+    codes = SpeedCodes.build(reference)
+    assert codes.n_var == 49 and np.max(np.diff(codes.boundaries_m)) <= 1000.0  # was 1 variable
+    assert SpeedCodes.build(reference, max_section_m=5000.0).n_var == 10  # an explicit choice wins
+    for name in ("wuguang-crh3", "yizhuang"):  # sections average 1.7 km and 280 m: unchanged
+        case = load_case(name)
+        assert SpeedCodes.build(case).n_var == len(gradient_limit_partition(case.line)) - 1 + (
+            len(np.unique(np.concatenate([gradient_limit_partition(case.line),
+                                          [p for r in case.line.neutral_sections for p in r]])))
+            - len(gradient_limit_partition(case.line)))
