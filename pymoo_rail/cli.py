@@ -118,7 +118,8 @@ def build_parser() -> argparse.ArgumentParser:
               pymoo-rail optimize yizhuang --out out/
               pymoo-rail optimize yizhuang --algorithm grnsga2 --pop-size 60 --n-gen 80 --out out/gr
               pymoo-rail optimize metro-a --objectives energy jerk stop_error time_error --out out/m4
-              pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc"""))
+              pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
+              pymoo-rail optimize --track T.json --train R.json --from 0 --to -1 --time 1500 --out out/t"""))
     p.add_argument("case", metavar="CASE", nargs="?", default=None,
                    help="built-in case name (see 'pymoo-rail cases') or a .toml case file; or give --track ...")
     _add_ttobench_options(p)
@@ -161,7 +162,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "time (optimal_trajectory.csv, optimal_profile.png).",
         epilog="examples:\n  pymoo-rail reference yizhuang --out out/ref\n"
                "  pymoo-rail reference yizhuang --times 140 150 160 170 --out out/ref")
-    p.add_argument("case", metavar="CASE", help="built-in case name or a .toml case file")
+    p.add_argument("case", metavar="CASE", nargs="?", default=None,
+                   help="built-in case name or a .toml case file; or give --track ...")
+    _add_ttobench_options(p)
     p.add_argument("--times", type=_positive_float, nargs="+", default=None, metavar="S",
                    help="running times (s); default: --n-points from the minimum time to 1.3 x planned")
     p.add_argument("--n-points", type=_positive_int, default=8, metavar="N", help="number of running times")
@@ -347,7 +350,7 @@ def _add_ttobench_options(p: argparse.ArgumentParser) -> None:
                    help="departure stop: index (0, 1, ..., -1 = last) or position in m (e.g. 8500.0)")
     p.add_argument("--to", dest="to_stop", default="-1", metavar="B", help="arrival stop (as --from)")
     p.add_argument("--time", dest="planned_time", type=float, default=None, metavar="S",
-                   help="planned running time in s (default: 1.15 x the minimum running time)")
+                   help="planned running time in s; without it, 1.15 x the minimum running time")
     p.add_argument("--curve-model", default="tang2020", choices=["tang2020", "roeckl"],
                    help="curve resistance of the track's curvatures")
 
@@ -517,7 +520,7 @@ def _default_times(case, n_points: int):
 
 
 def cmd_reference(args) -> int:
-    case = _load_case("CASE", args.case)
+    case = _case_from_args(args)
     try:
         from pymoo_rail.optimal import optimal_front, optimal_profile
     except ImportError as err:
