@@ -148,10 +148,11 @@ def build_parser() -> argparse.ArgumentParser:
                     "every timing point, and write into --out: timing.csv (time and speed at every timing "
                     "point, window and check), trajectory_<k>.csv per section and journey.png.",
         epilog="example:\n  pymoo-rail journey tracks/../journeys/J.json --train trains/CH_Stadler_KISS_SBB.json")
-    p.add_argument("journey", metavar="JOURNEY", help="TTOBench journey JSON file")
+    p.add_argument("journey", metavar="JOURNEY", help="TTOBench journey JSON file, or a .toml journey "
+                                                       "(track, train and timing points, docs/ttobench.md)")
     p.add_argument("--track", default=None, metavar="T.json",
                    help="TTOBench track file (default: ../tracks/<associated track>.json next to the journey)")
-    p.add_argument("--train", required=True, metavar="R.json", help="TTOBench train file")
+    p.add_argument("--train", default=None, metavar="R.json", help="TTOBench train file (for a JSON journey)")
     p.add_argument("--curve-model", default="tang2020", choices=["tang2020", "roeckl"], help="curve resistance")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory")
 
@@ -387,19 +388,25 @@ def _case_from_args(args):
 
 
 def cmd_journey(args) -> int:
-    from pymoo_rail.journeys.timing import read_timing_points, solve_timed_journey, timed_journey_from_ttobench
+    from pymoo_rail.journeys.timing import (read_timing_points, solve_timed_journey, timed_journey_from_toml,
+                                            timed_journey_from_ttobench)
     from pymoo_rail.plotting.journey import plot_timed_run
     from pymoo_rail.plotting import save_figure
 
-    out = _out_dir(args.out)
-    track = args.track
-    if track is None:
-        _, track_id, _, _ = read_timing_points(args.journey)
-        track = Path(args.journey).resolve().parent.parent / "tracks" / f"{track_id}.json"
-    timed = timed_journey_from_ttobench(args.journey, track, args.train, curve_model=args.curve_model)
-    run = solve_timed_journey(timed)
     import pandas as pd
 
+    out = _out_dir(args.out)
+    if args.journey.endswith(".toml"):
+        timed = timed_journey_from_toml(args.journey)
+    else:
+        if args.train is None:
+            raise UsageError("--train", "a TTOBench journey file names no train: give --train R.json")
+        track = args.track
+        if track is None:
+            _, track_id, _, _ = read_timing_points(args.journey)
+            track = Path(args.journey).resolve().parent.parent / "tracks" / f"{track_id}.json"
+        timed = timed_journey_from_ttobench(args.journey, track, args.train, curve_model=args.curve_model)
+    run = solve_timed_journey(timed)
     pd.DataFrame(list(run.checks)).to_csv(out / "timing.csv", index=False)
     for k, traj in enumerate(run.trajectories):
         traj.to_frame().to_csv(out / f"trajectory_{k}.csv", index=False)

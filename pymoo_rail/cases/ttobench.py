@@ -33,10 +33,13 @@ Mapping decisions (the full table is in ``docs/ttobench.md``):
   mass is a train of :data:`POINT_MASS_LENGTH_M` (1 mm) with ``gradient_model = "point_mass"``.
 - Efficiencies absent (TTOBench allows omitting both) give traction efficiency 1 and no regen,
   so net energy is the traction work at the wheel.
-- Not represented (a :class:`CaseError` if present and not trivial): track ``curvatures`` with a
-  finite radius and ``tunnels`` (TTOBench's tunnel drag depends on cross-section and speed; the
-  model's tunnel term does not). Informational train fields (``num seats``, ``num coaches``,
-  ``tunnel resistance``, ``ETCS braking data``) are accepted and not used.
+- Curvatures become ``line.curves`` (clothoids cut into pieces of at most 5 m), with the curve
+  resistance the caller picks (``curve_model``: ``"tang2020"`` 600 / R, or ``"roeckl"``);
+  tunnels become ``line.tunnels`` (``tunnel_model``: Liu (2019) eq. 2-12, or ``"none"``).
+- Read and checked but not modelled, each named in a :class:`TTOBenchWarning`: ``ETCS braking
+  data`` (tracks and trains) and the trains' speed-dependent ``tunnel resistance``. ``num seats``
+  and ``num coaches`` are kept on :class:`TTOBenchTrain`. An efficiency map (not part of the
+  released format) is a :class:`CaseError`.
 
 The TTOBench files shipped in ``pymoo_rail/cases/data/`` (Yizhuang line and Beijing subway train)
 are copies under the BSD 2-Clause license; the notice is in ``data/TTOBENCH_LICENSE``.

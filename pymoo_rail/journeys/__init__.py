@@ -33,6 +33,7 @@ from pymoo_rail.journeys.timing import (
     TimingPoint,
     read_timing_points,
     solve_timed_journey,
+    timed_journey_from_toml,
     timed_journey_from_ttobench,
 )
 from pymoo_rail.journeys.timed_problem import TimedSectionProblem
@@ -42,4 +43,4 @@ __all__ = ["Journey", "Allocation", "allocate_running_time", "allocate_on_fronts
            "section_fronts", "marginal_slopes", "strategy_front", "strategy_programs", "convex_front",
            "check_front", "front_energy", "front_slopes", "RunningTimeAllocationProblem", "BudgetRepair",
            "project_to_budget", "DEFAULT_FRONT_SOURCE", "TimingPoint", "TimedJourney", "TimedRun", "TimingError",
-           "read_timing_points", "timed_journey_from_ttobench", "solve_timed_journey", "TimedSectionProblem"]
+           "read_timing_points", "timed_journey_from_ttobench", "timed_journey_from_toml", "solve_timed_journey", "TimedSectionProblem"]

@@ -159,6 +159,48 @@ def timed_journey_from_ttobench(journey_path: ttobench.Source, track_path: ttobe
     return TimedJourney(journey=journey, windows=tuple(tuple(g) for g in merged))
 
 
+_TOML_TOP = {"name", "track", "train", "curve_model", "tunnel_model", "train_length_m", "timing_points"}
+_TOML_POINT = ("position_m", "earliest_s", "latest_s", "min_speed_kmh", "max_speed_kmh")
+
+
+def timed_journey_from_toml(path: str | Path) -> TimedJourney:
+    """A journey with timing points from a TOML file (TTOBench track and train files beside it).
+
+    ``name``, ``track`` and ``train`` (paths relative to the file), optional ``curve_model``,
+    ``tunnel_model``, ``train_length_m``, and one ``[[timing_points]]`` table per point with
+    ``position_m`` and any of ``earliest_s``, ``latest_s``, ``min_speed_kmh``, ``max_speed_kmh``
+    (a stop has both speeds 0). The rules are those of TTOBench journey files.
+    """
+    from pymoo_rail.model.toml_io import tomllib
+
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as err:
+        raise CaseError("<file>", str(path), f"cannot read the journey file: {err}", str(path)) from None
+    for key in sorted(set(data) - _TOML_TOP):
+        raise CaseError(key, data[key], f"unknown key (allowed: {', '.join(sorted(_TOML_TOP))})", str(path))
+    for key in ("name", "track", "train", "timing_points"):
+        if key not in data:
+            raise CaseError(key, None, "is required", str(path))
+    rows = []
+    for k, point in enumerate(data["timing_points"]):
+        if not isinstance(point, dict) or "position_m" not in point:
+            raise CaseError(f"timing_points[{k}].position_m", None, "is required", str(path))
+        for key in sorted(set(point) - set(_TOML_POINT)):
+            raise CaseError(f"timing_points[{k}].{key}", point[key],
+                            f"unknown key (allowed: {', '.join(_TOML_POINT)})", str(path))
+        rows.append([point.get(key) for key in _TOML_POINT])
+    journey = {"metadata": {"id": data["name"]},
+               "timing points": {"units": {"position": "m", "lower time constraint": "s",
+                                           "upper time constraint": "s", "lower speed constraint": "km/h",
+                                           "upper speed constraint": "km/h"}, "values": rows}}
+    return timed_journey_from_ttobench(journey, path.parent / data["track"], path.parent / data["train"],
+                                       train_length_m=data.get("train_length_m"),
+                                       curve_model=data.get("curve_model", "tang2020"),
+                                       tunnel_model=data.get("tunnel_model", "liu2019"))
+
+
 def window_start_s(point: TimingPoint) -> float:
     """The earliest time of a timing point, 0 when it has none."""
     return point.earliest_s if point.earliest_s is not None else 0.0

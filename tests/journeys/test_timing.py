@@ -148,3 +148,26 @@ def test_metaheuristic_form_meets_the_windows_it_reports_feasible():
     traj = problem.trajectory(res.X)
     t_pass = float(np.interp(1100.0, traj.position_m, traj.time_s))
     assert t_pass <= 90.0 and 150.0 <= traj.running_time_s <= 170.0
+
+
+def test_toml_journey_reads_like_the_ttobench_file(tmp_path):
+    from pymoo_rail.journeys import timed_journey_from_toml
+
+    rows = json.loads(JOURNEY.read_text())["timing points"]["values"]
+    keys = ("position_m", "earliest_s", "latest_s", "min_speed_kmh", "max_speed_kmh")
+    text = f'name = "StGallen_Wil_toml"\ntrack = "{TRACK}"\ntrain = "{KISS}"\n'
+    for row in rows:
+        text += "\n[[timing_points]]\n" + "".join(f"{k} = {float(v)}\n" for k, v in zip(keys, row) if v is not None)
+    path = tmp_path / "j.toml"
+    path.write_text(text)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TTOBenchWarning)
+        from_toml = timed_journey_from_toml(path)
+    from_json = timed(JOURNEY)
+    assert from_toml.windows == from_json.windows
+    for a, b in zip(from_toml.journey.sections, from_json.journey.sections):
+        assert (a.line, a.train) == (b.line, b.train)
+    path.write_text(text + "\n[[timing_points]]\nposition_m = 29600.0\nwhen = 3\n")
+    with pytest.raises(CaseError, match="unknown key") as err:
+        timed_journey_from_toml(path)
+    assert err.value.field == "timing_points[6].when"
