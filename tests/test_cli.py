@@ -37,7 +37,7 @@ def test_cases_lists_and_describes(capsys):
     for name in list_cases():
         assert name in out
     yizhuang = next(line for line in out.splitlines() if line.startswith("yizhuang"))
-    assert "2,265 m" in yizhuang and "150 s" in yizhuang and "seed 000" in yizhuang  # seed 000, 5.1
+    assert "2,265 m" in yizhuang and "150 s" in yizhuang and "Liu (2019)" in yizhuang  # Liu (2019), 5.1
     code, out, _ = run(capsys, "cases", "yizhuang")
     assert code == 0 and "2,265.0 m in 150 s planned" in out and "194.295 t" in out and "-8" in out
 

@@ -1,4 +1,4 @@
-"""Multi-objective Artificial Bee Colony (MOABC) of seed 000, section 4.5.2.
+"""Multi-objective Artificial Bee Colony (MOABC) of Liu (2019), section 4.5.2.
 
 Pareto-dominance greedy choice, onlooker fitness ``dom(i) / N``, an external archive of
 non-dominated solutions truncated by crowding distance, and a neighbour search guided by
@@ -98,7 +98,7 @@ def crowding_truncation_indices(F: np.ndarray, max_size: int) -> np.ndarray:
 def truncate_by_crowding(pop: Population, max_size: int) -> Population:
     """Remove the most crowded member, one at a time, until ``len(pop) <= max_size``.
 
-    Crowding distance as in NSGA-II (seed 000, eq. 4-26), recomputed after every removal;
+    Crowding distance as in NSGA-II (Liu (2019), eq. 4-26), recomputed after every removal;
     boundary points have infinite distance. Ties go to the lowest index, so the result is
     deterministic.
     """
@@ -108,14 +108,14 @@ def truncate_by_crowding(pop: Population, max_size: int) -> Population:
 
 
 class MOABC(BeeColony):
-    """Multi-objective Artificial Bee Colony (seed 000, section 4.5.2).
+    """Multi-objective Artificial Bee Colony (Liu (2019), section 4.5.2).
 
     Parameters
     ----------
     pop_size : int
         Colony size (employed plus onlooker bees), even and at least 2; there are
         ``SN = pop_size // 2`` food sources. The initial sample has ``pop_size`` points;
-        the ``SN`` with the largest ``dom(i)`` become food sources (seed 000, 4.5.3 step 3)
+        the ``SN`` with the largest ``dom(i)`` become food sources (Liu (2019), 4.5.3 step 3)
         and its non-dominated points start the archive.
     archive_size : int
         Maximum size of the external archive.

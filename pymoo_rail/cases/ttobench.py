@@ -28,7 +28,7 @@ Mapping decisions (the full table is in ``docs/ttobench.md``):
   below 2e-5).
 - Train length: TTOBench's benchmark formulations treat the train as a point mass and the train
   files have an optional ``length``. ``train_length_m=None`` uses that length when the file has one
-  (limits hold over the whole train and gradients are averaged over it, seed 000 eq. 4-14), and a
+  (limits hold over the whole train and gradients are averaged over it, Liu (2019) eq. 4-14), and a
   point mass otherwise; ``0`` forces a point mass. The model needs a positive length, so a point
   mass is a train of :data:`POINT_MASS_LENGTH_M` (1 mm) with ``gradient_model = "point_mass"``.
 - Efficiencies absent (TTOBench allows omitting both) give traction efficiency 1 and no regen,
@@ -70,7 +70,7 @@ TTOBENCH_NOTICE = "TTOBench data, BSD 2-Clause License, Copyright (c) 2022, Dimi
 
 # TTOBench stores positions only. Station names of the Beijing Subway Yizhuang line in the order of
 # the stops in CN_Songjiazhuang_Yizhuang.json (public line map, not part of TTOBench). Stops 9 -> 10
-# are seed 000's Tongjinan Rd -> Jinghai Rd run (2265 m in both sources).
+# are Liu's (2019) Tongjinan Rd -> Jinghai Rd run (2265 m in both sources).
 YIZHUANG_STOP_NAMES = (
     "Songjiazhuang", "Xiaocun", "Xiaohongmen", "Jiugong", "Yizhuangqiao", "Yizhuang Culture Park",
     "Wanyuan St", "Rongjing East St", "Rongchang East St", "Tongjinan Rd", "Jinghai Rd", "Ciqu South",

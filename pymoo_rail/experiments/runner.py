@@ -35,6 +35,7 @@ import numpy as np
 from pymoo_rail.experiments.metrics import convergence_point, front_indicators, true_front
 from pymoo_rail.experiments.registry import build_algorithm, build_problem
 from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
+from pymoo_rail.experiments.fronts import distinct_front
 from pymoo_rail.experiments.inputs import changed_inputs, run_inputs
 from pymoo_rail.experiments.store import CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, RecordError, ResultStore
 
@@ -131,10 +132,10 @@ def execute_run(run: RunSpec, inputs: dict[str, str] | None = None) -> dict[str,
     wall_time_s = time.perf_counter() - start
     cpu_time_s = time.process_time() - start_cpu
 
-    opt = res.algorithm.opt
-    X = np.asarray(opt.get("X"), dtype=float) if opt is not None else np.empty((0, problem.n_var))
-    F = np.asarray(opt.get("F"), dtype=float) if opt is not None else np.empty((0, problem.n_obj))
-    CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1) if opt is not None else np.empty(0)
+    opt = distinct_front(res.algorithm.opt)  # one member per objective vector
+    X = np.asarray(opt.get("X"), dtype=float) if len(opt) else np.empty((0, problem.n_var))
+    F = np.asarray(opt.get("F"), dtype=float) if len(opt) else np.empty((0, problem.n_obj))
+    CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1) if len(opt) else np.empty(0)
     feasible = CV <= 0.0
     indicators = front_indicators(F[feasible], pf)
     return {

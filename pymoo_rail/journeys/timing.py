@@ -336,7 +336,7 @@ def _meet_passing_windows(solver, case, passing: Sequence[TimingPoint], start_m:
         # stretch before point j is priced exp(sum of log ratios of the points at or after it)
         after = np.searchsorted(point_x, cells_mid)  # index of the first point after each cell
         cum = np.concatenate([np.cumsum(ratios[::-1])[::-1], [0.0]])
-        solver.price_shape = np.exp(cum[after])
+        solver.set_price_shape(np.exp(cum[after]))
         traj = solver.profile(running_time_s)
         return traj, _passing_times(traj, passing, start_m, depart_s)
 
@@ -381,12 +381,14 @@ def _meet_passing_windows(solver, case, passing: Sequence[TimingPoint], start_m:
 def solve_timed_journey(timed: TimedJourney, *, n_bisect: int = 12, **settings) -> TimedRun:
     """The least-energy run of the journey that meets every timing point (exact solver per section).
 
-    ``settings`` go to :class:`pymoo_rail.optimal.OptimalSolver` (``dx_m``, ``n_speeds`` ...).
+    ``settings`` go to :class:`pymoo_rail.optimal.OptimalSolver` (``dx_m``, ``n_speeds`` ...;
+    ``certify`` is off unless asked for: the window search solves many running times).
     Raises :class:`TimingError` naming the first point no run with one price per section can meet.
     """
     from pymoo_rail.optimal.solver import OptimalSolver
 
     check_windows_reachable(timed)
+    settings.setdefault("certify", False)
     trajectories, departures = [], []
     arrival_prev = 0.0
     for k, group in enumerate(timed.windows):

@@ -5,8 +5,8 @@ eq. 2-10), a curve of radius R gives ``600 / R`` (Liu (2019) eq. 2-11, Tang et a
 ``line.curve_model = "tang2020"``) or Roeckl's standard-gauge ``650 / (R - 55)`` for R >= 300 m and
 ``500 / (R - 30)`` below (``"roeckl"``), a tunnel of length Ls gives ``0.00013 Ls`` (Liu (2019)
 eq. 2-12). Averaged over the train, ``600 / R`` is Tang et al.'s ``10.5 alpha / L_c`` branch for a
-curve shorter than the train (alpha in degrees: ``10.5 alpha / L_c = 601.6 L_r / (R L_c)``). With ``gradient_model = "train_length"`` they act on the train as the
-average over its length (eq. 4-14); the stations beyond both ends count as flat. Each grid cell
+curve shorter than the train (alpha in degrees: ``10.5 alpha / L_c = 601.6 L_r / (R L_c)``). With
+``gradient_model = "train_length"`` they act on the train as the average over its length (eq. 4-14); the stations beyond both ends count as flat. Each grid cell
 stores the exact mean of that (piecewise linear) average over the cell, so the work done against
 gradients over a run equals ``m g`` times the rise of the train's centre of mass exactly.
 """
@@ -22,8 +22,8 @@ from pymoo_rail.model.curves import KMH_PER_MS
 from pymoo_rail.model.errors import CaseError
 from pymoo_rail.model.train import GRAVITY_MS2
 
-CURVE_RESISTANCE_A = 600.0  # seed 000 eq. 2-11, the usual value in [450, 800]
-TUNNEL_RESISTANCE_PER_M = 0.00013  # seed 000 eq. 2-12, N/kN per metre of tunnel
+CURVE_RESISTANCE_A = 600.0  # Liu (2019) eq. 2-11, the usual value in [450, 800]
+TUNNEL_RESISTANCE_PER_M = 0.00013  # Liu (2019) eq. 2-12, N/kN per metre of tunnel
 
 
 @dataclass(frozen=True, eq=False)

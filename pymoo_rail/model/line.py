@@ -49,7 +49,7 @@ class Line:
     ``gradients`` rows are ``(start_m, end_m, permille)`` with + uphill; ``speed_limits`` rows are
     ``(start_m, end_m, kmh)``; both must tile [0, length]. ``curves`` rows are
     ``(start_m, end_m, radius_m)``; ``tunnels`` and ``neutral_sections`` rows ``(start_m, end_m)``.
-    ``gradient_model`` is ``"train_length"`` (line resistance averaged over the train, seed 000
+    ``gradient_model`` is ``"train_length"`` (line resistance averaged over the train, Liu (2019)
     eq. 4-14) or ``"point_mass"``. ``curve_model`` picks the curve resistance: ``"tang2020"``
     (``600 / R`` N/kN) or ``"roeckl"`` (``650 / (R - 55)`` for R >= 300 m, ``500 / (R - 30)`` below;
     needs R > 30 m).

@@ -134,16 +134,27 @@ def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
 
 
 @njit(cache=True)
-def interp_value(v_next, top_u, u, bias):
-    """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
-    k_max = v_next.shape[0] - 1
+def value_position(top_u, u, k_max, bias):
+    """Where kinetic energy ``u`` falls among the speed nodes over ``[0, top_u]``: a fractional index.
+
+    ``-1`` above the top node (beyond rounding: no cost-to-go there), ``k_max`` on it. Depends on
+    the grid only, not on the price of time: the solver computes it once per transition.
+    """
     if u > top_u:
         if u <= top_u * (1.0 + _TOP_RTOL) + 1e-12:
-            return v_next[k_max]
-        return INF
+            return float(k_max)
+        return -1.0
     if top_u <= 0.0:
-        return v_next[0]
-    p = node_position(top_u, u, k_max, bias)
+        return 0.0
+    return node_position(top_u, u, k_max, bias)
+
+
+@njit(cache=True, inline="always")
+def interp_at(v_next, p):
+    """Cost-to-go at fractional node index ``p`` (from :func:`value_position`), linear in ``u``."""
+    if p < 0.0:
+        return INF
+    k_max = v_next.shape[0] - 1
     k = int(p)
     if k >= k_max:
         return v_next[k_max]
@@ -155,6 +166,12 @@ def interp_value(v_next, top_u, u, bias):
     if a == INF or b == INF:
         return INF
     return a + w * (b - a)
+
+
+@njit(cache=True)
+def interp_value(v_next, top_u, u, bias):
+    """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
+    return interp_at(v_next, value_position(top_u, u, v_next.shape[0] - 1, bias))
 
 
 N_FIXED = 4  # traction, coast, brake, hold
@@ -277,7 +294,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
                 u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
                 e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                fixed_u1[i, j, c] = u1
+                fixed_u1[i, j, c] = value_position(top1, u1, k_max, bias)
                 fixed_e[i, j, c] = e
                 fixed_dt[i, j, c] = dt
             s = i * n_speeds + j
@@ -291,7 +308,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
                 u1, f, w0 = cell_outcome(m, v0, i, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
                 e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                tgt_u1[p] = u1
+                tgt_u1[p] = value_position(top1, u1, k_max, bias)
                 tgt_e[p] = e
                 tgt_dt[p] = dt
                 p += 1
@@ -301,7 +318,8 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float):
     """Every cell's transitions from every speed node, which do not depend on the price of time.
 
     Returns a tuple ``(fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt)``: for the four
-    fixed controls arrays (n_cells, n_speeds, 4) of the kinetic energy reached, the net energy (J,
+    fixed controls arrays (n_cells, n_speeds, 4) of where the speed reached falls among the next
+    position's speed nodes (:func:`value_position`, computed once here rather than in every sweep), the net energy (J,
     with auxiliary power) and the time of the cell; for partial traction onto speed nodes the same
     in flat arrays, state ``s = i * n_speeds + j`` owning entries ``offsets[s]:offsets[s + 1]``.
     Infeasible transitions (a stop before the platform) have infinite energy. Stored in single
@@ -321,32 +339,32 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float):
 
 
 @njit(cache=True)
-def backward_sweep(envelope_ms, time_price_w, bias, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value):
-    """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the platform backwards.
+def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value):
+    """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
-    the energies): one value everywhere for a single running time, one per stretch between timing points.
+    the energies; one value everywhere for one running time, one per stretch between timing points);
+    ``fixed_u1`` and ``tgt_u1`` hold node positions (:func:`value_position`).
     """
     n, n_speeds = value.shape
     # at the end of the line: the envelope there is the final speed (0 at a platform: one state);
     # the simulator lands on it, a slower arrival (coasting in) is a run like any other
     value[n - 1, :] = 0.0
     for i in range(n - 2, -1, -1):
-        top1 = envelope_ms[i + 1] ** 2
         v_next = value[i + 1]
         for j in range(n_speeds):
             best = INF
             for c in range(N_FIXED):
                 e = fixed_e[i, j, c]
                 if e < INF:
-                    cost = e + time_price_w[i] * fixed_dt[i, j, c] + interp_value(v_next, top1, fixed_u1[i, j, c], bias)
+                    cost = e + time_price_w[i] * fixed_dt[i, j, c] + interp_at(v_next, fixed_u1[i, j, c])
                     if cost < best:
                         best = cost
             s = i * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_value(v_next, top1, tgt_u1[p], bias)
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_at(v_next, tgt_u1[p])
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J else PENALTY_J
@@ -411,7 +429,7 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     """
     n = model.position_m.shape[0]
     prices = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,)))
-    backward_sweep(model.envelope_ms, prices, float(bias), *tables, value)
+    backward_sweep(prices, *tables, value)
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)

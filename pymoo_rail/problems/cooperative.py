@@ -1,4 +1,4 @@
-"""Two trains sharing regenerative braking energy (seed 001): ``CooperativeTrainsProblem``.
+"""Two trains sharing regenerative braking energy (Chen et al. (2017)): ``CooperativeTrainsProblem``.
 
 Train A runs leg 0 of a two-leg case (station 1 -> 2), train B leg 1 (station 2 -> 3); B leaves
 station 2 ``offset_s`` seconds after A leaves station 1 (the seed's x; negative: B leaves first).
@@ -6,7 +6,7 @@ Both legs lie in one power-supply section, so while one train brakes the other c
 regenerated power (with utilisation eta, the case's ``regen_efficiency``). B runs ahead of A on
 the line, so A is the following train of the separation rule (eq. 9).
 
-Decision vector (seed 001 section 3.1, one flat vector):
+Decision vector (Chen et al. (2017) section 3.1, one flat vector):
 
 ``[dS_A, dS_B, gamma_1, v_1, q_1, ..., gamma_m, v_m, q_m, gamma'_1, v'_1, q'_1, ...]``
 
@@ -74,7 +74,7 @@ def _finite(name: str, value, *, positive: bool = False, nonneg: bool = False) -
 
 
 def scale_gradients(case: Case, phi: float) -> Case:
-    """The same case with every gradient multiplied by ``phi`` (seed 001 section 4.4, fig. 6)."""
+    """The same case with every gradient multiplied by ``phi`` (Chen et al. (2017) section 4.4, fig. 6)."""
     phi = _finite("phi", phi)
     line = replace(case.line, gradients=tuple((s, e, g * phi) for s, e, g in case.line.gradients))
     return replace(case, line=line, name=f"{case.name} (gradients x {phi:g})")
@@ -288,7 +288,7 @@ class _SubsectionModel(Problem):
 class SubsectionProblem(_SubsectionModel):
     """One train alone in the seed's subsection model: least traction energy, on time.
 
-    The uncoordinated case of seed 001 in its own encoding. Decision vector
+    The uncoordinated case of Chen et al. (2017) in its own encoding. Decision vector
     ``[dS, gamma_1, v_1, q_1, ..., gamma_m, v_m, q_m]``; parameters as in
     :class:`CooperativeTrainsProblem`. ``case`` is a single-run case (e.g. ``pair.leg(0)``).
     """
@@ -325,7 +325,7 @@ class SubsectionProblem(_SubsectionModel):
 
 
 class CooperativeTrainsProblem(_SubsectionModel):
-    """Cooperative timed driving of two trains sharing regenerative energy (seed 001).
+    """Cooperative timed driving of two trains sharing regenerative energy (Chen et al. (2017)).
 
     Parameters
     ----------
@@ -336,7 +336,7 @@ class CooperativeTrainsProblem(_SubsectionModel):
         B's departure from the start of leg 1 minus A's departure from the start of leg 0 (the
         seed's x, sections 4.2-4.4: -45, 0, 45, 90, 135 s).
     safety_margin_m : float
-        L_s of eq. 9 (seed 001 table 3: 40 m).
+        L_s of eq. 9 (Chen et al. (2017) table 3: 40 m).
     separation_decel_ms2 : float
         b of eq. 9 and the largest deceleration of the braking phase (table 3: 1.0 m/s^2).
     max_accel_change_ms2 : float or None
@@ -483,7 +483,7 @@ class CooperativeTrainsProblem(_SubsectionModel):
 
 # ---------------------------------------------------------------------- the seed's repair
 class PunctualityRepair(Repair):
-    """The repair of seed 001 section 3.2, step 1, as a pymoo ``Repair`` (Lamarckian: genes are rewritten).
+    """The repair of Chen et al. (2017) section 3.2, step 1, as a pymoo ``Repair`` (Lamarckian: genes are rewritten).
 
     When a train's planned time lies outside the window eq. 1 can reach (eq. 10), its exit-speed
     genes (and, to speed up, its traction coefficients) move together toward the fastest or the
@@ -523,7 +523,7 @@ def trajectory_energies(traj: Trajectory, train: Train) -> tuple[np.ndarray, np.
     """Per-cell traction energy drawn and regenerated energy usable by another train (J) of a trace.
 
     Traction is ``F dx / eta_traction``. Braking is regenerative within the train's regen force and
-    power caps and above its cut-off speed (seed 001 eq. 3), times ``regen_efficiency`` (eta, the
+    power caps and above its cut-off speed (Chen et al. (2017) eq. 3), times ``regen_efficiency`` (eta, the
     share the other train can use).
     """
     dx = np.diff(traj.position_m)
@@ -610,7 +610,7 @@ class Baseline:
 SOLO_METHODS = {
     # the seed's uncoordinated strategy: traction, cruise, coast, brake over the whole run
     "four_phase": dict(encoding="switching_points", regimes=("traction", "hold", "coast", "brake")),
-    # speed codes on the gradient/limit partition (seed 000), at most 200 m per section
+    # speed codes on the gradient/limit partition (Liu (2019)), at most 200 m per section
     "speed_codes": dict(encoding="speed_codes", max_section_m=200.0),
     # the seed's own subsection model for one train (SubsectionProblem, with the seed's repair)
     "subsections": None,
@@ -635,7 +635,7 @@ def solo_run(leg: Case, methods: Sequence[str] = tuple(SOLO_METHODS), *, pop_siz
     """The least traction energy of one train alone on ``leg``, within ``time_tolerance_s`` of its plan.
 
     Every method is solved with pymoo DE (``solo_problem``); the train's own regeneration is never
-    credited (in seed 001 regenerated energy only counts when another train uses it). The default
+    credited (in Chen et al. (2017) regenerated energy only counts when another train uses it). The default
     tolerance is 0.1 s, not 1 s: the cooperative problem runs both trains exactly on their plans,
     and on ``cooperative-pair`` one second more is worth 0.3-0.8 kWh per train.
     """
@@ -718,7 +718,7 @@ class BrakingDistanceProblem(Problem):
     """The outer problem of the nested GA: braking distances, each evaluated by an inner pymoo run.
 
     The value of a pair of braking distances is the best the inner algorithm finds for the rest of
-    the vector (seed 001 section 3.1); its constraint is that solution's violation. Inner runs are
+    the vector (Chen et al. (2017) section 3.1); its constraint is that solution's violation. Inner runs are
     seeded from the outer algorithm's ``random_state``.
     """
 
@@ -751,7 +751,7 @@ class BrakingDistanceProblem(Problem):
 def nested_minimize(problem: CooperativeTrainsProblem, *, outer_pop_size: int = 24, outer_n_gen: int = 20,
                     inner_pop_size: int = 100, inner_n_gen: int = 80, inner_algorithm=None, seed: int = 1,
                     verbose: bool = False):
-    """The nested GA of seed 001 section 3: an outer pymoo GA on the braking distances whose every
+    """The nested GA of Chen et al. (2017) section 3: an outer pymoo GA on the braking distances whose every
     evaluation runs an inner pymoo GA on the traction coefficients, exit speeds and time shares.
 
     Defaults are the seed's sizes (section 4.1: outer 24 x 20, inner 100 x 80); pymoo's GA
