@@ -42,9 +42,8 @@ MAX_TIME_ERROR_S = 0.5
 # Once solves on both sides of the requested time are this close to it, the search stops and moves
 # the last switch of the closer run instead (second-order error: E'' dT^2 / 2, far below 1e-4 kWh)
 ADJUST_WITHIN_S = 0.5
-ADJUST_NEAR_S = 0.25
 # The certificate is this many times the change when the speed grid is halved (see energy_bound_kwh)
-CERTIFICATE_FACTOR = 2.0  # ... or once one of them is this close
+CERTIFICATE_FACTOR = 2.0
 DEFAULT_TIE_J = 100.0
 LAMBDA_MIN_W = 1.0e2
 LAMBDA_MAX_W = 1.0e10
@@ -331,8 +330,7 @@ class OptimalSolver:
         lo, hi = math.log(slow.lambda_w), math.log(fast.lambda_w)
         repeats = 0
         for _ in range(40):
-            if (hi - lo < 1e-4 or repeats >= 2 or max(f_slow_true, -f_fast_true) <= ADJUST_WITHIN_S
-                    or min(f_slow_true, -f_fast_true) <= ADJUST_NEAR_S):
+            if hi - lo < 1e-4 or repeats >= 2 or max(f_slow_true, -f_fast_true) <= ADJUST_WITHIN_S:
                 # a jump of the discrete optimum, or close enough on both sides: moving the last
                 # switch of the closer run (``_adjust``, simulations only) meets the time
                 break
@@ -359,7 +357,8 @@ class OptimalSolver:
         return self._closest(slow, fast, target, "")
 
     def _closest(self, slow: _Solve | None, fast: _Solve | None, target: float, missing: str) -> _Solve:
-        if slow is not None and fast is not None:
+        if (slow is not None and fast is not None
+                and max(slow.time_s - target, target - fast.time_s) <= ADJUST_WITHIN_S):
             # the slope of the front at the target lies between the bracket's prices: their
             # geometric mean (any price on a plateau of the discrete optimum gives the same run)
             lam = math.sqrt(slow.lambda_w * fast.lambda_w)
