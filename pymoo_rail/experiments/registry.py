@@ -52,15 +52,15 @@ def _rosenbrock(n_var: int = 10):
     return Rosenbrock(n_var)
 
 
-def _case(case: Any):
-    from pymoo_rail.cases import load_case
+def _case(case: Any, load: str | None = None):
+    from pymoo_rail.cases import load_case, with_load
     from pymoo_rail.model import Case
 
     if isinstance(case, Case):
-        return case
+        return case if load is None else with_load(case, load)
     if not isinstance(case, str):
         raise StudyError("case", case, "must be a built-in case name or the path of a case file")
-    return load_case(case)
+    return load_case(case, load=load)
 
 
 def _tuples(params: dict) -> dict:
@@ -68,11 +68,12 @@ def _tuples(params: dict) -> dict:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
 
 
-def _speed_profile(case: Any = "yizhuang", **params):
-    """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path)."""
+def _speed_profile(case: Any = "yizhuang", load: str | None = None, **params):
+    """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path; ``load``:
+    a passenger load state such as ``"AW3"``)."""
     from pymoo_rail.problems import SpeedProfileProblem
 
-    return SpeedProfileProblem(_case(case), **_tuples(params))
+    return SpeedProfileProblem(_case(case, load), **_tuples(params))
 
 
 def _cooperative_trains(case: Any = "cooperative-pair", **params):
@@ -80,6 +81,20 @@ def _cooperative_trains(case: Any = "cooperative-pair", **params):
     from pymoo_rail.problems import CooperativeTrainsProblem
 
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
+
+
+def _kinematic_phases(case: Any = "metro-a", **params):
+    """``pymoo_rail.problems.KinematicPhasesProblem`` (the four-phase model of Meng et al. 2017)."""
+    from pymoo_rail.problems import KinematicPhasesProblem
+
+    return KinematicPhasesProblem(_case(case), **_tuples(params))
+
+
+def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
+    """``pymoo_rail.control.tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
+    from pymoo_rail.control.tuning import ControllerTuningProblem
+
+    return ControllerTuningProblem(_case(case, load), **params)
 
 
 def _rail_suite(suite_problem: str, **params):
@@ -100,6 +115,8 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "rosenbrock": _rosenbrock,
     "speed_profile": _speed_profile,
     "cooperative_trains": _cooperative_trains,
+    "kinematic_phases": _kinematic_phases,
+    "controller_tuning": _controller_tuning,
     "rail_suite": _rail_suite,
 }
 
@@ -232,7 +249,8 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
 
 ALIASES = {"smsemoa": "sms-emoa", "agemoea": "age-moea", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
            "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
-           "cooperative-trains": "cooperative_trains", "rail-suite": "rail_suite"}
+           "cooperative-trains": "cooperative_trains", "rail-suite": "rail_suite",
+           "kinematic-phases": "kinematic_phases", "controller-tuning": "controller_tuning"}
 
 # -------------------------------------------------------------------------------- operators
 
@@ -255,6 +273,8 @@ OPERATORS: dict[str, dict[str, tuple[str, str]]] = {
     "sampling": {
         "random": ("pymoo.operators.sampling.rnd", "FloatRandomSampling"),
         "lhs": ("pymoo.operators.sampling.lhs", "LHS"),
+        "binary": ("pymoo.operators.sampling.rnd", "BinaryRandomSampling"),
+        "integer": ("pymoo.operators.sampling.rnd", "IntegerRandomSampling"),
     },
 }
 

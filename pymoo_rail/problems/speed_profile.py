@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Sequence
 
 import numpy as np
 from pymoo.core.problem import Problem
 
 from pymoo_rail.model import Case
-from pymoo_rail.problems.encodings import ENCODINGS, SpeedCodes, SwitchingPoints
+from pymoo_rail.problems.encodings import ENCODINGS, BrakingOnset, SpeedCodes, SwitchingPoints
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 
@@ -22,7 +23,7 @@ OBJECTIVE_ALIASES = {"jerk": "accel_variation"}
 def canonical_objective(name: str) -> str:
     """The objective a name stands for (``"jerk"`` -> ``"accel_variation"``; others unchanged)."""
     return OBJECTIVE_ALIASES.get(name, name)
-DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m"}
+DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m", "braking_onset": "m (last: m/s^2)"}
 
 
 class DecisionError(ValueError):
@@ -39,16 +40,18 @@ def check_decisions(X: np.ndarray, xl: np.ndarray, xu: np.ndarray, unit: str = "
     if X.ndim != 2 or X.shape[1] != xl.shape[0]:
         raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {xl.shape[0]}")
     unit = f" {unit}" if unit else ""
-    for bad, what in ((~np.isfinite(X), "is not a finite number"), ((X < xl) | (X > xu), "is outside its bounds")):
-        rows = np.flatnonzero(bad.any(axis=1))
-        if rows.size:
-            r = int(rows[0])
-            j = int(np.flatnonzero(bad[r])[0])
-            listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
-            raise DecisionError(
-                f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
-                f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
-                "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(X) | (X < xl) | (X > xu)
+    rows = np.flatnonzero(bad.any(axis=1))
+    if rows.size:
+        r = int(rows[0])
+        j = int(np.flatnonzero(bad[r])[0])
+        what = "is not a finite number" if not np.isfinite(X[r, j]) else "is outside its bounds"
+        listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
+        raise DecisionError(
+            f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
+            f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
+            "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
     return X
 SEED_002_WEIGHTS = {"energy": 0.1, "jerk": 0.2, "stop_error": 0.4, "time_error": 0.3}
 
@@ -72,6 +75,19 @@ def objective_values(summaries: np.ndarray, names: Sequence[str], planned_time_s
     return np.column_stack(columns)
 
 
+class ConstantObjectiveWarning(UserWarning):
+    """An objective cannot vary under the problem's encoding: its front axis is dead."""
+
+
+def warn_constant_objectives(objectives: Sequence[str], encoding) -> None:
+    """Warn, naming them, about objectives the encoding holds constant."""
+    dead = [name for name in objectives if name in encoding.constant_objectives]
+    if dead:
+        warnings.warn(f"objective(s) {', '.join(dead)} are constant under encoding '{encoding.name}' "
+                      "(every run stops exactly at the platform): use encoding='braking_onset' for a "
+                      "live stop error", ConstantObjectiveWarning, stacklevel=3)
+
+
 class SpeedProfileProblem(Problem):
     """Recommended speed profile of one train between two stops, as a vectorised pymoo problem.
 
@@ -87,9 +103,12 @@ class SpeedProfileProblem(Problem):
         ``"stop_error"`` (m, Meng et al. (2017) eq. 6). Several give the Pareto form; one with
         ``time_tolerance_s`` gives the constrained form of Liu (2019) 4.4; ``weights`` give the
         weighted sum of Meng et al. (2017) eq. 9.
-    encoding : {"speed_codes", "switching_points"}
-        Speed codes per section (km/h) or regime switching positions (m); see
-        :mod:`pymoo_rail.problems.encodings`.
+    encoding : {"speed_codes", "switching_points", "braking_onset"}
+        Speed codes per section (km/h), regime switching positions (m), or the phases of
+        Meng et al. (2017) with the braking onset (m) and deceleration (m/s^2) as decisions (the
+        only one where the stop error varies without ``tracking``); see
+        :mod:`pymoo_rail.problems.encodings`. An objective that cannot vary under the chosen
+        encoding (the stop error of speed codes) triggers a ``ConstantObjectiveWarning``.
     partition : {"gradient_limit", "equal"}
         Sections of the speed-code encoding (Liu (2019) figs. 4-4 and 4-3).
     n_sections : int, optional
@@ -123,6 +142,11 @@ class SpeedProfileProblem(Problem):
         :mod:`pymoo_rail.control`. ``trajectory(x)`` then returns the tracked run.
     control_period_s : float
         Control period of ``tracking`` (default 0.2 s).
+    integer_codes : bool
+        Whole-km/h speed codes (``vtype=int``), for pymoo's integer operators (e.g.
+        ``IntegerRandomSampling``, ``SBX(repair=RoundingRepair(), vtype=float)``).
+    decel_range_ms2 : (float, float), optional
+        Bounds of the braking deceleration of ``encoding="braking_onset"``.
 
     Notes
     -----
@@ -144,7 +168,8 @@ class SpeedProfileProblem(Problem):
                  weights: Sequence[float] | None = None, scales: Sequence[float] | None = None,
                  stop_tolerance_m: float | None = 0.25, regimes: Sequence[str] | None = None,
                  floor_kmh: float = 10.0, dx_m: float | None = None, tracking=None,
-                 control_period_s: float = 0.2, time_window_s=None, **kwargs):
+                 control_period_s: float = 0.2, time_window_s=None, integer_codes: bool = False,
+                 decel_range_ms2: tuple[float, float] | None = None, **kwargs):
         if isinstance(objectives, str):
             objectives = (objectives,)
         objectives = tuple(objectives)
@@ -156,9 +181,15 @@ class SpeedProfileProblem(Problem):
         if len({canonical_objective(name) for name in objectives}) != len(objectives):
             raise ValueError(f"objectives = {objectives!r} repeats an objective (jerk is an alias of accel_variation)")
         if encoding == "speed_codes":
-            self.encoding = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh)
+            self.encoding = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh, integer_codes)
         elif encoding == "switching_points":
             self.encoding = SwitchingPoints.build(case, tuple(regimes) if regimes is not None else None)
+        elif encoding == "braking_onset":
+            if tracking is not None:
+                raise ValueError("encoding = 'braking_onset' with tracking: the controllers track an ideal "
+                                 "curve that ends at the platform; use speed_codes or switching_points")
+            self.encoding = BrakingOnset.build(case, tuple(regimes) if regimes is not None else None,
+                                               decel_range_ms2, dx_m=dx_m)
         else:
             raise ValueError(f"encoding = {encoding!r} is unknown (known: {', '.join(ENCODINGS)})")
         if time_tolerance_s is not None and not (np.isfinite(time_tolerance_s) and time_tolerance_s > 0):
@@ -181,6 +212,8 @@ class SpeedProfileProblem(Problem):
             self.simulator.check_planned_time()  # raises, naming planned_time_s, when impossible
         self.min_running_time_s = fastest.running_time_s
         self.time_window_s = self._check_window(time_window_s, case)
+        if tracking is None:
+            warn_constant_objectives(objectives, self.encoding)
 
         self.weights = None
         self.scales = None
@@ -203,7 +236,7 @@ class SpeedProfileProblem(Problem):
         n_obj = 1 if self.weights is not None else len(objectives)
         n_ieq = 1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None) + (self.time_window_s is not None)
         super().__init__(n_var=self.encoding.n_var, n_obj=n_obj, n_ieq_constr=n_ieq,
-                         xl=self.encoding.xl.copy(), xu=self.encoding.xu.copy(), vtype=float, **kwargs)
+                         xl=self.encoding.xl.copy(), xu=self.encoding.xu.copy(), vtype=self.encoding.vtype, **kwargs)
 
     # ------------------------------------------------------------------ evaluation
     def summaries(self, X: np.ndarray) -> np.ndarray:
@@ -214,7 +247,7 @@ class SpeedProfileProblem(Problem):
         programs = self.encoding.programs(np.ascontiguousarray(X))
         if self.tracker is not None:
             return self.tracker.run_batch(programs)
-        return self.simulator.run_batch(programs)
+        return self._runner().run_batch(programs)
 
     def check_decisions(self, X: np.ndarray) -> np.ndarray:
         """``X`` as a float array (N, n_var) after checking it is finite and inside ``[xl, xu]``.
@@ -319,7 +352,11 @@ class SpeedProfileProblem(Problem):
         program = self.encoding.programs(self.check_decisions(x[None, :]))[0]
         if self.tracker is not None:
             return self.tracker.run_program(program)
-        return self.simulator.run(program)
+        return self._runner().run(program)
+
+    def _runner(self):
+        # braking_onset simulates its own (longer) track: the train may stop past the platform
+        return self.encoding if isinstance(self.encoding, BrakingOnset) else self.simulator
 
     def describe(self) -> str:
         form = "weighted sum" if self.weights is not None else (

@@ -18,6 +18,7 @@ from pymoo_rail.model import CaseError, Line
 from pymoo_rail.sim.kernel import (
     MODE_BRAKE,
     MODE_COAST,
+    MODE_DECEL,
     MODE_HOLD,
     MODE_HOLD_BRAKE,
     MODE_NAMES,
@@ -106,6 +107,34 @@ def switching_programs(positions_m: np.ndarray, regimes: tuple[str, ...], length
     programs[:, -1, 0] = length_m
     programs[:, :, 1] = modes
     programs[:, :, 2] = 0.0
+    return programs
+
+
+def braking_programs(positions_m: np.ndarray, regimes: tuple[str, ...], decel_ms2: np.ndarray,
+                     length_m: float) -> np.ndarray:
+    """Programs whose last regime is braking at a chosen constant deceleration (``MODE_DECEL``).
+
+    Parameters
+    ----------
+    positions_m : (n_switch,) or (N, n_switch)
+        Switching positions of ``regimes`` followed by the braking onset; sorted along each row,
+        so the largest is the onset.
+    regimes : sequence of str
+        ``n_switch`` regimes run before braking (traction, hold, coast ...).
+    decel_ms2 : (N,) or float
+        Service deceleration of the braking phase (m/s^2, > 0).
+    length_m : float
+        Where the braking row ends (the end of the simulated track).
+    """
+    pos = np.atleast_2d(np.asarray(positions_m, dtype=float))
+    decel = np.broadcast_to(np.asarray(decel_ms2, dtype=float), (pos.shape[0],))
+    _check_finite("braking_decel_ms2", decel[:, None])
+    if (decel <= 0).any():
+        idx = int(np.argwhere(decel <= 0)[0, 0])
+        raise ValueError(f"braking_decel_ms2[{idx}] = {float(decel[idx])}: the deceleration must be > 0")
+    programs = switching_programs(pos, tuple(regimes) + ("brake",), length_m)
+    programs[:, -1, 1] = MODE_DECEL
+    programs[:, -1, 2] = decel
     return programs
 
 

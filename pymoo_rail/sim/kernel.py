@@ -20,6 +20,10 @@ cell midpoint passes ``end_m``. Modes:
 - ``MODE_HOLD_BRAKE``: hold the entry speed by partial traction or, where coasting would
   accelerate, by partial braking (electric first, so it regenerates); maximum braking where even
   that cannot hold it. The cruise control of an ATO on a descent.
+- ``MODE_DECEL``: brake at the constant deceleration ``target`` (m/s^2, resistance and gradient
+  included) until standstill, the service-brake command of a stopping programme (seed 002's
+  braking phase); maximum braking where that is not enough, coasting where the line alone
+  decelerates more. Where it stops is the programme's consequence (short of or past the platform).
 
 Whatever the program says, the train never rises above the braking envelope: it brakes onto every
 lower limit ahead and onto the platform at the latest moment the braking curve allows.
@@ -41,7 +45,8 @@ from pymoo_rail.sim.physics import (
 )
 
 MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
-MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake")
+MODE_DECEL = 6
+MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake", "decel")
 REGIME_TRACTION, REGIME_HOLD, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
 REGIME_CRUISE = REGIME_HOLD  # the older name of the same regime
 # "hold": the speed is held (partial traction or braking); one word in every output and doc
@@ -101,6 +106,26 @@ def _full_step(m, v0, cell, kind):
     w0 = davis_force(m, v_half)
     u1 = v0 * v0 + 2.0 * ((f - w0 - wl) * gain)
     return u1, f, w0, v_half
+
+
+@njit(cache=True, inline="always")
+def _decel_step(m, v0, cell, decel_ms2):
+    """One cell braking at the constant deceleration ``decel_ms2`` (MODE_DECEL).
+
+    Returns (u1, control force N, W0 N, regime). u1 < 0 means the train stops inside the cell,
+    exactly ``v0^2 / (2 decel)`` after its start (``complete_cell`` measures it).
+    """
+    u1 = v0 * v0 - 2.0 * m.dx_m * decel_ms2
+    v1 = math.sqrt(u1) if u1 > 0.0 else 0.0
+    v_mid = 0.5 * (v0 + v1)
+    w0 = davis_force(m, v_mid)
+    f = -m.effective_mass_kg * decel_ms2 + w0 + m.line_force_n[cell]
+    if f > 0.0:  # resistance and gradient alone decelerate more: coast
+        u1, f, w0, _ = _full_step(m, v0, cell, _KIND_COAST)
+        return u1, f, w0, REGIME_COAST
+    if -f > max_braking(m, v_mid, cell):  # more than the brakes give: brake fully
+        u1, f, w0, _ = _full_step(m, v0, cell, _KIND_BRAKE)
+    return u1, f, w0, REGIME_BRAKE
 
 
 @njit(cache=True, inline="always")
@@ -301,6 +326,8 @@ def drive_cell(m, program, totals, i, v, row, hold_speed):
     elif mode == MODE_BRAKE:
         u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)
         regime = REGIME_BRAKE
+    elif mode == MODE_DECEL:
+        u1, f, w0, regime = _decel_step(m, v, i, target)
     else:
         u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
         regime = REGIME_COAST

@@ -68,8 +68,11 @@ class Simulator:
         return self.run(flat_out_program(self.length_m))
 
     def min_running_time_s(self) -> float:
-        """Running time of the flat-out run, the shortest the train can do on this grid."""
-        return self.flat_out().running_time_s
+        """Running time of the flat-out run, the shortest the train can do on this grid.
+
+        Raises :class:`InfeasibleCaseError` naming the cause when even that run stops short
+        (a time for a run that never arrives would be meaningless)."""
+        return self.check_reachable().running_time_s
 
     def check_reachable(self) -> Trajectory:
         """The flat-out run; :class:`InfeasibleCaseError` naming the cause when it stops short."""
