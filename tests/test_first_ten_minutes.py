@@ -123,9 +123,9 @@ def test_study_records_have_distinct_objective_vectors():
 
 
 def test_accel_variation_is_the_objective_jerk_names(yizhuang):
-    X = np.random.default_rng(3).uniform(30, 80, (5, 8))
     by_jerk = SpeedProfileProblem(yizhuang, objectives=("energy", "jerk"))
     by_name = SpeedProfileProblem(yizhuang, objectives=("energy", "accel_variation"))
+    X = by_name.xl + (by_name.xu - by_name.xl) * np.random.default_rng(3).uniform(0.3, 1.0, (5, by_name.n_var))
     np.testing.assert_array_equal(by_jerk.evaluate(X, return_values_of=["F"]),
                                   by_name.evaluate(X, return_values_of=["F"]))
     with pytest.raises(ValueError, match="alias"):

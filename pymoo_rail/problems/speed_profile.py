@@ -40,16 +40,18 @@ def check_decisions(X: np.ndarray, xl: np.ndarray, xu: np.ndarray, unit: str = "
     if X.ndim != 2 or X.shape[1] != xl.shape[0]:
         raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {xl.shape[0]}")
     unit = f" {unit}" if unit else ""
-    for bad, what in ((~np.isfinite(X), "is not a finite number"), ((X < xl) | (X > xu), "is outside its bounds")):
-        rows = np.flatnonzero(bad.any(axis=1))
-        if rows.size:
-            r = int(rows[0])
-            j = int(np.flatnonzero(bad[r])[0])
-            listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
-            raise DecisionError(
-                f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
-                f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
-                "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(X) | (X < xl) | (X > xu)
+    rows = np.flatnonzero(bad.any(axis=1))
+    if rows.size:
+        r = int(rows[0])
+        j = int(np.flatnonzero(bad[r])[0])
+        what = "is not a finite number" if not np.isfinite(X[r, j]) else "is outside its bounds"
+        listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
+        raise DecisionError(
+            f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
+            f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
+            "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
     return X
 SEED_002_WEIGHTS = {"energy": 0.1, "jerk": 0.2, "stop_error": 0.4, "time_error": 0.3}
 
