@@ -24,22 +24,26 @@ def certified_gap(front: CertifiedFront, running_time_s, energy_kwh) -> dict[str
     Returns
     -------
     dict
-        ``gap_median_pct`` and ``gap_min_pct`` (100 (E - E*(T)) / E*(T) over the members whose
-        running time the front covers), ``n_in_range``, and ``n_below_certificate``: members below
-        the optimum by more than its certificate (``E < E*(T) - bound(T)``), which a correct
-        certificate never allows. Gaps are NaN when no member lies in the front's range.
+        ``gap_median_kwh`` and ``gap_min_kwh`` (``E - E*(T)`` over the members whose running time
+        the front covers; in kWh, since on lines with strong regeneration ``E*`` can be near zero or
+        negative and a relative gap means nothing), ``gap_median_pct`` (the median gap in % of the
+        front's largest energy, its fastest run), ``n_in_range``, and ``n_below_certificate``:
+        members below the optimum by more than its certificate (``E < E*(T) - bound(T)``), which a
+        correct certificate never allows. Gaps are NaN when no member lies in the front's range.
     """
     t = np.asarray(running_time_s, dtype=float).reshape(-1)
     e = np.asarray(energy_kwh, dtype=float).reshape(-1)
     lo, hi = front.time_range_s
     inside = (t >= lo) & (t <= hi) & np.isfinite(e)
-    out = {"n_in_range": float(inside.sum()), "n_below_certificate": 0.0,
-           "gap_median_pct": float("nan"), "gap_min_pct": float("nan")}
+    out = {"n_in_range": float(inside.sum()), "n_below_certificate": 0.0, "gap_median_kwh": float("nan"),
+           "gap_min_kwh": float("nan"), "gap_median_pct": float("nan")}
     if not inside.any():
         return out
     optimum, bound = front.energy_at(t[inside])
-    gap = 100.0 * (e[inside] - optimum) / optimum
-    out.update(gap_median_pct=float(np.median(gap)), gap_min_pct=float(np.min(gap)),
+    gap = e[inside] - optimum
+    scale = float(front.table["energy_kwh"].abs().max())
+    out.update(gap_median_kwh=float(np.median(gap)), gap_min_kwh=float(np.min(gap)),
+               gap_median_pct=100.0 * float(np.median(gap)) / scale,
                n_below_certificate=float(np.sum(e[inside] < optimum - bound - 1e-9)))
     return out
 

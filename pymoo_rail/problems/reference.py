@@ -10,12 +10,12 @@ This module turns the solver's runs into a front with a certificate and keeps it
   the front's slope ``lambda_kwh_per_s`` there.
 - **Certificate.** ``energy_bound_kwh`` bounds ``|energy_kwh - true optimum|`` at the node's
   running time. When the solver reports this bound (column ``energy_bound_kwh`` of
-  :func:`~pymoo_rail.optimal.optimal_front`) it is used as is (``certificate = "solver"``).
+  :func:`~pymoo_rail.optimal.optimal_front`) it is used (``certificate = "solver"``).
   Otherwise it is the two-grid estimate (``certificate = "two-grid"``): the difference between
-  the default grid and one with half the speed nodes at the same requested time, and at least
-  :data:`BOUND_FLOOR_REL` of the energy. The coarse grid errs more than the default one
-  (``docs/optimal.md``), so the difference over-estimates the default grid's error; it is an
-  estimate, not a proof.
+  the default grid and one with half the speed nodes at the same requested time. Either is
+  raised to at least :data:`BOUND_FLOOR_REL` of the energy. The coarse grid errs more than the
+  default one (``docs/optimal.md``), so the difference over-estimates the default grid's error;
+  it is an estimate, not a proof.
 - **Between nodes.** The front is convex and decreasing in time, so the chord between two nodes
   lies above it by at most ``h (lambda_left - lambda_right) / 4`` (the tangents at both ends
   bound it from below). :meth:`CertifiedFront.energy_at` interpolates and adds that to the bound.
@@ -229,14 +229,14 @@ def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = N
     t_min = min_running_time(case, dx_m)
     times = front_times(t_min, case.planned_time_s, n_times or n_times_for(case))
     fine = optimal_front(case, times, dx_m=dx_m)
-    if "energy_bound_kwh" in fine.columns:
+    if "energy_bound_kwh" in fine.columns and fine["energy_bound_kwh"].notna().all():
         bound = fine["energy_bound_kwh"].to_numpy(dtype=float)
         certificate = "solver"
     else:
         coarse = optimal_front(case, times, dx_m=dx_m, n_speeds=DEFAULT_N_SPEEDS // COARSE_FACTOR)
         bound = np.abs(fine["energy_at_request_kwh"].to_numpy() - coarse["energy_at_request_kwh"].to_numpy())
-        bound = np.maximum(bound, BOUND_FLOOR_REL * np.abs(fine["energy_kwh"].to_numpy()))
         certificate = "two-grid"
+    bound = np.maximum(bound, BOUND_FLOOR_REL * np.abs(fine["energy_kwh"].to_numpy()))
     table = pd.DataFrame({"requested_time_s": fine["requested_time_s"], "running_time_s": fine["running_time_s"],
                           "energy_kwh": fine["energy_kwh"], "lambda_kwh_per_s": fine["lambda_kwh_per_s"],
                           "energy_bound_kwh": bound})

@@ -109,7 +109,7 @@ def test_bad_input_names_the_field(cache, metro):
 
 def test_time_window_constraint(cache, metro):
     problem = SpeedProfileProblem(metro, objectives=("energy", "running_time"), time_window_s=(75.0, 90.0))
-    x = np.array([[80.0, 80.0, 80.0, 65.0], [30.0, 30.0, 30.0, 30.0]])
+    x = np.vstack([problem.xu, np.full(problem.n_var, 30.0)])
     out = problem.evaluate(x, return_as_dictionary=True)
     t = out["running_time_s"]
     assert np.allclose(out["G"][:, -1], np.maximum(75.0 - t, t - 90.0))

@@ -116,3 +116,20 @@ def test_cli_suite_list(capsys):
     out = capsys.readouterr().out
     assert "metro-a-bi" in out and "certified front" in out and "best-known" in out
     assert main(["suite", "verify", "atlantis"]) == 2
+
+
+def test_cli_optimize_draws_the_optimum_and_prints_the_gap(capsys, tmp_path, monkeypatch):
+    from pymoo_rail.cli import main
+
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    code = main(["optimize", "metro-a", "--pop-size", "12", "--n-gen", "3", "--out", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert code == 0 and "gap to the optimum at" in out and "certified within" in out
+    assert (tmp_path / "front.png").is_file() and (tmp_path / "profile.png").is_file()
+    import pandas as pd
+
+    front = pd.read_csv(tmp_path / "front.csv")
+    problem = get_problem("metro-a-bi")
+    lo, hi = problem.time_window_s
+    feasible = front[front["feasible"]]
+    assert ((feasible["running_time_s"] >= lo - 1e-6) & (feasible["running_time_s"] <= hi + 1e-6)).all()
