@@ -787,7 +787,7 @@ def _objective_of_column(column: str) -> str:
 
 
 def cmd_warmup(args) -> int:
-    from pymoo_rail.sim.jit import WARMUP_PARTS, warmup
+    from pymoo_rail.warmup import WARMUP_PARTS, warmup
 
     parts = WARMUP_PARTS if args.all else ("simulator",)
     for part, seconds in warmup(parts).items():

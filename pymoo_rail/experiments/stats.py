@@ -328,7 +328,7 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
     baseline ``ranksum.csv`` / ``ranksum.md`` (every test) and ``verdicts.md`` (+/=/- counts).
     Returns the paths written.
     """
-    from pymoo_rail.experiments.store import atomic_write_text
+    from pymoo_rail.atomic import atomic_write_text
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
