@@ -82,6 +82,21 @@ def _cooperative_trains(case: Any = "cooperative-pair", **params):
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
 
 
+def _cooperative_scaled(case: Any = "cooperative-pair", phi: float = 1.0, **params):
+    """``CooperativeTrainsProblem`` on a case with every gradient times ``phi`` (Chen et al. 2017, fig. 6)."""
+    from pymoo_rail.problems import CooperativeTrainsProblem
+    from pymoo_rail.problems.cooperative import scale_gradients
+
+    return CooperativeTrainsProblem(scale_gradients(_case(case), phi), **_tuples(params))
+
+
+def _timetable(case: Any = "cooperative-pair", **params):
+    """``pymoo_rail.problems.TimetableProblem``: several trains sharing braking energy."""
+    from pymoo_rail.problems import TimetableProblem
+
+    return TimetableProblem(_case(case), **_tuples(params))
+
+
 PROBLEMS: dict[str, Callable[..., Any]] = {
     **{f"zdt{i}": _pymoo_problem(f"zdt{i}") for i in range(1, 7)},
     **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}") for i in range(1, 8)},
@@ -90,6 +105,8 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "rosenbrock": _rosenbrock,
     "speed_profile": _speed_profile,
     "cooperative_trains": _cooperative_trains,
+    "cooperative_trains_scaled": _cooperative_scaled,
+    "timetable": _timetable,
 }
 
 # ------------------------------------------------------------------------------- algorithms

@@ -103,12 +103,13 @@ def shared_energy_bins(trac, regen, transmission_efficiency):
 
 @njit(cache=True)
 def separation_excess(t_f, x_f, v_f, shift_f, start_f, t_l, x_l, shift_l, start_l, gap_m, decel_ms2, t0_s, dt_s,
-                      n_steps):
+                      n_steps, clear_s=math.inf):
     """Largest ``v_f^2 / (2 b) - (dS - L_t - L_s)`` (m) of the following train while it runs.
 
     ``x_*`` are node positions on each train's own line, placed on a common line at ``start_*``;
     ``t_*`` node times from each departure at ``shift_*`` on the common clock. The leading train
-    stands at its start before departing and at its end after arriving. Checked every ``dt_s``
+    stands at its start before departing and at its end after arriving, until ``clear_s`` on the
+    common clock, when it leaves the line (a terminus cleared). Checked every ``dt_s``
     from ``t0_s`` and at the follower's arrival (> 0: the follower runs too close).
     """
     worst = -1e300
@@ -140,6 +141,8 @@ def separation_excess(t_f, x_f, v_f, shift_f, start_f, t_l, x_l, shift_l, start_
             x = x_f[i_f + 1]
         pos_f = start_f + x
         tau_l = t - shift_l
+        if t >= clear_s:
+            continue
         if tau_l <= 0.0:
             pos_l = start_l
         elif tau_l >= t_l[n_l - 1]:
@@ -266,13 +269,14 @@ def power_profiles(runs, labels, transmission_efficiency: float = 1.0, time_step
 
 
 def separation_m(follower: ClockedRun, leader: ClockedRun, gap_m: float, decel_ms2: float,
-                 time_step_s: float = 0.1) -> float:
+                 time_step_s: float = 0.1, clear_s: float = math.inf) -> float:
     """Largest excess (m) of the follower's braking distance over its room behind the leader (eq. 9).
 
     ``gap_m`` is the train length plus the safety margin; > 0 means the follower runs too close.
+    The leader stands at its last stop after arriving until ``clear_s`` (common clock), then leaves.
     """
     t0, n_bins = clock_span((follower, leader), time_step_s)
     f, lead = follower, leader
     return float(separation_excess(f.time_s, f.position_m, f.speed_ms, follower.departure_s, follower.start_m,
                                    lead.time_s, lead.position_m, leader.departure_s, leader.start_m, float(gap_m), float(decel_ms2), t0,
-                                   time_step_s, n_bins))
+                                   time_step_s, n_bins, float(clear_s)))
