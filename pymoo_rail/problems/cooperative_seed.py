@@ -47,7 +47,12 @@ from pymoo.core.problem import Problem
 from pymoo.core.repair import Repair
 
 from pymoo_rail.model import Case, CaseError
-from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S, finite_number, scale_gradients  # noqa: F401
+from pymoo_rail.problems.cooperative import (  # noqa: F401 (re-exported for reproduction scripts)
+    SEED_001_OFFSETS_S,
+    check_vectors,
+    finite_number,
+    scale_gradients,
+)
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import cooperation as coop
 from pymoo_rail.sim import subsections as sub
@@ -195,14 +200,7 @@ class _SubsectionModel(Problem):
 
     # ------------------------------------------------------------------ decision vectors
     def check_x(self, X: np.ndarray) -> np.ndarray:
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        if X.shape[1] != self.n_var:
-            raise ValueError(f"decision vectors have {X.shape[1]} values: this problem has n_var = {self.n_var}")
-        bad = np.argwhere(~np.isfinite(X))
-        if bad.size:
-            r, c = (int(i) for i in bad[0])
-            raise ValueError(f"decision vector {r}, variable {self.variable_names[c]} = {X[r, c]}: must be finite")
-        return X
+        return check_vectors(X, self.n_var, self.variable_names)
 
     def split(self, X: np.ndarray) -> list[tuple]:
         """Per train, (brake_m, gamma, v_exit, q) from decision vectors (N, n_var); v_exit in m/s or relative."""

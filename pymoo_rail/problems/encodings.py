@@ -19,19 +19,10 @@ import numpy as np
 
 from pymoo_rail.model import Case
 from pymoo_rail.sim import equal_partition, gradient_limit_partition, speed_code_programs, switching_programs
+from pymoo_rail.sim.pacing import split_long_sections
 
 KMH_PER_MS = 3.6
 PARTITIONS = ("gradient_limit", "equal")
-
-
-def _split_long(boundaries: np.ndarray, max_section_m: float | None) -> np.ndarray:
-    if max_section_m is None:
-        return boundaries
-    out = [boundaries[0]]
-    for a, b in zip(boundaries[:-1], boundaries[1:]):
-        pieces = int(np.ceil((b - a) / max_section_m - 1e-9))
-        out.extend(np.linspace(a, b, pieces + 1)[1:])
-    return np.asarray(out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,7 +43,7 @@ class SpeedCodes:
             bounds = gradient_limit_partition(line)
             neutral_points = [p for row in line.neutral_sections for p in row]
             bounds = np.unique(np.concatenate([bounds, neutral_points]))
-            bounds = _split_long(bounds, max_section_m)
+            bounds = split_long_sections(bounds, max_section_m)
         elif partition == "equal":
             bounds = equal_partition(line, n_sections if n_sections is not None else 10)
         else:
