@@ -128,18 +128,23 @@ def main() -> None:
     parser.add_argument("--phis", default="0.7,0.4,0")
     parser.add_argument("--phi-seeds", type=int, default=15)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--report-only", action="store_true",
+                        help="write the report from the records already stored (after a study was stopped early)")
     args = parser.parse_args()
     phis = [float(p) for p in args.phis.split(",") if p.strip()]
 
     base = baselines([1.0] + phis, REPORTS / "cooperative_baselines.json")
     directory = REPORTS / "cooperative_study"
-    run_study(study("cooperative_offsets", [1.0], args.seeds), directory / "offsets", workers=args.workers,
-              seed_major=True)
+    if not args.report_only:
+        run_study(study("cooperative_offsets", [1.0], args.seeds), directory / "offsets", workers=args.workers,
+                  seed_major=True)
     frames = [load_results(directory / "offsets")]
     if phis and args.phi_seeds > 0:
-        run_study(study("cooperative_gradients", phis, args.phi_seeds), directory / "gradients",
-                  workers=args.workers, seed_major=True)
-        frames.append(load_results(directory / "gradients"))
+        if not args.report_only:
+            run_study(study("cooperative_gradients", phis, args.phi_seeds), directory / "gradients",
+                      workers=args.workers, seed_major=True)
+        if (directory / "gradients").exists():
+            frames.append(load_results(directory / "gradients"))
     results = pd.concat(frames, ignore_index=True)
     table = rows(results, base, [1.0] + phis)
     text = report(table, base)
