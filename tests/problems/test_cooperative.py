@@ -85,6 +85,17 @@ def test_plain_ga_is_deterministic_and_beats_random_shapes(problem, evaluated):
     assert runs[0].F[0] <= evaluated["F"].min() + 1.0
 
 
+@pytest.mark.parametrize("name", ["de", "nsga2"])
+def test_de_and_nsga2_work_unchanged(problem, name):
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.algorithms.soo.nonconvex.de import DE
+
+    algorithm = DE(pop_size=8) if name == "de" else NSGA2(pop_size=8)
+    res = minimize(problem, algorithm, ("n_eval", 24), seed=2)
+    assert np.all(np.atleast_2d(res.CV) <= 0)  # every vector is on time: nothing to repair
+    assert np.all(np.atleast_1d(res.F) < 40.0)
+
+
 def test_pickling_keeps_the_problem(problem, population):
     copy = pickle.loads(pickle.dumps(problem))
     np.testing.assert_array_equal(copy.evaluate(population[:3], return_values_of=["F"]),
