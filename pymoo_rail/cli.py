@@ -354,6 +354,7 @@ def cmd_optimize(args) -> int:
 
     from pymoo_rail.experiments.registry import algorithm_names, build_algorithm, canonical_name, ALGORITHMS
     from pymoo_rail.experiments.spec import AlgorithmSpec, StudyError
+    from pymoo_rail.model import CaseError
     from pymoo_rail.plotting import plot_front, plot_speed_profile, plot_speed_time, save_figure
     from pymoo_rail.problems import SpeedProfileProblem
 
@@ -377,8 +378,10 @@ def cmd_optimize(args) -> int:
         kwargs["weights"] = args.weights
     try:
         problem = SpeedProfileProblem(case, **kwargs)
-    except ValueError as err:  # e.g. a planned time below the minimum running time
-        raise UsageError("CASE" if "planned_time" in str(err) else "--objectives", str(err)) from None
+    except CaseError as err:  # the case cannot be run (e.g. a planned time below the minimum): not an option's fault
+        raise UsageError("CASE", str(err)) from None
+    except ValueError as err:  # the message names the parameter; blame --objectives only for its own
+        raise UsageError("--objectives" if "objective" in str(err) else "options", str(err)) from None
     try:
         algorithm = build_algorithm(AlgorithmSpec(args.algorithm, {"pop_size": args.pop_size}), problem)
     except StudyError as err:

@@ -135,13 +135,17 @@ def feasibility_first_better(
     return cv_new <= 0.0 and f_new < f_old
 
 
-def constraint_dominates(f_a: np.ndarray, cv_a: float, f_b: np.ndarray, cv_b: float) -> bool:
-    """Whether ``a`` constraint-dominates ``b`` (Deb): less violation first, then Pareto."""
+def constraint_dominates(f_a, cv_a: float, f_b, cv_b: float) -> bool:
+    """Whether ``a`` constraint-dominates ``b`` (Deb): less violation first, then Pareto.
+
+    ``f_a`` and ``f_b`` are objective vectors (arrays or lists of floats).
+    """
     if cv_a < cv_b:
         return True
     if cv_b < cv_a:
         return False
-    return bool(np.all(f_a <= f_b) and np.any(f_a < f_b))
+    pairs = list(zip(f_a, f_b))
+    return all(a <= b for a, b in pairs) and any(a < b for a, b in pairs)
 
 
 def roulette(probabilities: np.ndarray, n: int, random_state: np.random.Generator) -> np.ndarray:

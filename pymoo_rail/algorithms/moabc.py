@@ -54,20 +54,45 @@ def dominance_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
     return fit / total
 
 
-def nondominated(pop: Population) -> Population:
-    """Constraint-non-dominated members of ``pop``, without duplicate ``X``, in order.
+def population_arrays(pop: Population) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Decisions (n, n_var), objectives (n, n_obj) and violations (n,) of a non-empty population.
 
-    With at least one feasible member these are the feasible Pareto-optimal ones;
-    otherwise the least-violating ones (ties broken by Pareto dominance).
+    The same values as ``pop.get("X")``, ``pop.get("F")``, ``pop.get("CV")[:, 0]`` in one pass.
     """
+    return (np.array([ind.X for ind in pop]), np.array([ind.F for ind in pop]),
+            np.array([ind.CV[0] for ind in pop]))
+
+
+def nondominated_indices(X: np.ndarray, F: np.ndarray, CV: np.ndarray) -> np.ndarray:
+    """Indices (ascending) of the constraint-non-dominated rows, first copy of each ``X`` only.
+
+    With at least one feasible row these are the feasible Pareto-optimal ones; otherwise the
+    least-violating ones (ties broken by Pareto dominance).
+    """
+    if len(X) == 0:
+        return np.zeros(0, dtype=int)
+    _, first = np.unique(X, axis=0, return_index=True)
+    idx = np.sort(first)
+    cv = CV[idx]
+    idx = idx[cv == cv.min()]
+    front = NonDominatedSorting().do(F[idx], only_non_dominated_front=True)
+    return idx[np.sort(front)]
+
+
+def nondominated(pop: Population) -> Population:
+    """Constraint-non-dominated members of ``pop``, without duplicate ``X``, in order."""
     if len(pop) == 0:
         return pop
-    _, first = np.unique(pop.get("X"), axis=0, return_index=True)
-    pop = pop[np.sort(first)]
-    CV = pop.get("CV")[:, 0]
-    pop = pop[CV == CV.min()]
-    front = NonDominatedSorting().do(pop.get("F"), only_non_dominated_front=True)
-    return pop[np.sort(front)]
+    return pop[nondominated_indices(pop.get("X"), pop.get("F"), pop.get("CV")[:, 0])]
+
+
+def crowding_truncation_indices(F: np.ndarray, max_size: int) -> np.ndarray:
+    """Indices (ascending) of the rows of ``F`` kept by :func:`truncate_by_crowding`."""
+    keep = np.arange(len(F))
+    while len(keep) > max_size:
+        cd = calc_crowding_distance(F[keep])
+        keep = np.delete(keep, int(np.argmin(cd)))
+    return keep
 
 
 def truncate_by_crowding(pop: Population, max_size: int) -> Population:
@@ -77,12 +102,9 @@ def truncate_by_crowding(pop: Population, max_size: int) -> Population:
     boundary points have infinite distance. Ties go to the lowest index, so the result is
     deterministic.
     """
-    while len(pop) > max_size:
-        cd = calc_crowding_distance(pop.get("F"))
-        keep = np.ones(len(pop), dtype=bool)
-        keep[int(np.argmin(cd))] = False
-        pop = pop[keep]
-    return pop
+    if len(pop) <= max_size:
+        return pop
+    return pop[crowding_truncation_indices(pop.get("F"), max_size)]
 
 
 class MOABC(BeeColony):
@@ -164,22 +186,32 @@ class MOABC(BeeColony):
             raise ValueError(f"w must be a positive finite number, got {w!r}")
         self.w = float(w)
         self.pareto_archive: Population | None = None
+        # the archive's decisions, objectives and violations, aligned with ``pareto_archive``:
+        # reading them back from the individuals each cycle cost more than the simulations
+        self.archive_X: np.ndarray | None = None
+        self.archive_F: np.ndarray | None = None
+        self.archive_CV: np.ndarray | None = None
+        self._infill_arrays: tuple | None = None
 
     # ------------------------------------------------------------------ initialisation
     def _initialize_advance(self, infills=None, **kwargs) -> None:
         dom = domination_counts(infills.get("F"), infills.get("CV")[:, 0])
         self.pareto_archive = Population.empty()
-        self._update_archive(infills)
+        self.archive_X = np.zeros((0, self.problem.n_var))
+        self.archive_F = np.zeros((0, self.problem.n_obj))
+        self.archive_CV = np.zeros(0)
+        self._update_archive(infills, population_arrays(infills))
         self._start_colony(infills, np.argsort(-dom, kind="stable"))
 
     # ------------------------------------------------------------------ one cycle
     def _onlooker_probabilities(self) -> np.ndarray:
-        return dominance_probabilities(self.pop.get("F"), self.pop.get("CV")[:, 0])
+        _, F, CV = population_arrays(self.pop)
+        return dominance_probabilities(F, CV)
 
     def _candidates(self, parents: np.ndarray) -> np.ndarray:
-        X = self.pop.get("X")[parents]
+        X = population_arrays(self.pop)[0][parents]
         guides = self.random_state.integers(0, len(self.pareto_archive), size=len(X))
-        return self._move(X, self.pareto_archive.get("X")[guides])
+        return self._move(X, self.archive_X[guides])
 
     def _move(self, X: np.ndarray, X_k: np.ndarray) -> np.ndarray:
         if self.move == "literal":
@@ -196,12 +228,14 @@ class MOABC(BeeColony):
         )
 
     def _observe(self, infills: Population) -> None:
-        self._update_archive(infills)  # every evaluated candidate may enter the archive
+        self._infill_arrays = population_arrays(infills)  # read once, used by _greedy too
+        self._update_archive(infills, self._infill_arrays)  # every evaluated candidate may enter the archive
 
     def _greedy(self, infills: Population) -> None:
         """Replace a source by a candidate that constraint-dominates it; count trials."""
-        off_F, off_CV = infills.get("F"), infills.get("CV")[:, 0]
-        pop_F, pop_CV = self.pop.get("F"), self.pop.get("CV")[:, 0]
+        # Python floats: a scalar comparison per pair is cheaper on lists than on array rows
+        _, off_F, off_CV = (a.tolist() for a in self._infill_arrays)
+        _, pop_F, pop_CV = (a.tolist() for a in population_arrays(self.pop))
         for c, i in enumerate(self._parents):
             if constraint_dominates(off_F[c], off_CV[c], pop_F[i], pop_CV[i]):
                 self.pop[i] = infills[c]
@@ -210,9 +244,15 @@ class MOABC(BeeColony):
             else:
                 self.trials[i] += 1
 
-    def _update_archive(self, infills: Population) -> None:
-        merged = Population.merge(self.pareto_archive, infills)
-        self.pareto_archive = truncate_by_crowding(nondominated(merged), self.archive_size)
+    def _update_archive(self, infills: Population, arrays: tuple) -> None:
+        X_new, F_new, CV_new = arrays
+        X = np.concatenate([self.archive_X, X_new])
+        F = np.concatenate([self.archive_F, F_new])
+        CV = np.concatenate([self.archive_CV, CV_new])
+        keep = nondominated_indices(X, F, CV)
+        keep = keep[crowding_truncation_indices(F[keep], self.archive_size)]
+        self.pareto_archive = Population.merge(self.pareto_archive, infills)[keep]
+        self.archive_X, self.archive_F, self.archive_CV = X[keep], F[keep], CV[keep]
 
     def _set_optimum(self) -> None:
         self.opt = self.pareto_archive

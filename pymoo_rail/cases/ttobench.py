@@ -441,9 +441,16 @@ _TTOBENCH_FIELD = {
 }
 
 
+def _boundary_speed_ms(field: str, kmh: float) -> float:
+    if isinstance(kmh, bool) or not isinstance(kmh, (int, float)) or not math.isfinite(kmh) or kmh < 0.0:
+        raise CaseError(field, kmh, "must be a finite number of km/h >= 0")
+    return kmh / KMH_PER_MS
+
+
 def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to_stop: StopRef,
                   planned_time_s: float, *, dwell_s: float = 0.0, stop_names: Sequence[str] | None = None,
-                  train_length_m: float | None = None, name: str | None = None) -> Case:
+                  train_length_m: float | None = None, name: str | None = None,
+                  initial_speed_kmh: float = 0.0, final_speed_kmh: float = 0.0) -> Case:
     """The run of a TTOBench train between two stops of a TTOBench track, as a :class:`Case`.
 
     Parameters
@@ -466,6 +473,9 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
         gradients averaged over it.
     name : str, optional
         Case name (default ``"<track id>[<i>-<j>]"``).
+    initial_speed_kmh, final_speed_kmh : float
+        Speeds at ``from_stop`` and ``to_stop`` (default 0: a stop at both); TTOBench benchmark
+        formulations such as the ms-eetc one start and end at a small speed (e.g. 1 m/s).
     """
     track = read_track(track_path)
     tt_train = read_train(train_path, train_length_m=train_length_m)
@@ -485,6 +495,8 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
               f"pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
     return Case(name=name or f"{track.id}[{i}-{j}]", train=tt_train.train, line=line,
                 planned_time_s=planned_time_s, dwell_s=dwell_s, source=source,
+                initial_speed_ms=_boundary_speed_ms("initial_speed_kmh", initial_speed_kmh),
+                final_speed_ms=_boundary_speed_ms("final_speed_kmh", final_speed_kmh),
                 description=f"{track.id} {stop_label(i)} -> {stop_label(j)}, {line.length_m:g} m, "
                             f"train {tt_train.id}")
 

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.experiments.inputs import changed_inputs, run_inputs
 from pymoo_rail.experiments.spec import Study
 from pymoo_rail.experiments.store import STUDY_FILE, ResultStore
 
@@ -34,7 +36,9 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
     study : Study, optional
         Keep the runs of this study and label them with its current labels. By default the
         directory's ``study.toml`` is used; records of runs the study no longer contains
-        (e.g. after its parameters were edited) are left out unless ``all_runs``.
+        (e.g. after its parameters were edited) are left out unless ``all_runs``; so are records
+        whose inputs changed since they were stored (an edited case file, another package
+        version), with a warning that says which: run the study again to redo them.
     all_runs : bool
         Return every record in the directory, with the labels stored in it.
     """
@@ -45,8 +49,14 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
         return list(store.records())
     runs = {r.run_id: r for r in study.runs()}
     records = []
+    cache: dict = {}
     for record in store.records(set(runs)):
         run = runs[record["run_id"]]
+        reasons = changed_inputs(record.get("inputs"), run_inputs(run, cache))
+        if reasons:
+            warnings.warn(f"{store.path(run.run_id)} ({run.describe()}) left out: {'; '.join(reasons)}; "
+                          "run the study again to redo it", stacklevel=2)
+            continue
         record["problem_label"] = run.problem.display
         record["algorithm_label"] = run.algorithm.display
         records.append(record)

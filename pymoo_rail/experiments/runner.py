@@ -2,8 +2,13 @@
 
 The same function, :func:`execute_run`, runs in every worker: it rebuilds the problem and the
 algorithm from their specs, calls pymoo's ``minimize`` with the run's seed and returns a plain
-record. The driver stores each record the moment it arrives (see :mod:`.store`), so stopping a
-study at any point loses only the runs still in flight; the next start skips every stored run.
+record. On the local pool (and in-process) the worker stores its own record atomically before it
+returns (:func:`execute_and_store`), so a run a worker finished is kept even if the driver dies;
+with Dask, whose workers may not see the study directory, the driver stores each record the
+moment it arrives. The driver claims each run (a file lock, see :mod:`.store`) before starting
+it, checks the stored record and its input fingerprint (:mod:`.inputs`), and redoes a run whose
+record is corrupt or whose inputs changed, saying why. Pool workers watch their parent and exit
+within a second when it dies.
 """
 
 from __future__ import annotations
@@ -13,9 +18,12 @@ import multiprocessing
 import os
 import platform
 import socket
+import sys
+import threading
 import time
 import traceback
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from collections import deque
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import ExitStack
 from dataclasses import dataclass, field
@@ -27,7 +35,8 @@ import numpy as np
 from pymoo_rail.experiments.metrics import convergence_point, front_indicators, true_front
 from pymoo_rail.experiments.registry import build_algorithm, build_problem
 from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
-from pymoo_rail.experiments.store import RECORD_FORMAT, STUDY_FILE, ResultStore
+from pymoo_rail.experiments.inputs import changed_inputs, run_inputs
+from pymoo_rail.experiments.store import CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, RecordError, ResultStore
 
 # per-individual outputs a rail problem puts next to F (DESIGN.md section 3); kept with the front
 EXTRA_KEYS = ("energy_kwh", "running_time_s", "stop_error_m")
@@ -98,9 +107,11 @@ def run_counters(algorithm) -> dict[str, float]:
     return counters
 
 
-def execute_run(run: RunSpec) -> dict[str, Any]:
+def execute_run(run: RunSpec, inputs: dict[str, str] | None = None) -> dict[str, Any]:
     """Run one study run and return its record (a JSON-ready dict).
 
+    ``inputs`` is the fingerprint of the run's inputs (:func:`.inputs.run_inputs`, computed here
+    when not given); it is stored with the record so a later start can tell a stale record.
     The record holds the final front (``F``, ``X``, constraint violation and, for rail problems,
     energy, running time and stop error of each member), its indicators, the evaluations used,
     the wall and CPU time (CPU time of this process, all its threads), the algorithm's
@@ -108,6 +119,8 @@ def execute_run(run: RunSpec) -> dict[str, Any]:
     """
     from pymoo.optimize import minimize
 
+    if inputs is None:
+        inputs = run_inputs(run)
     problem = build_problem(run.problem)
     algorithm = build_algorithm(run.algorithm, problem)
     pf = true_front(problem)
@@ -146,25 +159,70 @@ def execute_run(run: RunSpec) -> dict[str, Any]:
                   "extras": _extras(problem, opt, X) if len(X) else {}},
         "history": history.columns() if history is not None else None,
         "versions": versions(),
+        "inputs": dict(inputs),
         "host": socket.gethostname(),
         "finished_at": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
     }
 
 
-def execute_run_safely(run: RunSpec) -> tuple[str, dict[str, Any]]:
+def execute_run_safely(run: RunSpec, inputs: dict[str, str] | None = None) -> tuple[str, dict[str, Any]]:
     """:func:`execute_run` that returns an error as data (with its traceback) instead of raising."""
     try:
-        return "ok", execute_run(run)
+        return "ok", execute_run(run, inputs)
     except Exception as err:  # noqa: BLE001 - reported per run; the study goes on
         return "error", {"run_id": run.run_id, "run": run.describe(), "error": f"{type(err).__name__}: {err}",
                          "traceback": traceback.format_exc(),
                          "finished_at": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")}
 
 
-def _worker_init() -> None:
+# held while a worker writes a record, so the parent-death watcher never cuts a write short
+_WRITE_LOCK = threading.Lock()
+PARENT_POLL_S = 0.5
+
+
+def execute_and_store(run: RunSpec, directory: str, inputs: dict[str, str]) -> tuple[str, dict[str, Any]]:
+    """:func:`execute_run_safely`, then store the record (or the failure) in ``directory`` at once.
+
+    Returns ``("ok", {"run_id": ...})`` or ``("error", failure)``: the record itself never has to
+    travel back to the driver, so a run finished here is kept even if the driver is gone.
+    """
+    status, payload = execute_run_safely(run, inputs)
+    store = ResultStore(directory)
+    with _WRITE_LOCK:
+        if status == "ok":
+            store.write(payload)
+            return "ok", {"run_id": run.run_id}
+        store.write_failure(run.run_id, payload)
+    return status, payload
+
+
+def _watch_parent(parent_pid: int) -> None:
+    while True:
+        time.sleep(PARENT_POLL_S)
+        if os.getppid() != parent_pid:  # re-parented: the study process is gone
+            with _WRITE_LOCK:  # let a record being written finish
+                os._exit(0)
+
+
+def _worker_init(parent_pid: int | None = None) -> None:
     # one numba thread per worker process: the pool already uses every core
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
     os.environ.setdefault("OMP_NUM_THREADS", "1")
+    if parent_pid is not None:
+        # a pool worker outlives a killed driver (waiting on its queue forever): exit instead
+        threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True, name="parent-watch").start()
+
+
+class _InProcess(Executor):
+    """An executor that runs each task at submission, in this process (``workers=1``)."""
+
+    def submit(self, fn, /, *args, **kwargs) -> Future:
+        future: Future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except BaseException as err:  # noqa: BLE001 - delivered through the future, as a pool would
+            future.set_exception(err)
+        return future
 
 
 @dataclass
@@ -176,14 +234,19 @@ class StudyReport:
     n_skipped: int
     n_finished: int
     failures: list[dict] = field(default_factory=list)
+    n_elsewhere: int = 0  # stored meanwhile by another process working on the same directory
+    redone: list[str] = field(default_factory=list)  # why stored records were set aside and redone
 
     @property
     def complete(self) -> bool:
-        return self.n_skipped + self.n_finished == self.n_runs
+        return self.n_skipped + self.n_finished + self.n_elsewhere == self.n_runs
 
     def __str__(self) -> str:
-        text = (f"{self.n_runs} runs: {self.n_skipped} already stored, {self.n_finished} run now, "
+        elsewhere = f", {self.n_elsewhere} stored by another process" if self.n_elsewhere else ""
+        text = (f"{self.n_runs} runs: {self.n_skipped} already stored, {self.n_finished} run now{elsewhere}, "
                 f"{len(self.failures)} failed; results in {self.directory}")
+        for note in self.redone:
+            text += f"\n  REDONE {note}"
         for f in self.failures:
             text += f"\n  FAILED {f['run']}: {f['error']}"
         return text
@@ -283,8 +346,10 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
     store.prepare()
     write_study(study, store.directory / STUDY_FILE)
     runs = study.runs()
-    done = store.done_ids()
-    pending = pending_runs(study, done, seed_major)
+    cache: dict = {}
+    inputs = {run.run_id: run_inputs(run, cache) for run in runs}
+    pending = pending_runs(study, {r.run_id for r in runs if _stored_state(store, r, inputs[r.run_id])[0] == "stored"},
+                           seed_major)
     report = StudyReport(store.directory, len(runs), len(runs) - len(pending), 0)
     if not pending:
         return report
@@ -292,34 +357,77 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
     with ExitStack() as stack:
         bar = stack.enter_context(tqdm(total=len(runs), initial=report.n_skipped, desc=f"study {study.name}",
                                        unit="run", disable=not progress, dynamic_ncols=True))
+        local = scheduler is None
+        if local and workers == 1:
+            executor: Executor = _InProcess()
+        elif local:
+            executor = stack.enter_context(ProcessPoolExecutor(
+                max_workers=min(workers, len(pending)), mp_context=multiprocessing.get_context("spawn"),
+                initializer=_worker_init, initargs=(os.getpid(),)))
+        else:
+            executor = _dask_executor(stack, scheduler, workers)
 
-        def store_result(status: str, payload: dict) -> None:
+        def say(message: str) -> None:
+            report.redone.append(message)
+            if progress:
+                bar.write(f"REDO {message}")
+            else:
+                print(f"pymoo-rail study: REDO {message}", file=sys.stderr)
+
+        def submit(run: RunSpec) -> Future:
+            if local:  # the worker stores its own record
+                return executor.submit(execute_and_store, run, str(store.directory), inputs[run.run_id])
+            return executor.submit(execute_run_safely, run, inputs[run.run_id])
+
+        def finish(run: RunSpec, status: str, payload: dict) -> None:
             if status == "ok":
-                store.write(payload)
+                if not local:
+                    store.write(payload)
                 report.n_finished += 1
             else:
-                store.write_failure(payload["run_id"], payload)
+                if not local:
+                    store.write_failure(run.run_id, payload)
                 report.failures.append(payload)
                 bar.write(f"FAILED {payload['run']}: {payload['error']}")
             bar.update(1)
 
-        if scheduler is None and workers == 1:
-            for run in pending:
-                store_result(*execute_run_safely(run))
-            return report
-
-        if scheduler is not None:
-            executor = _dask_executor(stack, scheduler, workers)
-        else:
-            executor = stack.enter_context(ProcessPoolExecutor(
-                max_workers=min(workers, len(pending)), mp_context=multiprocessing.get_context("spawn"),
-                initializer=_worker_init))
-        futures: dict[Future, RunSpec] = {}
+        window = 2 * workers  # runs in flight: enough to keep every worker busy
+        queue = deque((run, False) for run in pending)
+        busy: list[RunSpec] = []  # claimed by another process: waited for once our own work is done
+        in_flight: dict[Future, tuple[RunSpec, Any]] = {}
         try:
-            for run in pending:
-                futures[executor.submit(execute_run_safely, run)] = run
-            for future in as_completed(futures):
-                store_result(*future.result())
+            while queue or in_flight or busy:
+                if not queue and not in_flight:
+                    queue.extend((run, True) for run in busy)
+                    busy.clear()
+                while queue and len(in_flight) < window:
+                    run, blocking = queue.popleft()
+                    lock = store.claim(run.run_id, wait=blocking)
+                    if lock is None:
+                        busy.append(run)
+                        continue
+                    state, reason = _stored_state(store, run, inputs[run.run_id])
+                    if state == "stored":  # another process finished it while we were busy
+                        lock.release()
+                        report.n_elsewhere += 1
+                        bar.update(1)
+                        continue
+                    if state == "corrupt":
+                        moved = store.set_aside(run.run_id, CORRUPT_DIR)
+                        say(f"{run.describe()}: {reason}; moved to {moved}")
+                    elif state == "stale":
+                        moved = store.set_aside(run.run_id, STALE_DIR)
+                        say(f"{run.describe()}: {reason}; the old record is in {moved}")
+                    in_flight[submit(run)] = (run, lock)
+                if not in_flight:
+                    continue
+                done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
+                for future in done:
+                    run, lock = in_flight.pop(future)
+                    try:
+                        finish(run, *future.result())
+                    finally:
+                        lock.release()
         except BrokenProcessPool as err:
             raise RuntimeError(
                 "a worker process of the local pool died, so the study stopped (finished runs are stored; "
@@ -327,9 +435,26 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
                 "import your main script, so call run_study under `if __name__ == \"__main__\":` and not "
                 "from standard input; or use workers=1 or a Dask scheduler.") from err
         except BaseException:
-            for f in futures:
+            for f in in_flight:
                 f.cancel()
             if isinstance(executor, ProcessPoolExecutor):
                 executor.shutdown(wait=False, cancel_futures=True)
             raise
+        finally:
+            for _, lock in in_flight.values():
+                lock.release()
     return report
+
+
+def _stored_state(store: ResultStore, run: RunSpec, inputs: dict[str, str]) -> tuple[str, str]:
+    """``("stored", "")``, ``("missing", "")``, ``("corrupt", why)`` or ``("stale", why)`` for one run."""
+    try:
+        record = store.load(run.run_id)
+    except RecordError as err:
+        return "corrupt", f"record {err.path} cannot be used ({err.reason})"
+    if record is None:
+        return "missing", ""
+    reasons = changed_inputs(record.get("inputs"), inputs)
+    if reasons:
+        return "stale", "inputs changed: " + "; ".join(reasons)
+    return "stored", ""

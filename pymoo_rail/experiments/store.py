@@ -1,123 +1,221 @@
-"""The result store of a study: one JSON file per finished run, written atomically.
+"""The result store of a study: one checksummed JSON file per finished run, written atomically.
 
 Layout of a study directory::
 
     study.toml              the study that was run (rewritten at each start)
     runs/<run_id>.json      one record per finished run
     failed/<run_id>.json    the error of a run that raised (removed once the run succeeds)
+    corrupt/<run_id>.json.<time>   a record that failed its check, moved aside (then redone)
+    stale/<run_id>.json.<time>     a record whose inputs changed, moved aside (then redone)
+    locks/<run_id>.lock     the claim of a process computing that run (``filelock``)
 
-A record is written to a temporary file in the same directory, flushed and fsync'ed, then
-renamed over its final name (``os.replace`` is atomic on POSIX and Windows) and the directory
-is fsync'ed. A reader therefore sees either no file or a complete one; a killed process leaves
-at most a temporary file, which is ignored and cleaned up at the next start. Because the file
-name is the run id, a run can never be stored twice.
+Guarantees (``docs/experiments.md`` says how each is tested):
+
+- A record is written through :func:`pymoo_rail.atomic.atomic_path` (temporary file, fsync,
+  rename), so a reader sees no file or a complete one. Temporary files carry their writer's pid;
+  a start removes only those whose writer has ended.
+- Every record carries a SHA-256 checksum of its content. A record that does not parse, lacks
+  a field, names another run or fails its checksum is a :class:`RecordError` naming the file;
+  the study runner moves it to ``corrupt/`` and redoes the run.
+- A record carries the fingerprint of the run's inputs (``inputs``: the case content, files the
+  specs name, package versions); the runner compares it with the current one and redoes a run
+  whose inputs changed, saying which.
+- A run is computed only by the process holding its claim (an OS file lock from ``filelock``,
+  released by the system when the holder dies), so two studies on one directory compute each
+  run once.
 """
 
 from __future__ import annotations
 
+import datetime as _dt
+import hashlib
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import Iterator
 
-RECORD_FORMAT = "pymoo-rail/run-record/1"
+from filelock import FileLock, Timeout
+
+from pymoo_rail.atomic import TEMP_PREFIX, atomic_write_text, is_abandoned_temp
+
+RECORD_FORMAT = "pymoo-rail/run-record/2"
+# records written before checksums and input fingerprints: readable, but always redone by a study
+LEGACY_FORMATS = ("pymoo-rail/run-record/1",)
 RUNS_DIR = "runs"
 FAILED_DIR = "failed"
+CORRUPT_DIR = "corrupt"
+STALE_DIR = "stale"
+LOCKS_DIR = "locks"
 STUDY_FILE = "study.toml"
-_TMP_PREFIX = ".tmp-"
+REQUIRED_FIELDS = ("format", "run_id", "problem", "algorithm", "seed", "budget", "n_var", "n_obj", "front",
+                   "indicators")
+
+__all__ = ["ResultStore", "RecordError", "record_checksum", "atomic_write_text", "RECORD_FORMAT"]
 
 
-def _fsync_dir(path: Path) -> None:
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:  # e.g. Windows cannot open directories; the rename is still atomic
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
+class RecordError(ValueError):
+    """A stored record that cannot be trusted; the message names the file and what is wrong."""
+
+    def __init__(self, path: Path, reason: str):
+        self.path = Path(path)
+        self.reason = reason
+        super().__init__(f"{self.path}: {reason}")
 
 
-def atomic_write_text(path: Path, text: str) -> Path:
-    """Write ``text`` to ``path`` so that readers never see a partial file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=_TMP_PREFIX + path.name + ".", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-    _fsync_dir(path.parent)
-    return path
+def record_checksum(record: dict) -> str:
+    """SHA-256 of the record's content (key-sorted compact JSON, without the checksum itself)."""
+    body = {k: v for k, v in record.items() if k != "checksum"}
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
+
+
+def _stamp() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).strftime("%Y%m%dT%H%M%S.%fZ")
 
 
 class ResultStore:
-    """Records of a study directory (see the module docstring for the layout)."""
+    """Records of a study directory (see the module docstring for the layout and guarantees)."""
 
     def __init__(self, directory: str | Path):
         self.directory = Path(directory)
         self.runs_dir = self.directory / RUNS_DIR
         self.failed_dir = self.directory / FAILED_DIR
+        self.locks_dir = self.directory / LOCKS_DIR
 
     def prepare(self) -> None:
-        """Create the directories and remove temporary files a killed run left behind."""
-        self.runs_dir.mkdir(parents=True, exist_ok=True)
-        self.failed_dir.mkdir(parents=True, exist_ok=True)
+        """Create the directories; remove temporary files whose writing process has ended."""
+        for folder in (self.runs_dir, self.failed_dir, self.locks_dir):
+            folder.mkdir(parents=True, exist_ok=True)
         for folder in (self.directory, self.runs_dir, self.failed_dir):
-            for stale in folder.glob(_TMP_PREFIX + "*"):
-                try:
-                    stale.unlink()
-                except OSError:
-                    pass
+            for temp in folder.glob(TEMP_PREFIX + "*"):
+                if is_abandoned_temp(temp):
+                    try:
+                        temp.unlink()
+                    except OSError:  # another process cleaned it first
+                        pass
 
     def path(self, run_id: str) -> Path:
         return self.runs_dir / f"{run_id}.json"
 
     def done_ids(self) -> set[str]:
-        """Ids of the runs with a stored record."""
+        """Ids of the runs with a record file (not checked: see :meth:`load`)."""
         if not self.runs_dir.is_dir():
             return set()
         return {p.stem for p in self.runs_dir.glob("*.json") if not p.name.startswith(".")}
 
+    # ------------------------------------------------------------------ writing
     def write(self, record: dict) -> Path:
-        """Store a finished run at once; clears an earlier failure of the same run."""
+        """Store a finished run (adding its checksum); clears an earlier failure of the same run."""
+        record = {**record, "checksum": record_checksum(record)}
         path = atomic_write_text(self.path(record["run_id"]), json.dumps(record))
         failure = self.failed_dir / f"{record['run_id']}.json"
-        if failure.exists():
+        try:
             failure.unlink()
+        except FileNotFoundError:
+            pass
         return path
 
     def write_failure(self, run_id: str, failure: dict) -> Path:
         return atomic_write_text(self.failed_dir / f"{run_id}.json", json.dumps(failure, indent=1))
 
+    def set_aside(self, run_id: str, folder: str) -> Path | None:
+        """Move the record of ``run_id`` into ``folder`` (``corrupt`` or ``stale``), time-stamped.
+
+        Returns the new path, or None when there was no record.
+        """
+        target_dir = self.directory / folder
+        target_dir.mkdir(parents=True, exist_ok=True)
+        target = target_dir / f"{run_id}.json.{_stamp()}"
+        try:
+            os.replace(self.path(run_id), target)
+        except FileNotFoundError:
+            return None
+        return target
+
+    # ------------------------------------------------------------------ claims
+    def claim(self, run_id: str, wait: bool = False) -> FileLock | None:
+        """Take the lock of one run: the holder alone computes it.
+
+        Returns the held lock (release it with ``.release()``), or None when another process
+        holds it and ``wait`` is false. The operating system releases the lock of a process
+        that dies, so a killed study never blocks the next one.
+        """
+        self.locks_dir.mkdir(parents=True, exist_ok=True)
+        lock = FileLock(self.locks_dir / f"{run_id}.lock", thread_local=False)
+        try:
+            lock.acquire(timeout=-1 if wait else 0)
+        except Timeout:
+            return None
+        return lock
+
+    # ------------------------------------------------------------------ reading
+    def check(self, path: Path) -> dict:
+        """The record in ``path`` after every check; :class:`RecordError` names what failed."""
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except UnicodeDecodeError as err:
+            raise RecordError(path, f"not UTF-8 text ({err.reason}): the record is corrupt") from None
+        if not text.strip():
+            raise RecordError(path, "the record is empty (truncated)")
+        try:
+            record = json.loads(text)
+        except json.JSONDecodeError as err:
+            raise RecordError(path, f"not valid JSON ({err.msg} at character {err.pos} of {len(text)}): "
+                                    "the record is truncated or corrupt") from None
+        if not isinstance(record, dict):
+            raise RecordError(path, f"holds a {type(record).__name__}, not a run record")
+        fmt = record.get("format")
+        if fmt != RECORD_FORMAT and fmt not in LEGACY_FORMATS:
+            raise RecordError(path, f"field 'format' = {fmt!r}: not a {RECORD_FORMAT} record")
+        missing = [k for k in REQUIRED_FIELDS if k not in record]
+        if missing:
+            raise RecordError(path, f"field '{missing[0]}' is missing: the record is incomplete")
+        if record["run_id"] != path.stem:
+            raise RecordError(path, f"field 'run_id' = {record['run_id']!r} does not match the file name")
+        if fmt == RECORD_FORMAT:
+            expected = record_checksum(record)
+            if record.get("checksum") != expected:
+                raise RecordError(path, f"field 'checksum' = {record.get('checksum')!r} does not match the "
+                                        f"content ({expected}): the record was altered or damaged")
+        return record
+
+    def load(self, run_id: str) -> dict | None:
+        """The checked record of ``run_id``, None when there is none; :class:`RecordError` when bad."""
+        path = self.path(run_id)
+        if not path.is_file():
+            return None
+        return self.check(path)
+
+    def read(self, run_id: str) -> dict:
+        return self.check(self.path(run_id))
+
     def failures(self) -> list[dict]:
         if not self.failed_dir.is_dir():
             return []
-        return [json.loads(p.read_text(encoding="utf-8")) for p in sorted(self.failed_dir.glob("*.json"))
-                if not p.name.startswith(".")]
-
-    def read(self, run_id: str) -> dict:
-        return json.loads(self.path(run_id).read_text(encoding="utf-8"))
+        out = []
+        for p in sorted(self.failed_dir.glob("*.json")):
+            if p.name.startswith("."):
+                continue
+            try:
+                out.append(json.loads(p.read_text(encoding="utf-8")))
+            except (json.JSONDecodeError, UnicodeDecodeError):
+                out.append({"run_id": p.stem, "run": p.stem, "error": f"{p}: unreadable failure record"})
+        return out
 
     def records(self, run_ids: set[str] | None = None) -> Iterator[dict]:
-        """Every stored record (or those in ``run_ids``), in file-name order."""
+        """Every stored record (or those in ``run_ids``), checked, in file-name order.
+
+        Raises :class:`RecordError` naming the first record that fails its checks; running the
+        study again moves it aside and redoes the run.
+        """
         if not self.runs_dir.is_dir():
             return
         for p in sorted(self.runs_dir.glob("*.json")):
             if p.name.startswith(".") or (run_ids is not None and p.stem not in run_ids):
                 continue
-            record = json.loads(p.read_text(encoding="utf-8"))
-            if record.get("format") != RECORD_FORMAT:
-                raise ValueError(f"{p}: field 'format' = {record.get('format')!r}: not a {RECORD_FORMAT} record")
-            yield record
+            try:
+                yield self.check(p)
+            except RecordError as err:
+                raise RecordError(err.path, f"{err.reason}; run the study again to set it aside and redo "
+                                            "the run") from None

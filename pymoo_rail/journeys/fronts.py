@@ -131,9 +131,7 @@ def strategy_front(case: Case, *, dx_m: float | None = None, n_speeds: int = 31,
     coast = np.linspace(0.02 * length, length, n_coast)
     cruise, coast_from = (a.ravel() for a in np.meshgrid(speeds, coast, indexing="ij"))
     out = sim.run_batch(strategy_programs(length, cruise, coast_from))
-    fastest = sim.flat_out()
-    if not fastest.reached:
-        raise CaseError("line", case.name, "the train cannot reach the platform even at full traction")
+    fastest = sim.check_reachable()  # raises naming the cause (neutral section, descent, mass, climb)
     reached = out[:, k.OUT_REACHED] > 0
     times = out[:, k.OUT_RUNNING_TIME_S]
     keep = reached & (times <= max_time_factor * fastest.running_time_s)

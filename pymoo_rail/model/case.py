@@ -5,7 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.curves import KMH_PER_MS
+from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
@@ -26,6 +27,11 @@ class Case:
 
     ``legs`` is empty for a single stop-to-stop run; multi-section cases (e.g. the cooperative
     pair of seed 001) list consecutive legs, and ``leg(k)`` returns each as a case of its own.
+
+    ``initial_speed_ms`` and ``final_speed_ms`` are the speeds at the start and at the end of the
+    line (default 0: from standstill to a stop at the platform); a run may start and end moving,
+    e.g. at a timing point of a journey or in a benchmark that fixes boundary speeds. Case files
+    give them in km/h (``run.initial_speed_kmh``, ``run.final_speed_kmh``).
     """
 
     name: str
@@ -37,18 +43,22 @@ class Case:
     description: str = ""
     time_margin_s: float = 0.0
     legs: tuple[Leg, ...] = ()
+    initial_speed_ms: float = 0.0
+    final_speed_ms: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise CaseError("name", self.name, "must be a non-empty string")
         for field in ("planned_time_s", "dwell_s", "time_margin_s"):
             value = getattr(self, field)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise CaseError(f"run.{field}", value, "must be a finite number")
-            if value < 0 or (field == "planned_time_s" and value <= 0):
-                raise CaseError(f"run.{field}", value, "must be positive" if field == "planned_time_s" else "must be >= 0")
+            check_number(f"run.{field}", value, positive=field == "planned_time_s", nonneg=True)
+        self._check_boundary_speeds()
         previous_end = 0.0
         for k, leg in enumerate(self.legs):
+            check_number(f"run.legs[{k}].start_m", leg.start_m, nonneg=True)
+            check_number(f"run.legs[{k}].end_m", leg.end_m, positive=True)
+            check_number(f"run.legs[{k}].planned_time_s", leg.planned_time_s, positive=True)
+            check_number(f"run.legs[{k}].dwell_s", leg.dwell_s, nonneg=True)
             if abs(leg.start_m - previous_end) > 1e-9 or leg.end_m <= leg.start_m:
                 raise CaseError(f"run.legs[{k}]", leg, "legs must be consecutive, positive-length and start at 0")
             if leg.planned_time_s <= 0:
@@ -56,6 +66,24 @@ class Case:
             previous_end = leg.end_m
         if self.legs and abs(previous_end - self.line.length_m) > 1e-9:
             raise CaseError("run.legs", f"end at {previous_end} m", f"must end at line.length_m = {self.line.length_m}")
+
+    def _check_boundary_speeds(self) -> None:
+        limits = self.line.speed_limits
+        ends = (("initial_speed", self.initial_speed_ms, limits[0][2] if limits else math.inf),
+                ("final_speed", self.final_speed_ms, limits[-1][2] if limits else math.inf))
+        for field, speed_ms, limit_kmh in ends:
+            name = f"run.{field}_kmh"
+            if isinstance(speed_ms, bool) or not isinstance(speed_ms, (int, float)) or not math.isfinite(speed_ms):
+                raise CaseError(name, speed_ms, "must be a finite number")
+            kmh = speed_ms * KMH_PER_MS
+            if speed_ms < 0.0:
+                raise CaseError(name, kmh, "must be >= 0")
+            cap = min(limit_kmh, self.train.max_speed_kmh)
+            if kmh > cap + 1e-9:
+                raise CaseError(name, kmh, f"is above the speed limit there ({cap:g} km/h)")
+        if self.legs and (self.initial_speed_ms or self.final_speed_ms):
+            raise CaseError("run.legs", len(self.legs), "a case with legs starts and ends each leg at rest: "
+                                                        "boundary speeds are not supported with legs")
 
     def leg(self, index: int) -> Case:
         """Leg ``index`` of a multi-section case as a single-run case."""

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.errors import CaseError, check_number
 
 KMH_PER_MS = 3.6
 
@@ -43,27 +43,50 @@ class ForceCurve:
             raise CaseError("segments|table|max_force_kn", forms,
                             "exactly one form of the force curve must be given")
         if self.segments is not None:
+            if len(self.segments) == 0:
+                raise CaseError("segments", [], "needs at least one segment {v_max_kmh = ..., poly = [...]}")
             last = 0.0
             for k, (v_max, poly) in enumerate(self.segments):
-                if not (math.isfinite(v_max) and v_max > last):
-                    raise CaseError(f"segments[{k}].v_max_kmh", v_max,
-                                    "segment speeds must be finite and strictly increasing")
-                if len(poly) == 0 or not all(math.isfinite(c) for c in poly):
-                    raise CaseError(f"segments[{k}].poly", poly, "needs finite coefficients")
+                v_max = check_number(f"segments[{k}].v_max_kmh", v_max)
+                if not v_max > last:
+                    raise CaseError(f"segments[{k}].v_max_kmh", v_max, "segment speeds must be > 0 and strictly increase")
+                if len(poly) == 0:
+                    raise CaseError(f"segments[{k}].poly", list(poly), "needs at least one coefficient")
+                for j, c in enumerate(poly):
+                    check_number(f"segments[{k}].poly[{j}]", c)
                 last = v_max
         if self.table is not None:
-            if len(self.table) < 1 or self.table[0][0] != 0.0:
-                raise CaseError("table", self.table[:1], "the first point must be at 0 km/h")
+            if len(self.table) == 0:
+                raise CaseError("table", [], "needs at least one point [v_kmh, force_kn]")
+            for k, row in enumerate(self.table):
+                if len(row) != 2:
+                    raise CaseError(f"table[{k}]", list(row), "needs 2 numbers [v_kmh, force_kn]")
+                check_number(f"table[{k}][0]", row[0], nonneg=True)
+                check_number(f"table[{k}][1]", row[1], nonneg=True)
+            if self.table[0][0] != 0.0:
+                raise CaseError("table[0]", list(self.table[0]), "the first point must be at 0 km/h")
             for k in range(1, len(self.table)):
                 if not self.table[k][0] > self.table[k - 1][0]:
-                    raise CaseError(f"table[{k}]", self.table[k], "speeds must strictly increase")
-            for k, (_, f) in enumerate(self.table):
-                if not (math.isfinite(f) and f >= 0):
-                    raise CaseError(f"table[{k}]", self.table[k], "forces must be finite and >= 0")
-        if self.max_force_kn is not None and not (math.isfinite(self.max_force_kn) and self.max_force_kn > 0):
-            raise CaseError("max_force_kn", self.max_force_kn, "must be a positive number")
-        if self.max_power_kw is not None and not (math.isfinite(self.max_power_kw) and self.max_power_kw > 0):
-            raise CaseError("max_power_kw", self.max_power_kw, "must be a positive number")
+                    raise CaseError(f"table[{k}]", list(self.table[k]), "speeds must strictly increase")
+        check_number("max_force_kn", self.max_force_kn, positive=True, optional=True)
+        check_number("max_power_kw", self.max_power_kw, positive=True, optional=True)
+
+    def check_nonnegative(self, field: str, max_speed_kmh: float) -> None:
+        """Raise :class:`CaseError` if a polynomial segment is negative anywhere from 0 to
+        ``max_speed_kmh`` (a negative force limit would be clipped to 0: another train)."""
+        if self.segments is None:
+            return  # tables and caps are checked >= 0 point by point
+        lower = 0.0
+        for k, (v_max, poly) in enumerate(self.segments):
+            # the speeds the train uses: the last segment also applies beyond its v_max
+            upper = max_speed_kmh if k == len(self.segments) - 1 else min(v_max, max_speed_kmh)
+            if upper > lower:
+                speed, value = _polynomial_minimum(poly, lower, upper)
+                if value < -1e-9:
+                    raise CaseError(f"{field}.segments[{k}].poly", list(poly),
+                                    f"gives {value:.6g} kN at {speed:.6g} km/h: a force limit must be >= 0 over "
+                                    f"the segment's speeds [{lower:g}, {upper:g}] km/h")
+            lower = v_max
 
     def piecewise_si(self) -> tuple[np.ndarray, np.ndarray, float, float]:
         """The curve in SI units for the kernels.
@@ -119,6 +142,19 @@ class ForceCurve:
         return np.maximum(out, 0.0)
 
 
+def _polynomial_minimum(poly: tuple[float, ...], lower: float, upper: float) -> tuple[float, float]:
+    """(speed, value) of the smallest value of a polynomial on [lower, upper] (ends and stationary points)."""
+    candidates = [lower, upper]
+    if len(poly) > 2:
+        derivative = np.polynomial.polynomial.polyder(np.asarray(poly, dtype=float))
+        for root in np.polynomial.polynomial.polyroots(derivative):
+            if abs(root.imag) < 1e-9 and lower < root.real < upper:
+                candidates.append(float(root.real))
+    values = np.polynomial.polynomial.polyval(np.asarray(candidates), np.asarray(poly, dtype=float))
+    k = int(np.argmin(values))
+    return candidates[k], float(values[k])
+
+
 @dataclass(frozen=True)
 class DavisResistance:
     """Basic running resistance ``W0 = a + b v + c v^2``.
@@ -136,13 +172,11 @@ class DavisResistance:
 
     def __post_init__(self) -> None:
         for name in ("a", "b", "c"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise CaseError(f"resistance.{name}", value, "must be a finite number >= 0")
+            check_number(f"train.resistance.{name}", getattr(self, name), nonneg=True)
         if self.unit not in ("kN", "N/kN"):
-            raise CaseError("resistance.unit", self.unit, "must be 'kN' or 'N/kN'")
+            raise CaseError("train.resistance.unit", self.unit, "must be 'kN' or 'N/kN'")
         if self.speed_unit not in ("kmh", "ms"):
-            raise CaseError("resistance.speed_unit", self.speed_unit, "must be 'kmh' or 'ms'")
+            raise CaseError("train.resistance.speed_unit", self.speed_unit, "must be 'kmh' or 'ms'")
 
     def coefficients_si(self, mass_kg: float, g_ms2: float = 9.81) -> tuple[float, float, float]:
         """(A [N], B [N s/m], C [N s^2/m^2]) with v in m/s."""

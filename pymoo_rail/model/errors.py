@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 
 class CaseError(ValueError):
     """A case file or case object holds a value the model cannot use.
@@ -21,3 +23,27 @@ class CaseError(ValueError):
 
 class InfeasibleCaseError(CaseError):
     """The case asks for something the train cannot do (e.g. a planned time below the minimum)."""
+
+
+def check_number(field: str, value: object, *, positive: bool = False, nonneg: bool = False,
+                 upper: float | None = None, optional: bool = False, source: str | None = None) -> float | None:
+    """``value`` as a float after checking its type and range; :class:`CaseError` naming ``field``.
+
+    Booleans and strings are refused (TOML ``true`` or ``"80"`` are not numbers), as are NaN and
+    infinities: nothing is coerced.
+    """
+    if value is None:
+        if optional:
+            return None
+        raise CaseError(field, value, "is required", source)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise CaseError(field, value, f"must be a number, not {type(value).__name__}", source)
+    if not math.isfinite(value):
+        raise CaseError(field, value, "must be a finite number", source)
+    if positive and value <= 0:
+        raise CaseError(field, value, "must be > 0 (positive)", source)
+    if nonneg and value < 0:
+        raise CaseError(field, value, "must be >= 0", source)
+    if upper is not None and value > upper:
+        raise CaseError(field, value, f"must be <= {upper}", source)
+    return float(value)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.errors import CaseError, check_number
 
 Interval = tuple[float, float]
 Valued = tuple[float, float, float]
@@ -58,11 +58,15 @@ class Line:
     gradient_model: str = "train_length"
 
     def __post_init__(self) -> None:
-        if isinstance(self.length_m, bool) or not isinstance(self.length_m, (int, float)) \
-                or not math.isfinite(self.length_m) or self.length_m <= 0:
-            raise CaseError("line.length_m", self.length_m, "must be a positive number")
+        check_number("line.length_m", self.length_m, positive=True)
         for name in ("gradients", "speed_limits", "curves", "tunnels", "neutral_sections"):
-            object.__setattr__(self, name, tuple(tuple(float(v) for v in row) for row in getattr(self, name)))
+            rows = []
+            for k, row in enumerate(getattr(self, name)):
+                if isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
+                    raise CaseError(f"line.{name}[{k}]", row, "must be an array of numbers")
+                # type-checked before converting: true or "80" is not a number
+                rows.append(tuple(check_number(f"line.{name}[{k}][{j}]", v) for j, v in enumerate(row)))
+            object.__setattr__(self, name, tuple(rows))
         _check_intervals("line.gradients", self.gradients, self.length_m, tile=True, width=3)
         _check_intervals("line.speed_limits", self.speed_limits, self.length_m, tile=True, width=3)
         _check_intervals("line.curves", self.curves, self.length_m, tile=False, width=3)

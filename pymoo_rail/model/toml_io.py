@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -12,13 +13,13 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 from pymoo_rail.model.case import Case, Leg
-from pymoo_rail.model.curves import DavisResistance, ForceCurve
+from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
 from pymoo_rail.model.errors import CaseError
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
 _TOP = {"name", "source", "description", "run", "train", "line"}
-_RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs"}
+_RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs", "initial_speed_kmh", "final_speed_kmh"}
 _LEG = {"start_m", "end_m", "planned_time_s", "dwell_s"}
 _TRAIN = {"name", "mass_t", "rotary_factor", "length_m", "max_speed_kmh", "max_accel_ms2", "max_decel_ms2",
           "traction_efficiency", "regen_efficiency", "regen_min_speed_kmh", "aux_power_kw",
@@ -43,23 +44,42 @@ def _table(data: Any, field: str, allowed: set[str], required: set[str], source:
     return data
 
 
+def _list(value: Any, field: str, source: str) -> list:
+    if not isinstance(value, list):
+        raise CaseError(field, value, f"must be an array, not {type(value).__name__}", source)
+    return value
+
+
+def _rows(value: Any, field: str, source: str) -> tuple[tuple, ...]:
+    """An array of arrays (e.g. ``[[start_m, end_m, permille], ...]``), each checked to be an array."""
+    return tuple(tuple(_list(row, f"{field}[{k}]", source)) for k, row in enumerate(_list(value, field, source)))
+
+
 def _curve(data: Any, field: str, allowed: set[str], source: str) -> ForceCurve:
     data = _table(data, field, allowed, set(), source)
     segments = None
     if "segments" in data:
         rows = []
-        for k, seg in enumerate(data["segments"]):
+        for k, seg in enumerate(_list(data["segments"], f"{field}.segments", source)):
             seg = _table(seg, f"{field}.segments[{k}]", _SEGMENT, _SEGMENT, source)
-            rows.append((float(seg["v_max_kmh"]), tuple(float(c) for c in seg["poly"])))
+            rows.append((seg["v_max_kmh"], tuple(_list(seg["poly"], f"{field}.segments[{k}].poly", source))))
         segments = tuple(rows)
-    table = None
-    if "table" in data:
-        table = tuple((float(v), float(f)) for v, f in data["table"])
+    table = _rows(data["table"], f"{field}.table", source) if "table" in data else None
     try:
         return ForceCurve(segments=segments, table=table, max_force_kn=data.get("max_force_kn"),
                           max_power_kw=data.get("max_power_kw"))
     except CaseError as err:
         raise CaseError(f"{field}.{err.field}", err.value, err.reason, source) from None
+
+
+def _speed_ms(run: dict, key: str) -> float:
+    """A boundary speed of ``[run]`` (km/h in the file) in m/s; a bad value names the field."""
+    value = run.get(key, 0.0)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise CaseError(f"run.{key}", value, "must be a finite number of km/h")
+    if value < 0.0:
+        raise CaseError(f"run.{key}", value, "must be >= 0")
+    return value / KMH_PER_MS
 
 
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
@@ -73,7 +93,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     line = _table(data["line"], "line", _LINE, {"length_m", "gradients", "speed_limits"}, source)
     try:
         legs = tuple(Leg(**_table(leg, f"run.legs[{k}]", _LEG, {"start_m", "end_m", "planned_time_s"}, source))
-                     for k, leg in enumerate(run.get("legs", [])))
+                     for k, leg in enumerate(_list(run.get("legs", []), "run.legs", source)))
         train = Train(
             name=tr.get("name", ""),
             mass_t=tr["mass_t"], length_m=tr["length_m"], max_speed_kmh=tr["max_speed_kmh"],
@@ -90,21 +110,24 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
             regen_max_power_kw=braking.get("regen_max_power_kw"),
         )
         line_obj = Line(
-            length_m=line["length_m"], gradients=tuple(map(tuple, line["gradients"])),
-            speed_limits=tuple(map(tuple, line["speed_limits"])),
-            curves=tuple(map(tuple, line.get("curves", []))), tunnels=tuple(map(tuple, line.get("tunnels", []))),
-            neutral_sections=tuple(map(tuple, line.get("neutral_sections", []))),
+            length_m=line["length_m"], gradients=_rows(line["gradients"], "line.gradients", source),
+            speed_limits=_rows(line["speed_limits"], "line.speed_limits", source),
+            curves=_rows(line.get("curves", []), "line.curves", source),
+            tunnels=_rows(line.get("tunnels", []), "line.tunnels", source),
+            neutral_sections=_rows(line.get("neutral_sections", []), "line.neutral_sections", source),
             gradient_model=line.get("gradient_model", "train_length"),
         )
         return Case(name=data["name"], source=data.get("source", ""), description=data.get("description", ""),
                     train=train, line=line_obj, planned_time_s=run["planned_time_s"],
-                    dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs)
+                    dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs,
+                    initial_speed_ms=_speed_ms(run, "initial_speed_kmh"),
+                    final_speed_ms=_speed_ms(run, "final_speed_kmh"))
     except CaseError as err:
         if err.source is None:
             raise CaseError(err.field, err.value, err.reason, source) from None
         raise
-    except (TypeError, ValueError) as err:  # wrong types inside rows, e.g. a string where a number goes
-        raise CaseError("<entry>", None, f"malformed value: {err}", source) from None
+    except (TypeError, ValueError) as err:  # a last resort: every field above is checked by name
+        raise CaseError("case", type(err).__name__, f"malformed value: {err}", source) from None
 
 
 def read_case(path: str | Path) -> Case:
@@ -166,6 +189,10 @@ def case_to_dict(case: Case) -> dict:
     ln = case.line
     run: dict[str, Any] = {"planned_time_s": case.planned_time_s, "dwell_s": case.dwell_s,
                            "time_margin_s": case.time_margin_s}
+    if case.initial_speed_ms:
+        run["initial_speed_kmh"] = case.initial_speed_ms * KMH_PER_MS
+    if case.final_speed_ms:
+        run["final_speed_kmh"] = case.final_speed_ms * KMH_PER_MS
     if case.legs:
         run["legs"] = [{"start_m": g.start_m, "end_m": g.end_m, "planned_time_s": g.planned_time_s,
                         "dwell_s": g.dwell_s} for g in case.legs]

@@ -2,29 +2,16 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.errors import CaseError, check_number
 
 GRAVITY_MS2 = 9.81
 
 
-def _require(field: str, value: float | None, *, positive: bool = False, nonneg: bool = False,
-             upper: float | None = None, optional: bool = False) -> None:
-    if value is None:
-        if optional:
-            return
-        raise CaseError(field, value, "is required")
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise CaseError(field, value, "must be a finite number")
-    if positive and value <= 0:
-        raise CaseError(field, value, "must be > 0")
-    if nonneg and value < 0:
-        raise CaseError(field, value, "must be >= 0")
-    if upper is not None and value > upper:
-        raise CaseError(field, value, f"must be <= {upper}")
+def _require(field: str, value: float | None, **kwargs) -> None:
+    check_number(field, value, **kwargs)
 
 
 @dataclass(frozen=True)
@@ -65,6 +52,11 @@ class Train:
         _require("train.braking.regen_max_force_kn", self.regen_max_force_kn, positive=True, optional=True)
         _require("train.braking.regen_max_power_kw", self.regen_max_power_kw, positive=True, optional=True)
         _require("train.aux_power_kw", self.aux_power_kw, nonneg=True)
+        for name in ("traction", "braking"):
+            curve = getattr(self, name)
+            if not isinstance(curve, ForceCurve):
+                raise CaseError(f"train.{name}", curve, "must be a ForceCurve")
+            curve.check_nonnegative(f"train.{name}", self.max_speed_kmh)
 
     @property
     def mass_kg(self) -> float:

@@ -327,7 +327,9 @@ def backward_sweep(envelope_ms, time_price_w, bias, fixed_u1, fixed_e, fixed_dt,
     ``time_price_w`` is the price of time beyond the auxiliary power (already in the energies).
     """
     n, n_speeds = value.shape
-    value[n - 1, :] = 0.0  # standstill at the platform (the envelope is 0 there: one state)
+    # at the end of the line: the envelope there is the final speed (0 at a platform: one state);
+    # the simulator lands on it, a slower arrival (coasting in) is a run like any other
+    value[n - 1, :] = 0.0
     for i in range(n - 2, -1, -1):
         top1 = envelope_ms[i + 1] ** 2
         v_next = value[i + 1]
@@ -351,7 +353,7 @@ def backward_sweep(envelope_ms, time_price_w, bias, fixed_u1, fixed_e, fixed_dt,
 
 @njit(cache=True)
 def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds):
-    """Drive from standstill choosing each cell's control from the cost-to-go (continuous state).
+    """Drive from the case's initial speed choosing each cell's control from the cost-to-go (continuous state).
 
     Between controls whose costs differ by at most ``tie_j`` (J) the run keeps its previous mode,
     or holds its speed after a partial-traction landing: near-ties otherwise make the regime
@@ -362,8 +364,8 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     control was found at that cell.
     """
     n = m.position_m.shape[0]
-    v = 0.0
-    speeds[0] = 0.0
+    v = m.initial_speed_ms
+    speeds[0] = v
     energy = 0.0
     time = 0.0
     previous = MODE_TRACTION

@@ -143,7 +143,10 @@ class OptimalSolver:
             raise InfeasibleCaseError("line", self.case.name,
                                       f"the solver finds no way to the platform beyond {x:.1f} m", self.case.name)
         program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
-        return _Solve(lambda_w, program, speeds, energy, time, float(self._value[0, 0]))
+        model = self.simulator.model
+        value_j = float(dp.interp_value(self._value[0], model.envelope_ms[0] ** 2, model.initial_speed_ms ** 2,
+                                        self.top_bias))
+        return _Solve(lambda_w, program, speeds, energy, time, value_j)
 
     def _adjust(self, solution: _Solve, target: float) -> _Solve | None:
         """Move the run's last switch into the final coast until it takes the requested time.

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Sequence
+
+from pymoo_rail.atomic import atomic_path
 
 # axis labels with units for the rail objectives (pymoo_rail.problems.OBJECTIVES) and indicators
 OBJECTIVE_LABELS = {
@@ -46,21 +46,15 @@ def indicator_label(name: str) -> str:
 def save_figure(fig, path: str | Path, dpi: int = 150, close: bool = True) -> Path:
     """Save a figure (format from the suffix) through a temporary file, so no half-written image
     is left behind; closes it by default to free memory in long loops."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-" + path.stem + ".", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        os.replace(tmp, path)
+        with atomic_path(path, suffix=Path(path).suffix) as tmp:
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
         if close:
             import matplotlib.pyplot as plt
 
             plt.close(fig)
-    return path
+    return Path(path)
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, figsize=(7.0, 4.5), **kwargs):

@@ -65,7 +65,12 @@ class SpeedCodes:
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
-        return speed_code_programs(self.boundaries_m, np.asarray(X, dtype=float) / KMH_PER_MS)
+        X = np.asarray(X, dtype=float)
+        negative = np.argwhere(X < 0)
+        if negative.size:  # reported in km/h, the unit it was given in
+            idx = tuple(int(i) for i in negative[0])
+            raise ValueError(f"speed_codes{list(idx)} = {float(X[idx])} km/h: speed codes must be >= 0 km/h")
+        return speed_code_programs(self.boundaries_m, X / KMH_PER_MS)
 
     def fixed(self) -> np.ndarray:
         """Mask of genes that cannot change (inside neutral sections)."""

@@ -13,6 +13,34 @@ from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 
 OBJECTIVES = ("energy", "running_time", "time_error", "jerk", "stop_error")
+DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m"}
+
+
+class DecisionError(ValueError):
+    """Decision vectors a problem cannot evaluate; ``rows`` lists every bad row of the population."""
+
+    def __init__(self, message: str, rows: list[int]):
+        self.rows = rows
+        super().__init__(message)
+
+
+def check_decisions(X: np.ndarray, xl: np.ndarray, xu: np.ndarray, unit: str = "") -> np.ndarray:
+    """``X`` (N, n_var) as floats after checking it is finite and within ``[xl, xu]``; else :class:`DecisionError`."""
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    if X.ndim != 2 or X.shape[1] != xl.shape[0]:
+        raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {xl.shape[0]}")
+    unit = f" {unit}" if unit else ""
+    for bad, what in ((~np.isfinite(X), "is not a finite number"), ((X < xl) | (X > xu), "is outside its bounds")):
+        rows = np.flatnonzero(bad.any(axis=1))
+        if rows.size:
+            r = int(rows[0])
+            j = int(np.flatnonzero(bad[r])[0])
+            listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
+            raise DecisionError(
+                f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
+                f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
+                "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
+    return X
 SEED_002_WEIGHTS = {"energy": 0.1, "jerk": 0.2, "stop_error": 0.4, "time_error": 0.3}
 
 
@@ -84,7 +112,14 @@ class SpeedProfileProblem(Problem):
     -----
     Every form carries the constraints "stop at the platform" and "never above a limit" (the
     kernel already brakes onto the limits, so the latter is a guard). Infeasible decisions come
-    back as constraint violation; a NaN in a decision vector is bad input and raises.
+    back as constraint violation.
+
+    Decision vectors must be finite and inside ``[xl, xu]``: ``evaluate`` raises a
+    :class:`DecisionError` (a ``ValueError``) naming every bad row of the population, the first
+    bad variable with its value, unit and bounds. pymoo's operators and ours repair offspring
+    into the bounds, so such a row is a bug upstream; nothing is clipped or turned into NaN
+    objectives behind the caller's back. Repair first (e.g. ``np.clip(X, problem.xl,
+    problem.xu)``) if clipping is what you mean.
     """
 
     def __init__(self, case: Case, objectives: Sequence[str] = ("energy", "time_error"),
@@ -163,8 +198,18 @@ class SpeedProfileProblem(Problem):
             return self.tracker.run_batch(programs)
         return self.simulator.run_batch(programs)
 
+    def check_decisions(self, X: np.ndarray) -> np.ndarray:
+        """``X`` as a float array (N, n_var) after checking it is finite and inside ``[xl, xu]``.
+
+        Raises
+        ------
+        DecisionError
+            Naming the bad rows, and the first bad variable, value and bounds in the encoding's unit.
+        """
+        return check_decisions(X, self.xl, self.xu, DECISION_UNITS.get(self.encoding.name, ""))
+
     def _evaluate(self, x, out, *args, **kwargs):
-        s = self.summaries(x)
+        s = self.summaries(self.check_decisions(x))
         values = objective_values(s, self.objectives, self.case.planned_time_s)
         if self.weights is not None:
             values = (values / self.scales) @ self.weights
@@ -186,7 +231,7 @@ class SpeedProfileProblem(Problem):
         x = np.asarray(x, dtype=float)
         if x.ndim != 1 or x.shape[0] != self.n_var:
             raise ValueError(f"x must be one decision vector of length n_var = {self.n_var}, got shape {x.shape}")
-        program = self.encoding.programs(x[None, :])[0]
+        program = self.encoding.programs(self.check_decisions(x[None, :]))[0]
         if self.tracker is not None:
             return self.tracker.run_program(program)
         return self.simulator.run(program)

@@ -35,6 +35,7 @@ from numba import njit, prange
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
+    landing_force,
     max_braking,
     max_traction,
 )
@@ -111,25 +112,8 @@ def _share_above(v0, v1, v_cut):
     return (hi * hi - v_cut * v_cut) / (hi * hi - lo * lo)
 
 
-@njit(cache=True, inline="always")
-def _landing_force(m, v0, v1, cell):
-    """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
-
-    Returns (force, W0, feasible): feasible is False when the force exceeds what the train has.
-    The tolerance is relative (1e-8): the braking envelope is built with the maximum braking force
-    at an iterated mid-speed, and landing on it can need that force plus a rounding residue far
-    above 1e-9 N when the force depends on speed (power caps, no deceleration cap).
-    """
-    v_mid = 0.5 * (v0 + v1)
-    w0 = davis_force(m, v_mid)
-    f = m.effective_mass_kg * (v1 * v1 - v0 * v0) / (2.0 * m.dx_m) + w0 + m.line_force_n[cell]
-    if f > 0.0:
-        f_max = max_traction(m, v_mid, cell)
-        feasible = f <= f_max + 1e-9 + 1e-8 * f_max
-    else:
-        f_max = max_braking(m, v_mid, cell)
-        feasible = -f <= f_max + 1e-9 + 1e-8 * f_max
-    return f, w0, feasible
+# the landing force lives with the braking envelope it must agree with (``physics``)
+_landing_force = landing_force
 
 
 # Slots of the running totals of a run (see ``new_totals``).
@@ -298,7 +282,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     n = m.position_m.shape[0]
     n_rows = program.shape[0]
     totals = new_totals()
-    v = 0.0
+    v = m.initial_speed_ms
     row = 0
     hold_speed = -1.0
     reached = True
@@ -306,7 +290,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     count = 1
     if record:
         tr_x[0] = 0.0
-        tr_v[0] = 0.0
+        tr_v[0] = v
         tr_t[0] = 0.0
     for i in range(n - 1):
         x_mid = m.position_m[i] + 0.5 * m.dx_m

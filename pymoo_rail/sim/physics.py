@@ -12,7 +12,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from pymoo_rail.model import Case, TrackGrid, build_grid
+from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
 
 
 class KernelModel(NamedTuple):
@@ -46,6 +46,8 @@ class KernelModel(NamedTuple):
     line_force_n: np.ndarray
     neutral: np.ndarray
     envelope_ms: np.ndarray
+    initial_speed_ms: float = 0.0
+    final_speed_ms: float = 0.0
 
 
 def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | None = None) -> KernelModel:
@@ -71,8 +73,14 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
         dx_m=grid.dx_m, position_m=grid.position_m, limit_ms=grid.limit_ms,
         grade_force_n=grid.grade_force_n, line_force_n=np.ascontiguousarray(grid.line_force_n),
         neutral=grid.neutral, envelope_ms=np.empty(0),
+        initial_speed_ms=float(case.initial_speed_ms), final_speed_ms=float(case.final_speed_ms),
     )
-    return model._replace(envelope_ms=braking_envelope(model))
+    envelope = braking_envelope(model)
+    if model.initial_speed_ms > envelope[0]:
+        raise InfeasibleCaseError("run.initial_speed_kmh", case.initial_speed_ms * 3.6,
+                                  f"is above the braking envelope at the start ({envelope[0] * 3.6:.3f} km/h): "
+                                  "no braking meets the limits ahead", case.name)
+    return model._replace(envelope_ms=envelope)
 
 
 @njit(cache=True, inline="always")
@@ -151,28 +159,87 @@ def electric_braking(m, v, brake_n):
     return electric_braking_capped(m, v, brake_n)
 
 
+# Relative tolerance of a landing: the force it needs may exceed what the train has by this much
+# (rounding of the force-speed curves); the braking envelope itself is built with none.
+LANDING_RTOL = 1e-8
+
+
+@njit(cache=True, inline="always")
+def landing_force(m, v0, v1, cell):
+    """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
+
+    The forces are taken at the mean speed ``(v0 + v1) / 2``, the second stage of the simulator's
+    step. Returns (force N, + traction / - braking, W0 N, feasible): feasible is False when the
+    force exceeds what the train has beyond :data:`LANDING_RTOL`.
+    """
+    v_mid = 0.5 * (v0 + v1)
+    w0 = davis_force(m, v_mid)
+    f = m.effective_mass_kg * (v1 * v1 - v0 * v0) / (2.0 * m.dx_m) + w0 + m.line_force_n[cell]
+    if f > 0.0:
+        f_max = max_traction(m, v_mid, cell)
+        feasible = f <= f_max + 1e-9 + LANDING_RTOL * f_max
+    else:
+        f_max = max_braking(m, v_mid, cell)
+        feasible = -f <= f_max + 1e-9 + LANDING_RTOL * f_max
+    return f, w0, feasible
+
+
+@njit(cache=True, inline="always")
+def braking_shortfall(m, v0, v1, cell):
+    """Braking force a landing from v0 onto v1 needs beyond the train's maximum (N, <= 0 if it can).
+
+    The exact expression of :func:`landing_force`, so that an envelope speed with a shortfall
+    <= 0 is, by construction, a speed from which the landing succeeds.
+    """
+    v_mid = 0.5 * (v0 + v1)
+    need = m.effective_mass_kg * (v0 * v0 - v1 * v1) / (2.0 * m.dx_m) - davis_force(m, v_mid) - m.line_force_n[cell]
+    return need - max_braking(m, v_mid, cell)
+
+
 @njit(cache=True)
 def braking_envelope(m):
     """Highest speed at each node from which maximum braking still meets every limit ahead.
 
-    Integrated backwards from standstill at the platform with the same two-stage scheme the
-    forward simulation uses, and never above the node's speed limit.
+    Integrated backwards from the final speed at the end of the line (standstill at the platform
+    by default), never above the node's speed limit. Each node's speed is the largest ``v0`` for
+    which :func:`landing_force` onto the next node's envelope is feasible without tolerance
+    (:func:`braking_shortfall` <= 0): a fixed-point estimate at the mean speed, then bisection
+    on the landing condition itself, so that the simulator can always land on the envelope.
     """
     n = m.position_m.shape[0]
     env = np.empty(n)
-    env[n - 1] = 0.0
+    v_end = m.final_speed_ms
+    env[n - 1] = v_end if v_end < m.limit_ms[n - 1] else m.limit_ms[n - 1]
     dx = m.dx_m
     for i in range(n - 2, -1, -1):
         v1 = env[i + 1]
-        # decelerating force at an estimate of the mean speed, refined twice
+        # decelerating force at an estimate of the mean speed, refined to a fixed point
         v_mid = v1
         u = v1 * v1
-        for _ in range(3):
+        for _ in range(8):
             decel = (max_braking(m, v_mid, i) + davis_force(m, v_mid) + m.line_force_n[i]) / m.effective_mass_kg
             u = v1 * v1 + 2.0 * dx * decel
             if u < 0.0:
                 u = 0.0
-            v_mid = 0.5 * (v1 + math.sqrt(u))
+            v_new = 0.5 * (v1 + math.sqrt(u))
+            if abs(v_new - v_mid) <= 1e-15 * (1.0 + v_mid):
+                break
+            v_mid = v_new
         v0 = math.sqrt(u)
-        env[i] = v0 if v0 < m.limit_ms[i] else m.limit_ms[i]
+        if v0 > m.limit_ms[i]:
+            v0 = m.limit_ms[i]
+        if braking_shortfall(m, v0, v1, i) > 0.0:
+            # the estimate is a rounding residue too fast: bisect down to a speed that lands
+            lo = v1 if braking_shortfall(m, v1, v1, i) <= 0.0 else 0.0
+            hi = v0
+            for _ in range(200):
+                mid = 0.5 * (lo + hi)
+                if mid <= lo or mid >= hi:
+                    break
+                if braking_shortfall(m, mid, v1, i) <= 0.0:
+                    lo = mid
+                else:
+                    hi = mid
+            v0 = lo
+        env[i] = v0
     return env

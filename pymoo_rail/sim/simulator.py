@@ -8,6 +8,7 @@ from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.drivers import flat_out_program
 from pymoo_rail.sim.physics import KernelModel, build_kernel_model
+from pymoo_rail.sim.stall import explain_stall
 from pymoo_rail.sim.trajectory import Trajectory, energy_from_summary, summary_dict
 
 
@@ -57,17 +58,20 @@ class Simulator:
         """Running time of the flat-out run, the shortest the train can do on this grid."""
         return self.flat_out().running_time_s
 
+    def check_reachable(self) -> Trajectory:
+        """The flat-out run; :class:`InfeasibleCaseError` naming the cause when it stops short."""
+        fastest = self.flat_out()
+        if not fastest.reached:
+            raise explain_stall(self.case, self.grid, float(fastest.summary["stop_position_m"]))
+        return fastest
+
     def check_planned_time(self, planned_time_s: float | None = None) -> float:
         """Raise :class:`InfeasibleCaseError` when the planned time is below the minimum.
 
         Returns the minimum running time.
         """
         planned = self.case.planned_time_s if planned_time_s is None else planned_time_s
-        fastest = self.flat_out()
-        if not fastest.reached:
-            raise InfeasibleCaseError("line", self.case.name,
-                                      f"the train stalls at {fastest.summary['stop_position_m']:.1f} m "
-                                      "even at full traction", self.case.name)
+        fastest = self.check_reachable()
         if planned < fastest.running_time_s:
             raise InfeasibleCaseError("run.planned_time_s", planned,
                                       f"is below the minimum running time {fastest.running_time_s:.2f} s "

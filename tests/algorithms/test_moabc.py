@@ -191,3 +191,14 @@ def test_bad_input_raises(kwargs, name):
     assert repr(next(iter(kwargs.values()))) in str(info.value) or str(
         next(iter(kwargs.values()))
     ) in str(info.value)
+
+
+def test_archive_arrays_match_the_archive_population():
+    """The archive's arrays (used for sorting and truncation) stay aligned with its members."""
+    res = minimize(BNH(), MOABC(pop_size=20, archive_size=15), ("n_gen", 15), seed=4)
+    algorithm = res.algorithm
+    archive = algorithm.pareto_archive
+    np.testing.assert_array_equal(algorithm.archive_X, archive.get("X"))
+    np.testing.assert_array_equal(algorithm.archive_F, archive.get("F"))
+    np.testing.assert_array_equal(algorithm.archive_CV, archive.get("CV")[:, 0])
+    assert len(archive) == 15

@@ -16,3 +16,42 @@ def small_study(n_gen: int = 8, name: str = "zdt-small") -> Study:
         budget={"n_gen": n_gen},
         baseline="nsga2",
     )
+
+
+def slow_zdt1(n_var: int = 4, delay_s: float = 0.0):
+    """pymoo's ZDT1, built after ``delay_s`` seconds (so runs overlap in the concurrency tests).
+
+    When the environment names a log file (``PYMOO_RAIL_TEST_LOG``), each build appends one line:
+    the tests count computations with it.
+    """
+    import os
+    import time
+
+    from pymoo.problems import get_problem
+
+    log = os.environ.get("PYMOO_RAIL_TEST_LOG")
+    if log:
+        with open(log, "a", encoding="utf-8") as handle:
+            handle.write(f"{os.getpid()}\n")
+    time.sleep(delay_s)
+    return get_problem("zdt1", n_var=n_var)
+
+
+def case_sphere(case: str, n_var: int = 3):
+    """A cheap problem whose optimum depends on a case's content: the sphere centred at
+    ``mass_t / 1000`` in every variable (its front moves when the case file is edited)."""
+    import numpy as np
+    from pymoo.core.problem import Problem
+
+    from pymoo_rail.cases import load_case
+
+    centre = load_case(case).train.mass_t / 1000.0
+
+    class CaseSphere(Problem):
+        def __init__(self):
+            super().__init__(n_var=n_var, n_obj=2, xl=-1.0, xu=1.0)
+
+        def _evaluate(self, x, out, *args, **kwargs):
+            out["F"] = np.column_stack([np.sum((x - centre) ** 2, axis=1), np.sum((x + centre) ** 2, axis=1)])
+
+    return CaseSphere()

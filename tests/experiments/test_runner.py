@@ -15,7 +15,7 @@ import pytest
 
 from pymoo_rail.experiments import ResultStore, Study, algorithm, execute_run, load_results, problem, run_study
 from pymoo_rail.experiments.stats import write_tables
-from pymoo_rail.experiments.store import atomic_write_text
+from pymoo_rail.experiments.store import RECORD_FORMAT
 from tests.experiments.studies import small_study
 
 REPO = Path(__file__).resolve().parents[2]
@@ -169,8 +169,8 @@ def test_killed_study_resumes_without_losing_or_duplicating_runs(pool_study_dir,
 
     before = {p.name: p.read_bytes() for p in runs_dir.glob("*.json")}
     assert 5 <= len(before) < 45
-    for text in before.values():  # every stored record is complete
-        assert json.loads(text)["format"] == "pymoo-rail/run-record/1"
+    for name in before:  # every stored record is complete and passes its checksum
+        assert ResultStore(tmp_path).check(runs_dir / name)["format"] == RECORD_FORMAT
 
     report = run_study(study, tmp_path, workers=2, progress=False)
     assert report.n_skipped == len(before)
@@ -211,16 +211,21 @@ def test_check_refuses_a_bad_study_before_any_work(tmp_path):
     assert not (tmp_path / "runs").exists() or not list((tmp_path / "runs").iterdir())
 
 
-def test_store_ignores_and_cleans_temporary_files(tmp_path):
+def test_store_ignores_temporary_files_and_cleans_only_those_of_ended_processes(tmp_path):
     store = ResultStore(tmp_path)
     store.prepare()
-    (store.runs_dir / ".tmp-abc.json.123").write_text("{half a rec")  # what a kill mid-write leaves
-    atomic_write_text(store.path("0123456789abcdef"), json.dumps({"format": "pymoo-rail/run-record/1",
-                                                                   "run_id": "0123456789abcdef"}))
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                           text=True, check=True)
+    dead_pid = int(ended.stdout)
+    (store.runs_dir / f".tmp-{dead_pid}-abc.json.x1").write_text("{half a rec")  # what a kill mid-write leaves
+    alive = store.runs_dir / f".tmp-{os.getppid()}-def.json.x2"  # a live process is writing it
+    alive.write_text("{being written")
+    store.write({"format": RECORD_FORMAT, "run_id": "0123456789abcdef", "problem": {}, "algorithm": {},
+                 "seed": 1, "budget": {}, "n_var": 1, "n_obj": 1, "front": {}, "indicators": {}})
     assert store.done_ids() == {"0123456789abcdef"}
     assert [r["run_id"] for r in store.records()] == ["0123456789abcdef"]
     store.prepare()
-    assert sorted(p.name for p in store.runs_dir.iterdir()) == ["0123456789abcdef.json"]
+    assert sorted(p.name for p in store.runs_dir.iterdir()) == sorted(["0123456789abcdef.json", alive.name])
 
 
 def test_results_follow_the_current_study(pool_study_dir):

@@ -11,7 +11,7 @@ from pymoo.algorithms.soo.nonconvex.de import DE
 from pymoo.optimize import minimize
 
 from pymoo_rail.model import InfeasibleCaseError
-from pymoo_rail.problems import SEED_002_WEIGHTS, SpeedProfileProblem
+from pymoo_rail.problems import SEED_002_WEIGHTS, DecisionError, SpeedProfileProblem
 from tests.conftest import make_case
 
 # A flat line, no resistance, 100 kN traction and braking on 100 t: a = +-1 m/s^2 (closed form).
@@ -133,14 +133,39 @@ def test_bad_arguments(yizhuang, kwargs, match):
         SpeedProfileProblem(yizhuang, **kwargs)
 
 
-def test_nan_decision_vector_names_the_entry(yizhuang):
+def test_nan_decision_vector_names_the_row_and_entry(yizhuang):
     p = SpeedProfileProblem(yizhuang)
-    X = np.full((3, 8), 50.0)
+    X = np.full((6, 8), 50.0)
     X[2, 5] = np.nan
-    with pytest.raises(ValueError, match=r"speed_codes\[2, 5\] = nan"):
+    X[4, 1] = np.inf
+    with pytest.raises(DecisionError, match=r"decision row 2, variable 5 = nan km/h is not a finite number") as raised:
         p.evaluate(X)
+    assert raised.value.rows == [2, 4] and "2 of 6 rows" in str(raised.value)
+    good = np.delete(X, raised.value.rows, axis=0)  # what a caller can do with the rows it is told
+    assert np.all(np.isfinite(p.evaluate(good)))
     with pytest.raises(ValueError, match="n_var = 8"):
         p.summaries(np.ones((2, 5)))
+
+
+def test_out_of_bound_decisions_are_refused_not_clipped(yizhuang):
+    p = SpeedProfileProblem(yizhuang)
+    X = np.tile(p.xu, (3, 1))
+    X[1, 3] = p.xu[3] + 1.0
+    with pytest.raises(DecisionError, match=rf"row 1, variable 3 = {float(p.xu[3]) + 1.0!r} km/h is outside its bounds"):
+        p.evaluate(X)
+    with pytest.raises(DecisionError, match="outside its bounds"):
+        p.trajectory(X[1])
+    p.evaluate(np.tile(p.xl, (2, 1)))  # the bounds themselves are fine
+
+
+def test_a_negative_speed_code_is_reported_in_kmh(yizhuang):
+    p = SpeedProfileProblem(yizhuang)
+    X = np.full((1, 8), 50.0)
+    X[0, 2] = -36.0
+    with pytest.raises(DecisionError, match="= -36.0 km/h"):
+        p.evaluate(X)
+    with pytest.raises(ValueError, match=r"speed_codes\[0, 2\] = -36.0 km/h"):  # the encoding alone
+        p.encoding.programs(X)
 
 
 def test_impossible_planned_time(yizhuang):
