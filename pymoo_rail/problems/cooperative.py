@@ -33,6 +33,7 @@ import pandas as pd
 from pymoo.core.problem import Problem
 
 from pymoo_rail.model import Case, CaseError
+from pymoo_rail.problems.speed_profile import check_decisions
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import cooperation as coop
 from pymoo_rail.sim.kernel import OUT_TRACTION_KWH
@@ -199,7 +200,7 @@ class CooperativeTrainsProblem(Problem):
 
     def simulate(self, X: np.ndarray) -> dict:
         """Paced runs of both trains, their traces on the common clock and their interaction."""
-        X = check_vectors(X, self.n_var)
+        X = check_decisions(X, self.xl, self.xu)
         paced = [tr.paced(X[:, s], self.time_tol_s) for tr, s in zip(self.trains, self.slices)]
         n = X.shape[0]
         shared = np.zeros(n)
@@ -236,7 +237,7 @@ class CooperativeTrainsProblem(Problem):
     # ------------------------------------------------------------------ inspection
     def decode(self, x: np.ndarray) -> CooperativeSolution:
         """Both trajectories, the shared energy and the constraints of one vector."""
-        x = check_vectors(x, self.n_var)
+        x = check_decisions(x, self.xl, self.xu)
         if x.shape[0] != 1:
             raise ValueError(f"decode takes one decision vector, got {x.shape[0]}")
         sim = self.simulate(x)

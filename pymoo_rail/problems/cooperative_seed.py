@@ -393,9 +393,12 @@ class CooperativeSeedProblem(_SubsectionModel):
             for row, (t, e, shift) in enumerate(((t_a[r], tr_a[r], 0.0), (t_a[r], rg_a[r], 0.0),
                                                  (t_b[r], tr_b[r], self.offset_s), (t_b[r], rg_b[r], self.offset_s))):
                 coop.bin_energy(t, e, shift, self.t0_s, self.time_step_s, bins[row])
-            # eq. 5 both ways: A's traction against B's regeneration, and B's against A's
-            shared[r, 0] = coop.shared_energy_bins(bins[0:1], bins[3:4], 1.0).sum() / J_PER_KWH
-            shared[r, 1] = coop.shared_energy_bins(bins[2:3], bins[1:2], 1.0).sum() / J_PER_KWH
+            # eq. 5 one way at a time: A drawing from B's braking, then B from A's
+            none = np.zeros(self.n_bins)
+            shared[r, 0] = coop.shared_energy_bins(np.vstack([bins[0], none]), np.vstack([none, bins[3]]),
+                                                   1.0).sum() / J_PER_KWH
+            shared[r, 1] = coop.shared_energy_bins(np.vstack([none, bins[2]]), np.vstack([bins[1], none]),
+                                                   1.0).sum() / J_PER_KWH
             separation[r] = coop.separation_excess(t_a[r], a.model.position_m, v_a[r], 0.0, a.start_m, t_b[r],
                                                    b.model.position_m, self.offset_s, b.start_m, gap_m,
                                                    self.separation_decel_ms2, self.t0_s, self.time_step_s,

@@ -29,7 +29,8 @@ import numpy as np
 from pymoo.core.problem import Problem
 
 from pymoo_rail.model import Case
-from pymoo_rail.problems.cooperative import PacedTrain, check_vectors, finite_number
+from pymoo_rail.problems.cooperative import PacedTrain, finite_number
+from pymoo_rail.problems.speed_profile import check_decisions
 from pymoo_rail.sim import cooperation as coop
 from pymoo_rail.sim.kernel import OUT_TRACTION_KWH
 from pymoo_rail.sim.pacing import DEFAULT_TIME_TOL_S
@@ -122,14 +123,14 @@ class TimetableProblem(Problem):
 
     def departures_s(self, X: np.ndarray) -> np.ndarray:
         """Departure times (N, n_trains) from the first station."""
-        X = check_vectors(X, self.n_var)
+        X = check_decisions(X, self.xl, self.xu)
         nominal = self.headway_s * np.arange(self.n_trains)
         shifts = np.concatenate([np.zeros((X.shape[0], 1)), X[:, :self.n_trains - 1]], axis=1)
         return nominal + shifts
 
     def shapes(self, X: np.ndarray, leg: int) -> np.ndarray:
         """Shapes of every train on one leg, (N * n_trains, n_sections), train-major per vector."""
-        X = check_vectors(X, self.n_var)
+        X = check_decisions(X, self.xl, self.xu)
         first = self.n_trains - 1 + sum(tr.n_var for tr in self.legs[:leg])
         blocks = [X[:, first + i * self.n_shape: first + i * self.n_shape + self.legs[leg].n_var]
                   for i in range(self.n_trains)]
@@ -137,7 +138,7 @@ class TimetableProblem(Problem):
 
     def simulate(self, X: np.ndarray) -> dict:
         """Journeys of every train on the common clock, energies, separation and waiting time."""
-        X = check_vectors(X, self.n_var)
+        X = check_decisions(X, self.xl, self.xu)
         n, m = X.shape[0], self.n_trains
         departures = self.departures_s(X)
         paced = [tr.paced(self.shapes(X, k), self.time_tol_s) for k, tr in enumerate(self.legs)]

@@ -61,7 +61,7 @@ def test_lossless_supply_shares_at_least_as_much(pair):
 def test_trains_too_close_violate_separation(pair):
     # 20 s apart on a 190 s leg: the follower runs into the leader at station 2
     p = TimetableProblem(pair, 2, 20.0, window_s=0.0, dx_m=2.0)
-    x = np.full((1, p.n_var), 0.5)
+    x = np.clip(np.full((1, p.n_var), 0.5), p.xl, p.xu)
     assert p.evaluate(x, return_values_of=["G"])[0, 0] > 0
 
 
