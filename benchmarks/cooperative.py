@@ -152,8 +152,9 @@ def main() -> None:
     print(text)
 
 
-NOTES = (Path(__file__).parent / "cooperative_notes.md").read_text() if (Path(__file__).parent
-                                                                          / "cooperative_notes.md").exists() else ""
+NOTES = """How these compare with the earlier model and with the paper: `docs/cooperative.md`.
+A row with fewer seeds than asked for comes from a study stopped early (`--report-only`)."""
+
 
 if __name__ == "__main__":
     main()
