@@ -307,16 +307,12 @@ class SubsectionProblem(_SubsectionModel):
 
 
 class CooperativeSeedProblem(_SubsectionModel):
-    """Cooperative timed driving of two trains sharing regenerative energy (Chen et al. 2017).
+    """The paper's decision vector for :class:`~pymoo_rail.problems.CooperativeTrainsProblem`.
 
     Parameters
     ----------
-    case : Case
-        A case with exactly two consecutive legs (``load_case("cooperative-pair")``): train A runs
-        leg 0, train B leg 1.
-    offset_s : float
-        B's departure from the start of leg 1 minus A's departure from the start of leg 0 (the
-        seed's x, sections 4.2-4.4: -45, 0, 45, 90, 135 s).
+    case, offset_s
+        As for :class:`~pymoo_rail.problems.CooperativeTrainsProblem`.
     safety_margin_m : float
         L_s of eq. 9 (Chen et al. 2017 table 3: 40 m).
     separation_decel_ms2 : float
