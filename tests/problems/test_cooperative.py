@@ -118,3 +118,18 @@ def test_bad_input_names_the_field(pair, problem):
     x[0, 3] = np.nan
     with pytest.raises(ValueError, match="variable 3 = nan"):
         problem.evaluate(x)
+
+
+@pytest.mark.slow
+def test_plain_ga_saves_more_than_8_percent_against_the_exact_baseline(pair):
+    from pymoo_rail.problems.cooperative_baseline import exact_baseline
+
+    base = exact_baseline(pair)
+    # each train alone: no paced run of random shapes beats its exact optimum (solver accuracy 0.5 %)
+    p = CooperativeTrainsProblem(pair, -45.0)
+    out = p.evaluate(np.random.default_rng(1).random((30, p.n_var)), return_as_dictionary=True)
+    assert out["traction_a_kwh"].min() >= base.energies_kwh[0] * 0.995
+    assert out["traction_b_kwh"].min() >= base.energies_kwh[1] * 0.995
+    assert base.shared_by_chance_kwh(-45.0) >= 0.0
+    savings = [1 - minimize(p, GA(pop_size=60), ("n_eval", 6000), seed=s).F[0] / base.energy_kwh for s in (1, 2, 3)]
+    assert np.median(savings) >= 0.08
