@@ -15,9 +15,11 @@ import textwrap
 from pathlib import Path
 from typing import Sequence
 
-OBJECTIVE_NAMES = ("energy", "running_time", "time_error", "jerk", "stop_error")
+OBJECTIVE_NAMES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
 OBJECTIVE_COLUMNS = {"energy": "energy_kwh", "running_time": "running_time_s", "time_error": "time_error_s",
-                     "jerk": "jerk_ms2", "stop_error": "stop_error_m"}
+                     "accel_variation": "accel_variation_ms2", "stop_error": "stop_error_m"}
+TIME_OBJECTIVES = ("running_time", "time_error")
+DEFAULT_TIME_TOLERANCE_S = 1.0
 
 
 class UsageError(Exception):
@@ -29,20 +31,31 @@ class UsageError(Exception):
 
 
 class _Formatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
-    pass
+    """Raw descriptions; "(default: X)" appended once, and only where the help does not say it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if "default" in text or action.default in (None, False) or action.default is argparse.SUPPRESS:
+            return text
+        return super()._get_help_string(action)
 
 
 MAIN_EPILOG = """\
 examples:
   pymoo-rail cases                                  list the built-in cases
   pymoo-rail cases yizhuang                         describe one case
-  pymoo-rail optimize yizhuang --out out/           NSGA-II on energy and time error (about 10 s)
+  pymoo-rail optimize yizhuang --out out/           NSGA-II on energy and time error (about 3 s of
+                                                    CPU; the first run compiles, about 20 s more)
   pymoo-rail optimize yizhuang --algorithm moabc --pop-size 40 --n-gen 100 --seed 3 --out out/moabc
   pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
   pymoo-rail reference yizhuang --out out/ref       the exact minimum-energy front
   pymoo-rail study examples/study_zdt.toml --workers 2 --out out/zdt
   pymoo-rail plot study out/zdt                     redraw the tables and figures of a study
   pymoo-rail plot trajectory out/trajectory.csv --case yizhuang
+  pymoo-rail warmup --all                           compile the kernels ahead (images, clusters)
+
+The first run in a fresh installation compiles the simulator (Numba; it says so), later runs
+load the compiled kernels from the cache.
 
 Run 'pymoo-rail COMMAND --help' for the options of a command.
 """
@@ -105,39 +118,66 @@ def build_parser() -> argparse.ArgumentParser:
               trajectory.csv   the chosen run (the least energy within --time-tolerance, default 1 s,
                                of the planned time; else the member closest to it; for a single
                                objective the best one), one row per grid node
-              front.png        the front in objective space, the chosen member circled
-              profile.png      speed against distance over the line (limits, gradients, regimes)
-              speed_time.png   speed against time with the planned time"""),
+              front.png        the front in objective space, the chosen member circled, over the
+                               certified optimal front (energy with running time / time error)
+              profile.png      speed against distance over the line (limits, gradients, regimes),
+                               the optimal run at the chosen member's running time dashed
+              speed_time.png   speed against time with the planned time
+            and print the chosen member's gap to the optimum. Fronts with running time or time
+            error are kept inside a running-time window (--time-window; by default the minimum
+            running time to 1.3 x planned, the times a timetable planner uses)."""),
         epilog=textwrap.dedent("""\
             objectives: energy (net kWh), running_time (s), time_error (|T - T_plan|, s),
-                        jerk (comfort, m/s^2), stop_error (m)
+                        accel_variation (comfort: sum of |a_i - a_(i-1)|, m/s^2; alias jerk),
+                        stop_error (m). One objective without a time objective gets the
+                        constraint |T - T_plan| <= --time-tolerance (default 1 s).
             algorithms: nsga2, moabc, grnsga2, sms-emoa, moead, nsga3 (several objectives);
                         abc, de, ga, pso (one objective, e.g. with --time-tolerance)
 
             examples:
               pymoo-rail optimize yizhuang --out out/
               pymoo-rail optimize yizhuang --algorithm grnsga2 --pop-size 60 --n-gen 80 --out out/gr
-              pymoo-rail optimize metro-a --objectives energy jerk stop_error time_error --out out/m4
-              pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc"""))
-    p.add_argument("case", metavar="CASE", help="built-in case name (see 'pymoo-rail cases') or a .toml case file")
+              pymoo-rail optimize metro-a --objectives energy accel_variation stop_error time_error --encoding braking_onset --out out/m4
+              pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
+              pymoo-rail optimize --track T.json --train R.json --from 0 --to -1 --time 1500 --out out/t"""))
+    p.add_argument("case", metavar="CASE", nargs="?", default=None,
+                   help="built-in case name (see 'pymoo-rail cases') or a .toml case file; or give --track ...")
+    _add_ttobench_options(p)
     p.add_argument("--algorithm", "-a", default="nsga2", metavar="NAME", help="optimisation algorithm")
     p.add_argument("--pop-size", "-p", type=_positive_int, default=40, metavar="N", help="population size")
     p.add_argument("--n-gen", "-g", type=_positive_int, default=50, metavar="N", help="number of generations")
     p.add_argument("--objectives", "-o", nargs="+", default=["energy", "time_error"], metavar="NAME",
                    help="objectives to minimise")
     p.add_argument("--seed", "-s", type=_seed, default=1, help="random seed (same seed, same result)")
-    p.add_argument("--encoding", default="speed_codes", choices=["speed_codes", "switching_points"],
-                   help="decision variables: a speed code per section, or regime switching positions")
+    p.add_argument("--encoding", default="speed_codes", choices=["speed_codes", "switching_points", "braking_onset"],
+                   help="decision variables: a speed code per section, regime switching positions, or "
+                        "phases with the braking onset and deceleration (a live stop error)")
     p.add_argument("--partition", default="gradient_limit", choices=["gradient_limit", "equal"],
                    help="sections of the speed-code encoding")
     p.add_argument("--n-sections", type=_positive_int, default=None, metavar="N",
                    help="number of equal sections (with --partition equal)")
     p.add_argument("--time-tolerance", type=_positive_float, default=None, metavar="S",
-                   help="constraint |T - T_plan| <= S seconds (the single-objective form of seed 000)")
+                   help="constraint |T - T_plan| <= S seconds (the single-objective form of Liu (2019)); "
+                        "default: 1 s for one objective without running_time or time_error, else none")
     p.add_argument("--weights", type=float, nargs="+", default=None, metavar="W",
-                   help="one weight per objective: minimise the weighted sum (seed 002)")
+                   help="one weight per objective: minimise the weighted sum (Meng et al. (2017))")
+    _add_window_arguments(p)
     p.add_argument("--out", default="out", metavar="DIR", help="output directory")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+
+    p = sub.add_parser(
+        "journey", help="solve a TTOBench journey (timing points) with the exact solver", formatter_class=_Formatter,
+        description="Read a TTOBench journey file, its track and a train, find the least-energy run that meets "
+                    "every timing point, and write into --out: timing.csv (time and speed at every timing "
+                    "point, window and check), trajectory_<k>.csv per section and journey.png.",
+        epilog="example:\n  pymoo-rail journey tracks/../journeys/J.json --train trains/CH_Stadler_KISS_SBB.json")
+    p.add_argument("journey", metavar="JOURNEY", help="TTOBench journey JSON file, or a .toml journey "
+                                                       "(track, train and timing points, docs/ttobench.md)")
+    p.add_argument("--track", default=None, metavar="T.json",
+                   help="TTOBench track file (default: ../tracks/<associated track>.json next to the journey)")
+    p.add_argument("--train", default=None, metavar="R.json", help="TTOBench train file (for a JSON journey)")
+    p.add_argument("--curve-model", default="tang2020", choices=["tang2020", "roeckl"], help="curve resistance")
+    p.add_argument("--out", default="out", metavar="DIR", help="output directory")
 
     p = sub.add_parser(
         "reference", help="the exact minimum-energy front of a case", formatter_class=_Formatter,
@@ -146,7 +186,9 @@ def build_parser() -> argparse.ArgumentParser:
                     "time (optimal_trajectory.csv, optimal_profile.png).",
         epilog="examples:\n  pymoo-rail reference yizhuang --out out/ref\n"
                "  pymoo-rail reference yizhuang --times 140 150 160 170 --out out/ref")
-    p.add_argument("case", metavar="CASE", help="built-in case name or a .toml case file")
+    p.add_argument("case", metavar="CASE", nargs="?", default=None,
+                   help="built-in case name or a .toml case file; or give --track ...")
+    _add_ttobench_options(p)
     p.add_argument("--times", type=_positive_float, nargs="+", default=None, metavar="S",
                    help="running times (s); default: --n-points from the minimum time to 1.3 x planned")
     p.add_argument("--n-points", type=_positive_int, default=8, metavar="N", help="number of running times")
@@ -202,6 +244,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also compute every train's exact optimum alone (about a CPU minute per leg)")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory")
 
+    p = sub.add_parser(
+        "warmup", help="compile the simulator's kernels now (container images, clusters)", formatter_class=_Formatter,
+        description="Compile the Numba kernels a command uses and store them in Numba's cache (next to the "
+                    "installed package, or in NUMBA_CACHE_DIR), so that the first real run starts at once. Run "
+                    "it when building a container image, or once before a study on a cluster whose workers "
+                    "share the cache directory. Already compiled kernels are only loaded.",
+        epilog="examples:\n  pymoo-rail warmup\n  pymoo-rail warmup --all\n"
+               "  NUMBA_CACHE_DIR=/shared/numba pymoo-rail warmup --all")
+    p.add_argument("--all", action="store_true",
+                   help="also the exact reference solver ('reference') and the ATO tracking controllers")
+    _add_suite_parser(sub)
+
     p = sub.add_parser("plot", help="redraw figures from stored results or CSV files", formatter_class=_Formatter,
                        description="Redraw figures without recomputing anything.",
                        epilog=textwrap.dedent("""\
@@ -222,7 +276,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--y", default=None, metavar="COLUMN", help="column on the y axis (default: second objective)")
     q.add_argument("--reference", default=None, metavar="CSV",
                    help="a reference front to draw as a line (optimal_front.csv, same column names)")
-    q.add_argument("--out", default=None, metavar="PNG", help="image file (default: next to the CSV)")
+    q.add_argument("--out", default=None, metavar="PNG",
+                   help="image file (default: the CSV's name with _plot.png, e.g. front_plot.png, so the "
+                        "figure 'optimize' wrote is kept)")
     q = plot_sub.add_parser("trajectory", help="a speed profile from trajectory.csv", formatter_class=_Formatter)
     q.add_argument("csv", metavar="CSV", help="trajectory.csv written by 'pymoo-rail optimize'")
     q.add_argument("--case", default=None, metavar="CASE",
@@ -257,6 +313,11 @@ def _out_dir(value: str) -> Path:
 
 def _say(text: str) -> None:
     print(text, flush=True)
+
+
+def _count(n: int, noun: str) -> str:
+    """``1 solution``, ``2 solutions``."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 # ------------------------------------------------------------------------------ commands
@@ -313,6 +374,13 @@ def _objectives(values: Sequence[str]) -> tuple[str, ...]:
     return tuple(values)
 
 
+def choose_member(*args, **kwargs) -> int:
+    """:func:`pymoo_rail.experiments.fronts.choose_member` (the member ``optimize`` shows)."""
+    from pymoo_rail.experiments.fronts import choose_member as choose
+
+    return choose(*args, **kwargs)
+
+
 class _Progress:
     """pymoo callback that advances a tqdm bar by one per generation."""
 
@@ -323,27 +391,77 @@ class _Progress:
         self.bar.update(1)
 
 
-def choose_member(F: "np.ndarray", CV: "np.ndarray", running_time_s: "np.ndarray", energy_kwh: "np.ndarray",
-                  planned_time_s: float, window_s: float = 1.0) -> int:
-    """Index of the front member to show.
+def _add_ttobench_options(p: argparse.ArgumentParser) -> None:
+    """``--track T.json --train R.json --from A --to B --time S``: a TTOBench run instead of CASE."""
+    p.add_argument("--track", default=None, metavar="T.json", help="TTOBench track file (instead of CASE)")
+    p.add_argument("--train", default=None, metavar="R.json", help="TTOBench train file (with --track)")
+    p.add_argument("--from", dest="from_stop", default="0", metavar="A",
+                   help="departure stop: index (0, 1, ..., -1 = last) or position in m (e.g. 8500.0)")
+    p.add_argument("--to", dest="to_stop", default="-1", metavar="B", help="arrival stop (as --from)")
+    p.add_argument("--time", dest="planned_time", type=float, default=None, metavar="S",
+                   help="planned running time in s; without it, 1.15 x the minimum running time")
+    p.add_argument("--curve-model", default="tang2020", choices=["tang2020", "roeckl"],
+                   help="curve resistance of the track's curvatures")
 
-    One objective: the best. Several: the least energy among the members within ``window_s`` of
-    the planned time (what an operator would pick: punctual, then frugal); if none is that close,
-    the one closest to the planned time (ties: least energy). Feasible members first.
-    """
-    import numpy as np
 
-    candidates = np.flatnonzero(CV <= 0)
-    if len(candidates) == 0:
-        candidates = np.array([int(np.argmin(CV))])
-    if F.shape[1] == 1:
-        return int(candidates[np.argmin(F[candidates, 0])])
-    error = np.abs(running_time_s[candidates] - planned_time_s)
-    punctual = candidates[error <= window_s]
-    if len(punctual):
-        return int(punctual[np.argmin(energy_kwh[punctual])])
-    order = np.lexsort((energy_kwh[candidates], error))
-    return int(candidates[order[0]])
+def _stop_ref(value: str):
+    try:
+        return int(value)
+    except ValueError:
+        try:
+            return float(value)
+        except ValueError:
+            raise UsageError("--from/--to", f"{value!r} is neither a stop index nor a position in m") from None
+
+
+def _case_from_args(args):
+    """The case of CASE, or of --track/--train/--from/--to/--time."""
+    if args.track is None:
+        if args.train is not None:
+            raise UsageError("--train", "needs --track")
+        if args.case is None:
+            raise UsageError("CASE", "give a case name or file, or --track T.json --train R.json")
+        return _load_case("CASE", args.case)
+    if args.case is not None:
+        raise UsageError("CASE", "give either CASE or --track, not both")
+    if args.train is None:
+        raise UsageError("--train", "--track needs --train R.json")
+    from pymoo_rail.cases.ttobench import from_ttobench
+    from pymoo_rail.optimal import min_running_time
+
+    case = from_ttobench(args.track, args.train, _stop_ref(args.from_stop), _stop_ref(args.to_stop), 1.0,
+                         curve_model=args.curve_model)
+    time_s = args.planned_time if args.planned_time is not None else 1.15 * min_running_time(case)
+    return case.with_planned_time(time_s)
+
+
+def cmd_journey(args) -> int:
+    from pymoo_rail.journeys.timing import (read_timing_points, solve_timed_journey, timed_journey_from_toml,
+                                            timed_journey_from_ttobench)
+    from pymoo_rail.plotting.journey import plot_timed_run
+    from pymoo_rail.plotting import save_figure
+
+    import pandas as pd
+
+    out = _out_dir(args.out)
+    if args.journey.endswith(".toml"):
+        timed = timed_journey_from_toml(args.journey)
+    else:
+        if args.train is None:
+            raise UsageError("--train", "a TTOBench journey file names no train: give --train R.json")
+        track = args.track
+        if track is None:
+            _, track_id, _, _ = read_timing_points(args.journey)
+            track = Path(args.journey).resolve().parent.parent / "tracks" / f"{track_id}.json"
+        timed = timed_journey_from_ttobench(args.journey, track, args.train, curve_model=args.curve_model)
+    run = solve_timed_journey(timed)
+    pd.DataFrame(list(run.checks)).to_csv(out / "timing.csv", index=False)
+    for k, traj in enumerate(run.trajectories):
+        traj.to_frame().to_csv(out / f"trajectory_{k}.csv", index=False)
+    save_figure(plot_timed_run(timed, run), out / "journey.png")
+    _say(f"{timed.journey.name}: {run.energy_kwh:.2f} kWh net, every timing point met; wrote {out}/timing.csv, "
+         f"trajectory_*.csv, journey.png")
+    return 0
 
 
 def cmd_optimize(args) -> int:
@@ -352,13 +470,14 @@ def cmd_optimize(args) -> int:
     from pymoo.optimize import minimize
     from tqdm import tqdm
 
+    from pymoo_rail.experiments.fronts import distinct_front
     from pymoo_rail.experiments.registry import algorithm_names, build_algorithm, canonical_name, ALGORITHMS
     from pymoo_rail.experiments.spec import AlgorithmSpec, StudyError
     from pymoo_rail.model import CaseError
     from pymoo_rail.plotting import plot_front, plot_speed_profile, plot_speed_time, save_figure
     from pymoo_rail.problems import SpeedProfileProblem
 
-    case = _load_case("CASE", args.case)
+    case = _case_from_args(args)
     objectives = _objectives(args.objectives)
     if canonical_name(args.algorithm) not in ALGORITHMS:
         raise UsageError("--algorithm", f"unknown algorithm {args.algorithm!r} (choose from "
@@ -368,14 +487,22 @@ def cmd_optimize(args) -> int:
                                       f"({' '.join(objectives)}): give one weight per objective")
     if args.n_sections is not None and args.partition != "equal":
         raise UsageError("--n-sections", "only applies with --partition equal")
+    time_tolerance_s = args.time_tolerance
+    if time_tolerance_s is None and len(objectives) == 1 and args.weights is None \
+            and objectives[0] not in TIME_OBJECTIVES:
+        # one objective that ignores the running time: without this the run may take any time
+        time_tolerance_s = DEFAULT_TIME_TOLERANCE_S
+        _say(f"time constraint |T - T_plan| <= {time_tolerance_s:g} s (the default for one objective; "
+             "set it with --time-tolerance)")
     out = _out_dir(args.out)
 
     kwargs = {"objectives": objectives, "encoding": args.encoding, "partition": args.partition,
-              "time_tolerance_s": args.time_tolerance}
+              "time_tolerance_s": time_tolerance_s}
     if args.n_sections is not None:
         kwargs["n_sections"] = args.n_sections
     if args.weights is not None:
         kwargs["weights"] = args.weights
+    kwargs["time_window_s"] = _time_window(args, objectives)
     try:
         problem = SpeedProfileProblem(case, **kwargs)
     except CaseError as err:  # the case cannot be run (e.g. a planned time below the minimum): not an option's fault
@@ -395,12 +522,10 @@ def cmd_optimize(args) -> int:
         res = minimize(problem, algorithm, ("n_gen", args.n_gen), seed=args.seed, verbose=False,
                        callback=_Progress(bar))
 
-    opt = res.algorithm.opt
+    opt = distinct_front(res.algorithm.opt)  # one member per objective vector
     X = np.asarray(opt.get("X"), dtype=float)
     F = np.asarray(opt.get("F"), dtype=float)
     CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1)
-    X, index = np.unique(X, axis=0, return_index=True)  # a front may hold copies of one solution
-    F, CV = F[index], CV[index]
     trajectories = [problem.trajectory(x) for x in X]
     running = np.array([t.running_time_s for t in trajectories])
     energy = np.array([t.energy.net_kwh for t in trajectories])
@@ -415,13 +540,13 @@ def cmd_optimize(args) -> int:
     front["running_time_s"] = running
     front["energy_kwh"] = energy
     front["stop_error_m"] = [t.stop_error_m for t in trajectories]
-    front["jerk_ms2"] = [t.jerk_ms2 for t in trajectories]
+    front["accel_variation_ms2"] = [t.accel_variation_ms2 for t in trajectories]
     front["feasible"] = CV <= 0
     front["cv"] = CV
     for j in range(X.shape[1]):
         front[f"x{j}_{unit}"] = X[:, j]
     chosen = choose_member(F, CV, running, energy, case.planned_time_s,
-                           args.time_tolerance if args.time_tolerance is not None else 1.0)
+                           time_tolerance_s if time_tolerance_s is not None else DEFAULT_TIME_TOLERANCE_S)
     front.insert(0, "chosen", np.arange(len(front)) == chosen)
     trajectory = trajectories[chosen]
 
@@ -429,35 +554,98 @@ def cmd_optimize(args) -> int:
     front.to_csv(written[0], index=False)
     trajectory.to_frame().to_csv(written[1], index=False)
     label = f"{args.algorithm}, seed {args.seed}"
+    optimum = _optimum_for(problem, trajectory, args)
     if F.shape[1] >= 2:  # 4 or more objectives: a scatter matrix
         written.append(save_figure(plot_front(F, objectives, highlight=F[chosen], label=label,
+                                              reference=optimum.get("front"),
                                               title=f"{case.name}: front after {res.algorithm.evaluator.n_eval} "
                                                     "evaluations"), out / "front.png"))
-    written.append(save_figure(plot_speed_profile(trajectory, case, label=args.algorithm), out / "profile.png"))
+    others = [optimum["profile"]] if "profile" in optimum else []
+    written.append(save_figure(plot_speed_profile(trajectory, case, label=args.algorithm, others=others,
+                                                  other_labels=["optimal run at the same time"],
+                                                  other_linestyle="--"), out / "profile.png"))
     written.append(save_figure(plot_speed_time(trajectory, case), out / "speed_time.png"))
 
     n_feasible = int((CV <= 0).sum())
-    _say(f"front: {len(front)} solutions ({n_feasible} feasible), {res.algorithm.evaluator.n_eval} evaluations")
+    _say(f"front: {_count(len(front), 'solution')} ({n_feasible} feasible), "
+         f"{_count(res.algorithm.evaluator.n_eval, 'evaluation')}")
     _say(f"chosen: running time {trajectory.running_time_s:.2f} s (planned {case.planned_time_s:g} s), "
          f"energy {trajectory.energy.net_kwh:.3f} kWh, stop error {trajectory.stop_error_m:.3f} m"
          + ("" if CV[chosen] <= 0 else "  [INFEASIBLE: no feasible solution found]"))
+    _say(optimum["message"])
     for path in written:
         _say(f"wrote {path}")
     return 0
 
 
-def _default_times(case, n_points: int):
+def _add_window_arguments(p) -> None:
+    p.add_argument("--time-window", nargs="+", default=["default"], metavar="S",
+                   help="running-time window constraint LO HI in seconds; 'default' (the minimum running time "
+                        "to 1.3 x planned, where the certified optimal front is known: the times a timetable "
+                        "planner uses) or 'none'; applies to running_time / time_error fronts")
+    p.add_argument("--no-reference", action="store_true",
+                   help="skip the certified optimal front, the optimal profile and the gap to the optimum")
+
+
+def _time_window(args, objectives):
+    values = [v.lower() for v in args.time_window]
+    if values == ["none"]:
+        return None
+    if values == ["default"]:
+        if args.weights is None and {"running_time", "time_error"} & set(objectives) and len(objectives) > 1:
+            return "default"
+        return None
+    try:
+        lo, hi = (float(v) for v in values)
+    except ValueError:
+        raise UsageError("--time-window", f"{' '.join(args.time_window)!r}: give LO HI seconds, 'default' or "
+                                          "'none'") from None
+    if not 0 <= lo < hi < float("inf"):
+        raise UsageError("--time-window", f"{lo:g} {hi:g}: need 0 <= LO < HI seconds")
+    return (lo, hi)
+
+
+def _optimum_for(problem, trajectory, args) -> dict:
+    """The certified front in objective space, the optimal run at the chosen member's time, and the gap."""
+    from pymoo_rail.problems import reference
+
+    if args.no_reference:
+        return {"message": "optimum: skipped (--no-reference)"}
+    try:
+        front = problem.certified_front()
+    except reference.NoExactFrontError as err:
+        return {"message": f"optimum: none certified for this form ({str(err).split('no exact front: ')[-1]})"}
+    result = {}
+    if problem.n_obj == 2:
+        result["front"], _ = reference.mirrored(front, problem.objectives, 200, problem.time_window_s)
+    lo, hi = front.time_range_s
+    t = trajectory.running_time_s
+    if not lo <= t <= hi:
+        result["message"] = (f"optimum: the chosen run's {t:.2f} s lies outside the certified front's "
+                             f"{lo:.2f}-{hi:.2f} s; no gap reported")
+        return result
+    (energy,), (bound,) = front.energy_at(t)
+    gap = trajectory.energy.net_kwh - energy
+    result["message"] = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / abs(energy):+.2f} %); "
+                         f"optimum {energy:.3f} kWh (certified within {bound:.3f} kWh, {front.certificate})")
+    try:
+        from pymoo_rail.optimal import optimal_profile
+
+        result["profile"] = optimal_profile(problem.case, t)
+    except ValueError as err:  # a time the solver's grid cannot hit closely: the figure goes without it
+        result["message"] += f"; no optimal profile drawn ({err})"
+    return result
+
+
+def _default_times(t_min: float, planned_time_s: float, n_points: int):
     import numpy as np
 
-    from pymoo_rail.optimal import min_running_time
-
-    t_min = float(min_running_time(case))
-    upper = max(1.3 * case.planned_time_s, 1.1 * t_min)
+    upper = max(1.3 * planned_time_s, 1.1 * t_min)
     return np.linspace(1.01 * t_min, upper, n_points)
 
 
 def cmd_reference(args) -> int:
-    case = _load_case("CASE", args.case)
+    case = _case_from_args(args)
     try:
         from pymoo_rail.optimal import optimal_front, optimal_profile
     except ImportError as err:
@@ -465,10 +653,26 @@ def cmd_reference(args) -> int:
                            f"(optimal_front, optimal_profile), which this installation lacks: {err}") from None
     import numpy as np
 
+    from pymoo_rail.model import InfeasibleCaseError
+    from pymoo_rail.optimal import min_running_time
     from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
 
+    try:  # every check before any computing or writing
+        t_min = float(min_running_time(case))
+    except InfeasibleCaseError as err:
+        raise UsageError("CASE", str(err)) from None
+    if args.times is not None:
+        times = np.asarray(args.times, dtype=float)
+        too_short = times[times < t_min]
+        if too_short.size:
+            raise UsageError("--times", f"{too_short.min():g} s is below the minimum running time {t_min:.2f} s "
+                                        f"of {case.name} (flat out): give times of at least {t_min:.2f} s")
+    else:
+        times = _default_times(t_min, case.planned_time_s, args.n_points)
+    if case.planned_time_s < t_min:
+        raise UsageError("CASE", f"planned_time_s = {case.planned_time_s:g} s of {case.name} is below its minimum "
+                                 f"running time {t_min:.2f} s (flat out)")
     out = _out_dir(args.out)
-    times = np.asarray(args.times, dtype=float) if args.times is not None else _default_times(case, args.n_points)
     _say(f"{case.name}: exact minimum-energy runs for {len(times)} running times "
          f"({times.min():.1f}-{times.max():.1f} s)")
     front = optimal_front(case, times)
@@ -613,7 +817,8 @@ def cmd_plot(args, parser: argparse.ArgumentParser) -> int:
             reference = ref[[x, y]].to_numpy(float)
         fig = plot_fronts({csv.stem: table[[x, y]].to_numpy(float)}, names, reference=reference,
                           highlight=highlight, reference_label="reference front")
-        path = save_figure(fig, Path(args.out) if args.out else csv.with_suffix(".png"))
+        # not front.png: that is the figure 'optimize' wrote next to front.csv
+        path = save_figure(fig, Path(args.out) if args.out else csv.with_name(f"{csv.stem}_plot.png"))
     else:
         case = _load_case("--case", args.case) if args.case else None
         try:
@@ -625,6 +830,12 @@ def cmd_plot(args, parser: argparse.ArgumentParser) -> int:
     return 0
 
 
+def _run(commands: dict, args, parser: argparse.ArgumentParser) -> int:
+    if args.command == "plot":
+        return cmd_plot(args, parser)
+    return commands[args.command](args)
+
+
 def _objective_of_column(column: str) -> str:
     """Axis label key of a front column: ``f_energy`` -> energy, ``running_time_s`` -> running_time."""
     if column.startswith("f_"):
@@ -633,6 +844,57 @@ def _objective_of_column(column: str) -> str:
         if column == col:
             return name
     return column
+
+
+def cmd_warmup(args) -> int:
+    from pymoo_rail.sim.jit import WARMUP_PARTS, warmup
+
+    parts = WARMUP_PARTS if args.all else ("simulator",)
+    for part, seconds in warmup(parts).items():
+        _say(f"{part}: ready ({seconds:.1f} s)")
+    return 0
+
+
+COMPILING_COMMANDS = ("optimize", "optimise", "reference", "warmup", "plot", "suite", "journey")
+def _add_suite_parser(sub) -> None:
+    p = sub.add_parser(
+        "suite", help="the benchmark suite: list its problems, verify its shipped fronts", formatter_class=_Formatter,
+        description="The benchmark suite (pymoo_rail.suite, docs/suite.md): rail problems with certified exact "
+                    "fronts. 'list' prints the problems; 'verify' solves every shipped front again and exits 1 "
+                    "if any node drifts beyond its certificate (minutes per long line).",
+        epilog="examples:\n  pymoo-rail suite list\n  pymoo-rail suite verify metro-a yizhuang")
+    p.add_argument("action", choices=["list", "verify"], help="what to do")
+    p.add_argument("cases", nargs="*", metavar="CASE", help="suite cases to verify (default: all)")
+
+
+def cmd_suite(args) -> int:
+    from pymoo_rail.problems.reference import find_front
+    from pymoo_rail.suite import CASES, list_problems, suite_case, verify
+    from pymoo_rail.suite.problems import split
+
+    if args.action == "list":
+        for name in list_problems():
+            entry, form = split(name)
+            case = suite_case(entry.name)
+            if form == "4obj":
+                front = "best-known front (no exact front for four objectives)"
+            else:
+                path = find_front(case)
+                front = f"certified front {path.name}" if path is not None else "front computed on first use"
+            _say(f"{name:42s} {form:6s} {case.line.length_m:8.0f} m  {case.planned_time_s:6.0f} s  {front}")
+        return 0
+    known = [c.name for c in CASES]
+    for name in args.cases:
+        if name not in known:
+            raise UsageError("CASE", f"unknown suite case {name!r} (known: {', '.join(known)})")
+    report = verify(args.cases or None)
+    for case_name, rows in report.groupby("case", sort=False):
+        if "drift_kwh" in rows and rows["drift_kwh"].notna().any():
+            _say(f"{case_name:32s} {'ok' if rows['ok'].all() else 'DRIFT'}: largest drift "
+                 f"{rows['drift_kwh'].max():.4g} kWh, smallest certificate {rows['certificate_kwh'].min():.4g} kWh")
+        else:
+            _say(f"{case_name:32s} FAILED: {rows['problem'].iloc[0]}")
+    return 0 if bool(report["ok"].all()) else 1
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -646,12 +908,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 2
     commands = {"cases": cmd_cases, "optimize": cmd_optimize, "optimise": cmd_optimize, "reference": cmd_reference,
-                "study": cmd_study, "timetable": cmd_timetable}
+                "study": cmd_study, "warmup": cmd_warmup, "suite": cmd_suite, "journey": cmd_journey, "timetable": cmd_timetable}
     subparser = parser._subparsers._group_actions[0].choices[args.command]  # for its usage line
     try:
-        if args.command == "plot":
-            return cmd_plot(args, parser)
-        return commands[args.command](args)
+        if args.command not in COMPILING_COMMANDS:
+            return _run(commands, args, parser)
+        from tqdm import tqdm
+
+        from pymoo_rail.sim.jit import compile_notice
+
+        # a first run compiles the kernels: say so (tqdm.write keeps a progress bar intact)
+        with compile_notice(say=lambda text: tqdm.write(text, file=sys.stderr)):
+            return _run(commands, args, parser)
     except UsageError as err:
         if args.command == "plot" and getattr(args, "what", None):
             subparser = subparser._subparsers._group_actions[0].choices[args.what]

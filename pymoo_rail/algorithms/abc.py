@@ -1,6 +1,6 @@
 """Artificial Bee Colony (ABC) for single-objective problems.
 
-Karaboga's canonical ABC as described in seed 000, sections 3.2-3.3, written as a pymoo
+Karaboga's canonical ABC as described in Liu (2019), sections 3.2-3.3, written as a pymoo
 ``Algorithm`` in ask/tell form: one pymoo iteration is one full cycle (employed, onlooker
 and, when needed, scout phase); ``_advance`` returns ``False`` between the phases so every
 phase is one ``ask``/``tell`` pair and nothing is evaluated inside the algorithm.
@@ -34,7 +34,7 @@ def rank_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
 
     Sources are ordered feasibility first (by constraint violation, then by objective);
     the best of ``SN`` sources gets fitness ``SN``, the worst ``1``, and
-    ``P_i = fit_i / sum(fit)``. Unlike ``1 / (1 + f)`` (seed 000, eq. 3-3) this does not
+    ``P_i = fit_i / sum(fit)``. Unlike ``1 / (1 + f)`` (Liu (2019), eq. 3-3) this does not
     depend on the scale or sign of ``f`` and does not flatten out near ``f = 0``.
     Ties keep their index order, so the result is deterministic.
     """
@@ -46,7 +46,7 @@ def rank_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
 
 
 def inverse_probabilities(F: np.ndarray, CV: np.ndarray) -> np.ndarray:
-    """Onlooker probabilities of seed 000, eqs. 3-3 and 3-5 (Karaboga's fitness).
+    """Onlooker probabilities of Liu (2019), eqs. 3-3 and 3-5 (Karaboga's fitness).
 
     ``fit = 1 / (1 + f)`` for ``f >= 0`` and ``1 + |f|`` otherwise, ``P_i = fit_i / sum(fit)``.
     Infeasible sources are first given pymoo's parameter-less value ``max(f) + CV``, so they
@@ -62,16 +62,16 @@ ONLOOKER_FITNESS = {"rank": rank_probabilities, "inverse": inverse_probabilities
 
 
 class ABC(BeeColony):
-    """Artificial Bee Colony (Karaboga 2005; seed 000, sections 3.2-3.3).
+    """Artificial Bee Colony (Karaboga 2005; Liu (2019), sections 3.2-3.3).
 
     Parameters
     ----------
     pop_size : int
-        Colony size: employed plus onlooker bees, as in seed 000 (a colony of 30 has 15
+        Colony size: employed plus onlooker bees, as in Liu (2019) (a colony of 30 has 15
         employed bees, 15 onlookers and ``SN = 15`` food sources). Must be even and at
         least 4 (the neighbour move needs a second food source). The initial sample has
         ``pop_size`` points and the best ``SN = pop_size // 2`` become the food sources
-        (seed 000, section 3.3, steps 1-3).
+        (Liu (2019), section 3.3, steps 1-3).
     limit : int, optional
         A food source whose trial counter exceeds ``limit`` is abandoned and replaced by a
         random one (scout bee). Default ``SN * n_var``.
@@ -104,7 +104,7 @@ class ABC(BeeColony):
       like employed bees. Several onlookers on the same source are
       applied one after another in draw order.
     * Scout bees: every source whose trial counter exceeds ``limit`` is replaced by a
-      random point (seed 000 step 7-8 abandons each such source, not only the worst).
+      random point (Liu (2019) step 7-8 abandons each such source, not only the worst).
 
     The phases work on the colony as it was when the phase was asked for (a batch, not a
     bee-by-bee sequence), so one phase is one ``ask``/``tell``. The best solution ever seen

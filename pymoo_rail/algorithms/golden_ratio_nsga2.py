@@ -1,9 +1,9 @@
-"""Golden-ratio NSGA-II (seed 003, section 3.1).
+"""Golden-ratio NSGA-II (Tang et al. (2020), section 3.1).
 
 NSGA-II whose every generation also runs a golden-ratio local search on a sub-population
 P_z of elite individuals, accepts the local-search points into the main population with the
 Metropolis criterion, and adapts the crossover and mutation probabilities to the fitness of
-the parents (seed 003 eqs. 8 and 9). Depends on pymoo only.
+the parents (Tang et al. (2020) eqs. 8 and 9). Depends on pymoo only.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from pymoo.util.display.column import Column
 from pymoo.util.display.multi import MultiObjectiveOutput
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-# the golden-section fractions as seed 003 writes them (fig. 3, eqs. 8-9)
+# the golden-section fractions as Tang et al. (2020) writes them (fig. 3, eqs. 8-9)
 GOLDEN_SHORT = 0.382
 GOLDEN_LONG = 0.618
 
@@ -38,7 +38,7 @@ GOLDEN_LONG = 0.618
 
 
 def adaptive_probability(f, f_avg: float, f_max: float, p_max: float, p_min: float, k: float):
-    r"""Probability of eq. 8 (``k = 0.382``) or eq. 9 (``k = 0.618``) of seed 003.
+    r"""Probability of eq. 8 (``k = 0.382``) or eq. 9 (``k = 0.618``) of Tang et al. (2020).
 
     .. math::
 
@@ -179,7 +179,7 @@ def _check_int(name: str, value, low: int) -> int:
 
 
 class GoldenRatioNSGA2(NSGA2):
-    r"""Golden-ratio NSGA-II of seed 003 (Tang, Wang, Yu 2020, section 3.1).
+    r"""Golden-ratio NSGA-II of Tang et al. (2020) (Tang, Wang, Yu 2020, section 3.1).
 
     Each generation ``k`` asks for one batch: ``n_offsprings`` NSGA-II offspring ``Q_k``
     plus up to ``3 * local_size / 2`` golden-ratio points ``Z_k``; both are evaluated by
@@ -196,7 +196,7 @@ class GoldenRatioNSGA2(NSGA2):
        population, ordered by feasibility, constraint violation, rank, then descending
        crowding distance (so rank 0 whenever there are at least 2m of them).
 
-    Choices where seed 003 is silent (all deterministic given ``seed``):
+    Choices where Tang et al. (2020) is silent (all deterministic given ``seed``):
 
     * **Pairs.** The best m members of P_z are the points A; each is paired with one of the
       other m members C, in a random permutation drawn from ``random_state``.

@@ -1,4 +1,4 @@
-"""Multi-objective Artificial Bee Colony (MOABC) of seed 000, section 4.5.2.
+"""Multi-objective Artificial Bee Colony (MOABC) of Liu (2019), section 4.5.2.
 
 Pareto-dominance greedy choice, onlooker fitness ``dom(i) / N``, an external archive of
 non-dominated solutions truncated by crowding distance, and a neighbour search guided by
@@ -9,6 +9,7 @@ one pymoo iteration is one full cycle.
 from __future__ import annotations
 
 import numpy as np
+from pymoo.core.individual import default_config
 from pymoo.core.population import Population
 from pymoo.core.sampling import Sampling
 from pymoo.operators.sampling.rnd import FloatRandomSampling
@@ -24,6 +25,7 @@ from pymoo_rail.algorithms._bees import (
 )
 
 MOVES = ("centred", "canonical", "literal")
+_DEFAULT_CV_CONFIG = default_config()
 
 
 class MOABCOutput(ScoutColumn, MultiObjectiveOutput):
@@ -59,8 +61,13 @@ def population_arrays(pop: Population) -> tuple[np.ndarray, np.ndarray, np.ndarr
 
     The same values as ``pop.get("X")``, ``pop.get("F")``, ``pop.get("CV")[:, 0]`` in one pass.
     """
-    return (np.array([ind.X for ind in pop]), np.array([ind.F for ind in pop]),
-            np.array([ind.CV[0] for ind in pop]))
+    X = np.array([ind.X for ind in pop])
+    F = np.array([ind.F for ind in pop])
+    if all((ind.H is None or len(ind.H) == 0) and ind.config == _DEFAULT_CV_CONFIG for ind in pop):
+        # pymoo's default violation (sum of positive G, no H) for all rows at once
+        G = np.array([ind.G if ind.G is not None else np.zeros(0) for ind in pop])
+        return X, F, np.maximum(0.0, G - 0.0).sum(axis=1) if G.shape[1] > 0 else np.zeros(len(pop))
+    return X, F, np.array([ind.CV[0] for ind in pop])
 
 
 def nondominated_indices(X: np.ndarray, F: np.ndarray, CV: np.ndarray) -> np.ndarray:
@@ -98,7 +105,7 @@ def crowding_truncation_indices(F: np.ndarray, max_size: int) -> np.ndarray:
 def truncate_by_crowding(pop: Population, max_size: int) -> Population:
     """Remove the most crowded member, one at a time, until ``len(pop) <= max_size``.
 
-    Crowding distance as in NSGA-II (seed 000, eq. 4-26), recomputed after every removal;
+    Crowding distance as in NSGA-II (Liu (2019), eq. 4-26), recomputed after every removal;
     boundary points have infinite distance. Ties go to the lowest index, so the result is
     deterministic.
     """
@@ -108,14 +115,14 @@ def truncate_by_crowding(pop: Population, max_size: int) -> Population:
 
 
 class MOABC(BeeColony):
-    """Multi-objective Artificial Bee Colony (seed 000, section 4.5.2).
+    """Multi-objective Artificial Bee Colony (Liu (2019), section 4.5.2).
 
     Parameters
     ----------
     pop_size : int
         Colony size (employed plus onlooker bees), even and at least 2; there are
         ``SN = pop_size // 2`` food sources. The initial sample has ``pop_size`` points;
-        the ``SN`` with the largest ``dom(i)`` become food sources (seed 000, 4.5.3 step 3)
+        the ``SN`` with the largest ``dom(i)`` become food sources (Liu (2019), 4.5.3 step 3)
         and its non-dominated points start the archive.
     archive_size : int
         Maximum size of the external archive.

@@ -8,11 +8,33 @@
 
 from __future__ import annotations
 
+import re
+from dataclasses import replace
 from pathlib import Path
 
 from pymoo_rail.model import Case, CaseError, read_case
 
 _HERE = Path(__file__).resolve().parent
+
+# Passenger load states of the built-in cases: train mass in t per load name. Liu (2019) table 5-2
+# gives the Yizhuang B-type 3M3T train empty (AW0), at the rated load (AW2) and crush-loaded (AW3);
+# its traction and braking curves (eqs. 5-1, 5-2) are those of AW0 and are kept for every load.
+LOADS_T: dict[str, dict[str, float]] = {
+    "yizhuang": {"AW0": 194.295, "AW2": 282.375, "AW3": 307.095},
+}
+
+
+def with_load(case: Case, load: str) -> Case:
+    """The case with the train mass of a named load state (``LOADS_T``), named ``"<case>-<load>"``."""
+    table = LOADS_T.get(case.name)
+    if table is None:
+        raise CaseError("load", load, f"case '{case.name}' has no load states (cases with loads: "
+                                      f"{', '.join(sorted(LOADS_T))})")
+    if load not in table:
+        raise CaseError("load", load, f"unknown load of case '{case.name}' (known: {', '.join(table)})")
+    base = re.sub(r"\s*\((?:%s)\)$" % "|".join(table), "", case.train.name)  # drop the file's own load tag
+    train = replace(case.train, mass_t=table[load], name=f"{base} ({load}, {table[load]} t)")
+    return replace(case, name=f"{case.name}-{load}", train=train)
 
 
 def list_cases() -> list[str]:
@@ -28,20 +50,25 @@ def case_path(name: str) -> Path:
     return path
 
 
-def load_case(name_or_path: str | Path) -> Case:
+def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
     """Load a built-in case by name, or any case file by path.
 
     Parameters
     ----------
     name_or_path : str or Path
         A built-in name from :func:`list_cases` or the path of a TOML case file.
+    load : str, optional
+        A passenger load state of the case (``LOADS_T``), e.g. ``load_case("yizhuang", load="AW3")``:
+        the train mass of that load, the rest of the case unchanged.
     """
     candidate = Path(name_or_path)
     if candidate.suffix == ".toml" or candidate.is_file():
         if not candidate.is_file():
             raise CaseError("path", str(candidate), "no such case file")
-        return read_case(candidate)
-    return read_case(case_path(str(name_or_path)))
+        case = read_case(candidate)
+    else:
+        case = read_case(case_path(str(name_or_path)))
+    return case if load is None else with_load(case, load)
 
 
 def __getattr__(name: str):
@@ -53,4 +80,4 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'pymoo_rail.cases' has no attribute {name!r}")
 
 
-__all__ = ["load_case", "list_cases", "case_path", "from_ttobench", "to_ttobench"]
+__all__ = ["load_case", "list_cases", "case_path", "with_load", "LOADS_T", "from_ttobench", "to_ttobench"]

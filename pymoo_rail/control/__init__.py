@@ -21,7 +21,15 @@ from pymoo_rail.control.controllers import (
     symmetric_rules,
 )
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S, Tracker, track, tracked_summaries
+from pymoo_rail.control.disturbances import (  # noqa: E402 (needs Tracker)
+    DEFAULT_RANGES,
+    Disturbance,
+    disturbed_tracker,
+    draw_disturbances,
+    track_disturbed,
+)
 
 __all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMMETRIC_RULES",
            "symmetric_rules", "TERMS", "Tracker", "track",
-           "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S"]
+           "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
+           "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES"]

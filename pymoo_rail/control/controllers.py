@@ -2,8 +2,8 @@
 
 Each controller is plain data that the tracking kernel reads as an integer code and a parameter
 array (:meth:`code`, :meth:`params`); the state machines themselves are Numba functions in
-:mod:`pymoo_rail.control.kernel`. Errors are in km/h (the unit of seed 000's A and B and of the
-fuzzy universes of seed 002), time in s, and the command is a fraction of the largest traction
+:mod:`pymoo_rail.control.kernel`. Errors are in km/h (the unit of Liu's (2019) A and B and of the
+fuzzy universes of Meng et al. (2017)), time in s, and the command is a fraction of the largest traction
 (positive) or braking (negative) force the train has at its speed, in [-1, 1].
 """
 
@@ -61,7 +61,7 @@ def symmetric_rules(rules: np.ndarray) -> np.ndarray:
 
     The printed tables are (nearly) anti-symmetric, dK(-e, -ec) = -dK(e, ec): they schedule the
     gains on the sign of the error, as for a step response from below. A tracking error takes
-    both signs, so the default rule base makes the increments depend only on |e| and on whether
+    both signs, so the default rule base makes the increments depend only on ``|e|`` and on whether
     the error grows or shrinks: rule(e, ec) = rule(-e, -ec).
     """
     out = np.array(rules, dtype=float)
@@ -95,7 +95,7 @@ def _check(name: str, value: object, *, positive: bool = False, upper: float | N
 
 @dataclass(frozen=True)
 class Hysteresis:
-    """Traction-coast tracking of seed 000 (section 5.1.3, fig. 5-2).
+    """Traction-coast tracking of Liu (2019) (section 5.1.3, fig. 5-2).
 
     With ``e = v_ref - v`` in km/h: coast once the train is within ``a_kmh`` of the reference
     (``e < A``), apply maximum traction once it has fallen more than ``b_kmh`` below it
@@ -109,7 +109,7 @@ class Hysteresis:
     Parameters
     ----------
     a_kmh, b_kmh : float
-        The band, ``0 <= A < B`` (seed 000 table 5-7 uses A = 2 and B = 3 ... 6 km/h).
+        The band, ``0 <= A < B`` (Liu (2019) table 5-7 uses A = 2 and B = 3 ... 6 km/h).
     overspeed_kmh : float
         Speed above the reference that starts braking (not in the seed; default 2 km/h).
     brake_fraction : float
@@ -182,7 +182,7 @@ class PID:
 
 @dataclass(frozen=True)
 class FuzzyPID:
-    """Adaptive fuzzy PID (seed 002, section 3.4, fig. 6): a PID whose gains a fuzzy system tunes.
+    """Adaptive fuzzy PID (Meng et al. (2017), section 3.4, fig. 6): a PID whose gains a fuzzy system tunes.
 
     The inputs ``e = v_ref - v`` (km/h) and ``ec = de/dt`` (km/h/s) are scaled onto the universe
     [-3, 3] (quantisation factors ``3 / e_range_kmh`` and ``3 / ec_range_kmhs``, saturating
@@ -199,7 +199,7 @@ class FuzzyPID:
     e_range_kmh, ec_range_kmhs : float
         Errors mapped onto the outer terms PB / NB.
     dkp, dki, dkd : float
-        Largest gain increments (seed 002 uses +-0.05 for Kp and +-0.002 for Ki and Kd in its
+        Largest gain increments (Meng et al. (2017) uses +-0.05 for Kp and +-0.002 for Ki and Kd in its
         own units).
     rules : (3, 7, 7) array, optional
         Output term (-3 = NB ... +3 = PB) for each (e, ec) pair, one table per gain; defaults to

@@ -1,6 +1,6 @@
 """The tracking kernel: a train driven by a controller along a reference speed-distance curve.
 
-The run has the three phases of seed 000 section 5.1.3:
+The run has the three phases of Liu (2019) section 5.1.3:
 
 1. start: maximum traction until the head reaches ``x_start_m``, where the reference leaves its
    first traction phase (the reference itself is maximum traction there);
@@ -211,11 +211,15 @@ def reference_phases(x, regime, count):
 
 @njit(cache=True)
 def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record,
-              tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, tr_u):
+              tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, tr_u, noise_ms, lag_s):
     """One tracked run; writes the ``OUT_*`` summary into ``out`` and, if ``record``, the trace.
 
-    ``v_ref`` is the reference speed at each grid node. ``tr_u`` receives the controller command
+    ``v_ref`` is the reference speed at each grid node. ``tr_u`` receives the command applied
     per cell (1 / -1 in the start / stop phases where the reference's own regime applies).
+    Disturbances of the controlled part: ``noise_ms`` is added to the measured speed at the
+    successive control instants (cycled; empty: none); the applied command follows the
+    controller's through a first-order lag of time constant ``lag_s`` (0: at once), the delayed
+    response of the traction and brake equipment.
     Returns the number of trace nodes written.
     """
     n = m.position_m.shape[0]
@@ -230,6 +234,10 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
     reached = True
     stop_pos = m.position_m[n - 1]
     count = 1
+    n_noise = noise_ms.shape[0]
+    k_instant = 0
+    u_act = 1.0
+    t_cell = 0.0
     if record:
         tr_x[0] = 0.0
         tr_v[0] = 0.0
@@ -243,7 +251,11 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             t_last = t - period_s
         # 1. the command
         if phase == 1 and t >= t_next - 1e-12:
-            u_cmd = controller_command(code, params, state, (v_ref[i] - v) * _MS_TO_KMH, t - t_last)
+            v_meas = v
+            if n_noise > 0:
+                v_meas = v + noise_ms[k_instant % n_noise]
+                k_instant += 1
+            u_cmd = controller_command(code, params, state, (v_ref[i] - v_meas) * _MS_TO_KMH, t - t_last)
             t_last = t
             while t_next <= t + 1e-12:
                 t_next += period_s
@@ -251,12 +263,17 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             u_cmd = 1.0
         elif phase == 2:
             u_cmd = 0.0  # on the envelope: the clamp below brakes along it
-        u1, f, w0 = _command_step(m, v, i, u_cmd)
-        if u_cmd >= 1.0:
+        if phase == 1 and lag_s > 0.0:
+            u_act += (u_cmd - u_act) * (1.0 - math.exp(-(t - t_cell) / lag_s))
+        else:
+            u_act = u_cmd
+        t_cell = t
+        u1, f, w0 = _command_step(m, v, i, u_act)
+        if u_act >= 1.0:
             regime = REGIME_TRACTION
-        elif u_cmd <= -1.0:
+        elif u_act <= -1.0:
             regime = REGIME_BRAKE
-        elif u_cmd == 0.0:
+        elif u_act == 0.0:
             regime = REGIME_COAST
         else:
             regime = REGIME_CRUISE
@@ -267,6 +284,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             phase = 2
         if phase == 2:
             u_cmd = -1.0 if f < 0.0 else 0.0
+            u_act = u_cmd
 
         # 3. the rest of the cell exactly as the simulator does it
         v, stopped, x1, a_cell, totals = complete_cell(m, totals, i, v, u1, f, w0, regime)
@@ -274,7 +292,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[TOTAL_TIME], a_cell, f, regime)
         t = totals[TOTAL_TIME]
         if record:
-            tr_u[i] = u_cmd
+            tr_u[i] = u_act
         count = i + 2
         if stopped:
             reached = False
@@ -287,7 +305,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
 
 
 @njit(cache=True)
-def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s):
+def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms, lag_s):
     """One tracked run with its trace: (summary, x, v, t, a, force, regime, command), trimmed."""
     n = m.position_m.shape[0]
     out = np.empty(N_OUT)
@@ -298,7 +316,9 @@ def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s):
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
     u = np.empty(n)
-    count = track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, True, x, v, t, a, f, r, u)
+    record = n >= 0  # run-time booleans, not literals: one compiled track_run / run_program each
+    count = track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record, x, v, t, a, f, r, u,
+                      noise_ms, lag_s)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count], u[:count]
 
 
@@ -314,6 +334,9 @@ def track_programs(m, programs, code, params, period_s):
     out = np.empty((n_runs, N_OUT))
     empty = np.empty(0)
     empty_r = np.empty(0, dtype=np.int8)
+    # run-time booleans, not literals: with literals Numba compiles run_program and track_run once
+    # per value (see pymoo_rail.sim.kernel.simulate_batch)
+    record, no_record = n >= 0, n < 0
     for j in prange(n_runs):
         ref_out = np.empty(N_OUT)
         x = np.empty(n)
@@ -322,9 +345,9 @@ def track_programs(m, programs, code, params, period_s):
         a = np.empty(n)
         f = np.empty(n)
         r = np.empty(n, dtype=np.int8)
-        count = run_program(m, programs[j], ref_out, True, x, v, t, a, f, r)
+        count = run_program(m, programs[j], ref_out, record, x, v, t, a, f, r)
         v[count:] = 0.0
         x_start, x_stop = reference_phases(x, r, count)
-        track_run(m, v, x_start, x_stop, code, params, period_s, out[j], False,
-                  empty, empty, empty, empty, empty, empty_r, empty)
+        track_run(m, v, x_start, x_stop, code, params, period_s, out[j], no_record,
+                  empty, empty, empty, empty, empty, empty_r, empty, empty, 0.0)
     return out

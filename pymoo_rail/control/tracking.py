@@ -1,4 +1,4 @@
-"""Tracking a reference speed-distance curve with an ATO controller (seed 000 2.1 and 5.1.3)."""
+"""Tracking a reference speed-distance curve with an ATO controller (Liu (2019) 2.1 and 5.1.3)."""
 
 from __future__ import annotations
 
@@ -70,15 +70,25 @@ class Tracker:
     def case(self) -> Case:
         return self.simulator.case
 
-    def run(self, reference: Trajectory) -> Trajectory:
+    def run(self, reference: Trajectory, speed_noise_ms: np.ndarray | None = None,
+            traction_lag_s: float = 0.0) -> Trajectory:
         """The tracked run of one reference curve (any :class:`Trajectory` of this line).
 
         The summary has the simulator's keys plus the speed error (speed minus reference at the
         same position, km/h) over the whole run (``speed_error_rms_kmh``, ``speed_error_max_kmh``)
         and over the part the controller drives (``control_error_rms_kmh``,
         ``control_error_max_kmh``, between ``control_start_m`` and ``control_stop_m``).
+
+        ``speed_noise_ms`` (m/s, added to the measured speed at successive control instants) and
+        ``traction_lag_s`` (time constant of a first-order lag between command and force) disturb
+        the controlled part; see :class:`pymoo_rail.control.Disturbance`.
         """
         _check_reference(reference)
+        noise = np.zeros(0) if speed_noise_ms is None else np.ascontiguousarray(speed_noise_ms, dtype=float)
+        if noise.ndim != 1 or not np.all(np.isfinite(noise)):
+            raise ValueError("speed_noise_ms must be a finite 1-d array (m/s per control instant)")
+        if not (np.isfinite(traction_lag_s) and traction_lag_s >= 0):
+            raise ValueError(f"traction_lag_s = {traction_lag_s!r} must be a number >= 0")
         grid = self.simulator.grid
         x_ref = np.asarray(reference.position_m, dtype=float)
         v_ref_ms = np.asarray(reference.speed_ms, dtype=float)
@@ -86,7 +96,8 @@ class Tracker:
         regime = np.ascontiguousarray(reference.regime, dtype=np.int8)
         x_start, x_stop = ck.reference_phases(np.ascontiguousarray(x_ref), regime, x_ref.shape[0])
         out, x, v, t, a, f, r, u = ck.track_trace(self.simulator.model, v_ref, float(x_start), float(x_stop),
-                                                 self._code, self._params, self.control_period_s)
+                                                 self._code, self._params, self.control_period_s,
+                                                 noise, float(traction_lag_s))
         summary = summary_dict(out)
         err_kmh = (v - np.interp(x, x_ref, v_ref_ms, right=0.0)) * 3.6
         summary["speed_error_rms_kmh"] = float(np.sqrt(np.mean(err_kmh**2)))

@@ -4,10 +4,10 @@ Conventions (written down because papers differ):
 
 - ``igd``, ``gd``: pymoo's IGD and GD, i.e. the *mean* Euclidean distance to the nearest point
   (of the front for GD, of the approximation for IGD), in raw objective units.
-- ``gd_vv``: Van Veldhuizen's form ``sqrt(sum d_i^2) / n``, the GD of seed 003 eq. 13.
+- ``gd_vv``: Van Veldhuizen's form ``sqrt(sum d_i^2) / n``, the GD of Tang et al. (2020) eq. 13.
 - ``hv``: hypervolume of the front normalised by the true front's ideal and nadir points, with
   the reference point 1.1 in every normalised objective (points beyond it add nothing).
-- ``spacing``: Schott's spacing (``pymoo_rail.indicators.Spacing``, divides by n - 1, seed 003
+- ``spacing``: Schott's spacing (``pymoo_rail.indicators.Spacing``, divides by n - 1, Tang et al. (2020)
   eqs. 11-12), raw objective units; undefined (missing) for fewer than 2 points.
 - single objective: ``f_best`` and, where the optimum is known, ``error = f_best - f_opt``.
 

@@ -32,35 +32,35 @@ def _pymoo_problem(name: str) -> Callable[..., Any]:
 
 
 def _sphere(n_var: int = 10):
-    """Sphere on [-100, 100]^n (seed 000 eq. 3-6)."""
+    """Sphere on [-100, 100]^n (Liu (2019) eq. 3-6)."""
     from pymoo_rail.experiments.functions import Sphere
 
     return Sphere(n_var)
 
 
 def _griewank(n_var: int = 10):
-    """Griewank on [-600, 600]^n (seed 000 eq. 3-7)."""
+    """Griewank on [-600, 600]^n (Liu (2019) eq. 3-7)."""
     from pymoo_rail.experiments.functions import Griewank
 
     return Griewank(n_var)
 
 
 def _rosenbrock(n_var: int = 10):
-    """Rosenbrock on [-2.048, 2.048]^n (seed 000 eq. 3-8)."""
+    """Rosenbrock on [-2.048, 2.048]^n (Liu (2019) eq. 3-8)."""
     from pymoo_rail.experiments.functions import Rosenbrock
 
     return Rosenbrock(n_var)
 
 
-def _case(case: Any):
-    from pymoo_rail.cases import load_case
+def _case(case: Any, load: str | None = None):
+    from pymoo_rail.cases import load_case, with_load
     from pymoo_rail.model import Case
 
     if isinstance(case, Case):
-        return case
+        return case if load is None else with_load(case, load)
     if not isinstance(case, str):
         raise StudyError("case", case, "must be a built-in case name or the path of a case file")
-    return load_case(case)
+    return load_case(case, load=load)
 
 
 def _tuples(params: dict) -> dict:
@@ -68,15 +68,16 @@ def _tuples(params: dict) -> dict:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
 
 
-def _speed_profile(case: Any = "yizhuang", **params):
-    """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path)."""
+def _speed_profile(case: Any = "yizhuang", load: str | None = None, **params):
+    """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path; ``load``:
+    a passenger load state such as ``"AW3"``)."""
     from pymoo_rail.problems import SpeedProfileProblem
 
-    return SpeedProfileProblem(_case(case), **_tuples(params))
+    return SpeedProfileProblem(_case(case, load), **_tuples(params))
 
 
 def _cooperative_trains(case: Any = "cooperative-pair", **params):
-    """``pymoo_rail.problems.CooperativeTrainsProblem`` (seed 001)."""
+    """``pymoo_rail.problems.CooperativeTrainsProblem`` (Chen et al. (2017))."""
     from pymoo_rail.problems import CooperativeTrainsProblem
 
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
@@ -97,6 +98,30 @@ def _timetable(case: Any = "cooperative-pair", **params):
     return TimetableProblem(_case(case), **_tuples(params))
 
 
+def _kinematic_phases(case: Any = "metro-a", **params):
+    """``pymoo_rail.problems.KinematicPhasesProblem`` (the four-phase model of Meng et al. 2017)."""
+    from pymoo_rail.problems import KinematicPhasesProblem
+
+    return KinematicPhasesProblem(_case(case), **_tuples(params))
+
+
+def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
+    """``pymoo_rail.control.tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
+    from pymoo_rail.control.tuning import ControllerTuningProblem
+
+    return ControllerTuningProblem(_case(case, load), **params)
+
+
+def _rail_suite(suite_problem: str, **params):
+    """A problem of the rail benchmark suite by name (``pymoo_rail.suite.get_problem``)."""
+    from pymoo_rail.suite import get_problem
+
+    try:
+        return get_problem(suite_problem, **_tuples(params))
+    except ValueError as err:
+        raise StudyError("problem rail_suite suite_problem", suite_problem, str(err)) from None
+
+
 PROBLEMS: dict[str, Callable[..., Any]] = {
     **{f"zdt{i}": _pymoo_problem(f"zdt{i}") for i in range(1, 7)},
     **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}") for i in range(1, 8)},
@@ -105,6 +130,9 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "rosenbrock": _rosenbrock,
     "speed_profile": _speed_profile,
     "cooperative_trains": _cooperative_trains,
+    "kinematic_phases": _kinematic_phases,
+    "controller_tuning": _controller_tuning,
+    "rail_suite": _rail_suite,
     "cooperative_trains_scaled": _cooperative_scaled,
     "timetable": _timetable,
 }
@@ -147,6 +175,12 @@ def _smsemoa(problem, **params):
     return SMSEMOA(**params)
 
 
+def _agemoea(problem, **params):
+    from pymoo.algorithms.moo.age import AGEMOEA
+
+    return AGEMOEA(**params)
+
+
 def _de(problem, **params):
     from pymoo.algorithms.soo.nonconvex.de import DE
 
@@ -179,12 +213,12 @@ def _rail_algorithm(name: str, module: str) -> Any:
 
 
 def _abc(problem, **params):
-    """``pymoo_rail.algorithms.ABC`` (seed 000, 3.2-3.3)."""
+    """``pymoo_rail.algorithms.ABC`` (Liu (2019), 3.2-3.3)."""
     return _rail_algorithm("ABC", "abc")(**params)
 
 
 def _moabc(problem, **params):
-    """``pymoo_rail.algorithms.MOABC`` (seed 000, 4.5.2)."""
+    """``pymoo_rail.algorithms.MOABC`` (Liu (2019), 4.5.2)."""
     return _rail_algorithm("MOABC", "moabc")(**params)
 
 
@@ -198,7 +232,7 @@ def _fixed_genes(problem):
 
 
 def _grnsga2(problem, **params):
-    """``pymoo_rail.algorithms.GoldenRatioNSGA2`` (seed 003, 3.1); on a rail problem the genes of
+    """``pymoo_rail.algorithms.GoldenRatioNSGA2`` (Tang et al. (2020), 3.1); on a rail problem the genes of
     neutral sections are passed as ``fixed_genes`` unless given."""
     if "fixed_genes" not in params:
         fixed = _fixed_genes(problem)
@@ -221,17 +255,19 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
     "nsga3": AlgorithmEntry(_nsga3, "multi", "NSGA-III with pop_size reference directions (pymoo)"),
     "moead": AlgorithmEntry(_moead, "multi", "MOEA/D with pop_size weight vectors (pymoo)"),
     "sms-emoa": AlgorithmEntry(_smsemoa, "multi", "SMS-EMOA (pymoo)"),
+    "age-moea": AlgorithmEntry(_agemoea, "multi", "AGE-MOEA, adaptive geometry estimation (pymoo)"),
     "de": AlgorithmEntry(_de, "single", "differential evolution (pymoo)"),
     "pso": AlgorithmEntry(_pso, "single", "particle swarm (pymoo)"),
     "ga": AlgorithmEntry(_ga, "single", "genetic algorithm (pymoo)"),
-    "abc": AlgorithmEntry(_abc, "single", "artificial bee colony (pymoo_rail, seed 000)"),
-    "moabc": AlgorithmEntry(_moabc, "any", "multi-objective bee colony (pymoo_rail, seed 000)"),
-    "grnsga2": AlgorithmEntry(_grnsga2, "any", "golden-ratio NSGA-II (pymoo_rail, seed 003)"),
+    "abc": AlgorithmEntry(_abc, "single", "artificial bee colony (pymoo_rail, Liu (2019))"),
+    "moabc": AlgorithmEntry(_moabc, "any", "multi-objective bee colony (pymoo_rail, Liu (2019))"),
+    "grnsga2": AlgorithmEntry(_grnsga2, "any", "golden-ratio NSGA-II (pymoo_rail, Tang et al. (2020))"),
 }
 
-ALIASES = {"smsemoa": "sms-emoa", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
+ALIASES = {"smsemoa": "sms-emoa", "agemoea": "age-moea", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
            "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
-           "cooperative-trains": "cooperative_trains"}
+           "cooperative-trains": "cooperative_trains", "rail-suite": "rail_suite",
+           "kinematic-phases": "kinematic_phases", "controller-tuning": "controller_tuning"}
 
 # -------------------------------------------------------------------------------- operators
 
@@ -254,6 +290,8 @@ OPERATORS: dict[str, dict[str, tuple[str, str]]] = {
     "sampling": {
         "random": ("pymoo.operators.sampling.rnd", "FloatRandomSampling"),
         "lhs": ("pymoo.operators.sampling.lhs", "LHS"),
+        "binary": ("pymoo.operators.sampling.rnd", "BinaryRandomSampling"),
+        "integer": ("pymoo.operators.sampling.rnd", "IntegerRandomSampling"),
     },
 }
 

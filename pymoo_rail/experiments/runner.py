@@ -35,6 +35,7 @@ import numpy as np
 from pymoo_rail.experiments.metrics import convergence_point, front_indicators, true_front
 from pymoo_rail.experiments.registry import build_algorithm, build_problem
 from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
+from pymoo_rail.experiments.fronts import distinct_front
 from pymoo_rail.experiments.inputs import changed_inputs, run_inputs
 from pymoo_rail.experiments.store import CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, RecordError, ResultStore
 
@@ -131,10 +132,10 @@ def execute_run(run: RunSpec, inputs: dict[str, str] | None = None) -> dict[str,
     wall_time_s = time.perf_counter() - start
     cpu_time_s = time.process_time() - start_cpu
 
-    opt = res.algorithm.opt
-    X = np.asarray(opt.get("X"), dtype=float) if opt is not None else np.empty((0, problem.n_var))
-    F = np.asarray(opt.get("F"), dtype=float) if opt is not None else np.empty((0, problem.n_obj))
-    CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1) if opt is not None else np.empty(0)
+    opt = distinct_front(res.algorithm.opt)  # one member per objective vector
+    X = np.asarray(opt.get("X"), dtype=float) if len(opt) else np.empty((0, problem.n_var))
+    F = np.asarray(opt.get("F"), dtype=float) if len(opt) else np.empty((0, problem.n_obj))
+    CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1) if len(opt) else np.empty(0)
     feasible = CV <= 0.0
     indicators = front_indicators(F[feasible], pf)
     return {
@@ -328,8 +329,17 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
     Returns
     -------
     StudyReport
-        Counts of skipped, finished and failed runs. Failed runs are stored in ``failed/`` with
-        their traceback and are retried at the next start.
+        Counts of skipped, finished and failed runs, runs another process stored meanwhile
+        (``n_elsewhere``) and why stored records were redone (``redone``). Failed runs are stored
+        in ``failed/`` with their traceback and are retried at the next start.
+
+    Notes
+    -----
+    A stored run is skipped only if its record passes its checks and its input fingerprint
+    (case content, files and module the specs name, package versions) equals the current one;
+    otherwise the record is set aside (``corrupt/`` or ``stale/``), the reason is printed, and
+    the run is redone. Each run is claimed with a file lock first, so several processes can work
+    on one directory and each run is computed once. See ``docs/experiments.md``.
     """
     from tqdm import tqdm
 

@@ -1,8 +1,11 @@
 """Gap of an energy / running-time front to the optimal front of the case.
 
 The reference is the exact solver's front (``pymoo_rail.optimal.optimal_front``): convex and
-decreasing in the running time, so between its points it is interpolated linearly (the chord lies
-at most a little above the true curve; sample the reference densely where the gap matters).
+decreasing in the running time, so between its points it is interpolated linearly. The chord lies
+above the true curve, so interpolation understates gaps, most near the minimum running time where
+the front is steep (measured: 1.55 % by interpolation against 2.07 % solved at the point's own
+time). For exact gaps, :func:`pymoo_rail.optimal.solved_energy_gap` solves the optimum at each
+point's own running time, with its certificate.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ ENERGY_COLUMN = "energy_kwh"
 _DENSE_POINTS = 2000
 
 
-def _as_front(name: str, front) -> np.ndarray:
+def as_front(name: str, front) -> np.ndarray:
     """(n, 2) float array of (running time s, energy kWh) from an array or a DataFrame."""
     if isinstance(front, pd.DataFrame):
         missing = [c for c in (TIME_COLUMN, ENERGY_COLUMN) if c not in front.columns]
@@ -70,8 +73,8 @@ def energy_gap(front, reference, ref_point=None) -> dict:
         ``hv_reference`` of the reference curve (densely interpolated, so the ratio measures the
         distance to the continuous optimum), ``hv_ratio = hv / hv_reference`` and ``ref_point``.
     """
-    points = _as_front("front", front)
-    t_ref, e_ref = _reference_curve(_as_front("reference", reference))
+    points = as_front("front", front)
+    t_ref, e_ref = _reference_curve(as_front("reference", reference))
     t, e = points[:, 0], points[:, 1]
     in_range = (t >= t_ref[0]) & (t <= t_ref[-1])
     optimal = np.where(in_range, np.interp(t, t_ref, e_ref), np.nan)

@@ -19,7 +19,7 @@ class Spacing(Indicator):
         SP = \sqrt{\frac{1}{n - 1} \sum_{i=1}^{n} (\bar d - d_i)^2}
 
     ``d_i`` is the city-block (L1) distance from point ``i`` to its nearest neighbour in
-    the set. This is Schott's definition and seed 003 eqs. 11-12 (whose text calls ``d_i``
+    the set. This is Schott's definition and Tang et al. (2020) eqs. 11-12 (whose text calls ``d_i``
     Euclidean, while its formula is L1; the formula is implemented). SP = 0 means all
     nearest-neighbour gaps are equal. Smaller is better.
 

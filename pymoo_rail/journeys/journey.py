@@ -143,7 +143,7 @@ class Journey:
             Planned running time of each section (TTOBench has none). Default: each section's
             minimum running time plus ``supplement`` (10 %), a usual timetable running-time supplement.
         dwell_s : float or sequence of float
-            Dwell at each intermediate stop (default 30 s, seed 000 5.1.1 for this line).
+            Dwell at each intermediate stop (default 30 s, Liu (2019) 5.1.1 for this line).
         train_length_m : float, optional
             As in :func:`~pymoo_rail.cases.ttobench.from_ttobench` (default: point mass).
         """

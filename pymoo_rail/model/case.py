@@ -26,7 +26,7 @@ class Case:
     """Everything an optimisation needs: the train, the line, the planned running time.
 
     ``legs`` is empty for a single stop-to-stop run; multi-section cases (e.g. the cooperative
-    pair of seed 001) list consecutive legs, and ``leg(k)`` returns each as a case of its own.
+    pair of Chen et al. (2017)) list consecutive legs, and ``leg(k)`` returns each as a case of its own.
 
     ``initial_speed_ms`` and ``final_speed_ms`` are the speeds at the start and at the end of the
     line (default 0: from standstill to a stop at the platform); a run may start and end moving,

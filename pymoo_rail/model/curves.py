@@ -25,7 +25,7 @@ class ForceCurve:
         Piecewise polynomials in v (km/h) giving kN, coefficients from low to high order, ordered
         by speed. Segment k applies up to ``v_max_kmh``; the last one also beyond it.
     table : tuple of (v_kmh, force_kn)
-        Points interpolated linearly (seed 000 eq. 2-2), speeds strictly increasing from 0.
+        Points interpolated linearly (Liu (2019) eq. 2-2), speeds strictly increasing from 0.
     max_force_kn : float
         A constant force cap.
     max_power_kw : float

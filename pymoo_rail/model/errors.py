@@ -37,7 +37,7 @@ def check_number(field: str, value: object, *, positive: bool = False, nonneg: b
             return None
         raise CaseError(field, value, "is required", source)
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise CaseError(field, value, f"must be a number, not {type(value).__name__}", source)
+        raise CaseError(field, value, f"must be a finite number, not {type(value).__name__}", source)
     if not math.isfinite(value):
         raise CaseError(field, value, "must be a finite number", source)
     if positive and value <= 0:

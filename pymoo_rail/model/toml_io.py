@@ -1,8 +1,7 @@
-"""Reading and writing case files (TOML, DESIGN.md section 5)."""
+"""Reading and writing case files (TOML; the format: ``docs/case-format.md``)."""
 
 from __future__ import annotations
 
-import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -14,7 +13,7 @@ else:  # pragma: no cover - Python 3.10
 
 from pymoo_rail.model.case import Case, Leg
 from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
-from pymoo_rail.model.errors import CaseError
+from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
@@ -28,7 +27,22 @@ _RESISTANCE = {"a", "b", "c", "unit", "speed_unit"}
 _CURVE = {"segments", "table", "max_force_kn", "max_power_kw"}
 _BRAKING = _CURVE | {"regen_max_force_kn", "regen_max_power_kw"}
 _SEGMENT = {"v_max_kmh", "poly"}
-_LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_sections", "gradient_model"}
+_LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_sections", "gradient_model",
+         "curve_model"}
+
+
+# every table of the format and the keys it may hold ("[]": each table of an array of tables)
+CASE_TABLES = {"": _TOP, "run": _RUN, "run.legs[]": _LEG, "train": _TRAIN, "train.resistance": _RESISTANCE,
+               "train.traction": _CURVE, "train.traction.segments[]": _SEGMENT, "train.braking": _BRAKING,
+               "train.braking.segments[]": _SEGMENT, "line": _LINE}
+
+
+def case_keys() -> list[str]:
+    """Every key a case file may hold, as dotted paths (``train.resistance.unit``, ``run.legs[].end_m``).
+
+    ``docs/case-format.md`` documents each of them; a test keeps the two in step.
+    """
+    return sorted(f"{table}.{key}" if table else key for table, keys in CASE_TABLES.items() for key in keys)
 
 
 def _table(data: Any, field: str, allowed: set[str], required: set[str], source: str) -> dict:
@@ -74,12 +88,7 @@ def _curve(data: Any, field: str, allowed: set[str], source: str) -> ForceCurve:
 
 def _speed_ms(run: dict, key: str) -> float:
     """A boundary speed of ``[run]`` (km/h in the file) in m/s; a bad value names the field."""
-    value = run.get(key, 0.0)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise CaseError(f"run.{key}", value, "must be a finite number of km/h")
-    if value < 0.0:
-        raise CaseError(f"run.{key}", value, "must be >= 0")
-    return value / KMH_PER_MS
+    return check_number(f"run.{key}", run.get(key, 0.0), nonneg=True) / KMH_PER_MS
 
 
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
@@ -116,6 +125,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
             tunnels=_rows(line.get("tunnels", []), "line.tunnels", source),
             neutral_sections=_rows(line.get("neutral_sections", []), "line.neutral_sections", source),
             gradient_model=line.get("gradient_model", "train_length"),
+            curve_model=line.get("curve_model", "tang2020"),
         )
         return Case(name=data["name"], source=data.get("source", ""), description=data.get("description", ""),
                     train=train, line=line_obj, planned_time_s=run["planned_time_s"],
@@ -137,7 +147,7 @@ def read_case(path: str | Path) -> Case:
         with path.open("rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as err:
-        raise CaseError("<file>", str(path), f"is not valid TOML: {err}", str(path)) from None
+        raise CaseError("toml", str(path), f"is not valid TOML: {err}", str(path)) from None
     return case_from_dict(data, source=str(path))
 
 
@@ -196,12 +206,14 @@ def case_to_dict(case: Case) -> dict:
     if case.legs:
         run["legs"] = [{"start_m": g.start_m, "end_m": g.end_m, "planned_time_s": g.planned_time_s,
                         "dwell_s": g.dwell_s} for g in case.legs]
+    line = {"length_m": ln.length_m, "gradient_model": ln.gradient_model,
+            "gradients": [list(r) for r in ln.gradients], "speed_limits": [list(r) for r in ln.speed_limits],
+            "curves": [list(r) for r in ln.curves], "tunnels": [list(r) for r in ln.tunnels],
+            "neutral_sections": [list(r) for r in ln.neutral_sections]}
+    if ln.curve_model != "tang2020":  # the default stays out of the file (older files read the same)
+        line["curve_model"] = ln.curve_model
     return {"name": case.name, "source": case.source, "description": case.description, "run": run,
-            "train": train,
-            "line": {"length_m": ln.length_m, "gradient_model": ln.gradient_model,
-                     "gradients": [list(r) for r in ln.gradients], "speed_limits": [list(r) for r in ln.speed_limits],
-                     "curves": [list(r) for r in ln.curves], "tunnels": [list(r) for r in ln.tunnels],
-                     "neutral_sections": [list(r) for r in ln.neutral_sections]}}
+            "train": train, "line": line}
 
 
 def write_case(case: Case, path: str | Path) -> Path:

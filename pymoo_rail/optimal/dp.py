@@ -9,7 +9,8 @@ cell are far smaller than the node spacing (DESIGN.md section 8). Interpolating 
 than ``v`` makes the kinetic-energy part of the cost-to-go, which is linear in ``u``, exact.
 
 Controls of one cell are exactly the simulator's driving modes (``pymoo_rail.sim.kernel``):
-maximum traction, coasting, maximum braking, holding the entry speed, and ``toward`` a target
+maximum traction, coasting, maximum braking, holding the entry speed (by partial traction, or by
+partial regenerative-first braking where coasting would accelerate), and ``toward`` a target
 speed, which lands exactly on a speed node of the next position by partial traction (or partial
 braking). Each transition is computed by the simulator's own step functions, including its
 braking-envelope override (``clamp_to_envelope``), so a control sequence chosen here replays bit
@@ -35,6 +36,7 @@ from pymoo_rail.sim.kernel import (
     MODE_BRAKE,
     MODE_COAST,
     MODE_HOLD,
+    MODE_HOLD_BRAKE,
     MODE_TOWARD,
     MODE_TRACTION,
     REGIME_COAST,
@@ -85,12 +87,14 @@ def node_position(top_u, u, k_max, bias):
 def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w):
     """What the simulator's ``run_program`` does in one cell for a program row of its own.
 
-    The mode logic of ``run_program`` (a hold row holds the speed on entering it; ``toward`` pulls
-    or coasts to its target and lands on it), then the simulator's ``clamp_to_envelope``.
+    The mode logic of ``run_program`` (a hold row holds the speed on entering it, ``hold_brake``
+    also by partial braking where coasting would accelerate; ``toward`` pulls or coasts to its
+    target and lands on it), then the simulator's ``clamp_to_envelope``.
     ``tr_*``, ``co_*``, ``br_*`` are the cell's full traction, coast and brake steps from ``v0``
     (``_full_step``), computed once and shared by every control. Returns ``(u1, force_n, w0_n)``.
     """
-    if mode == MODE_HOLD:
+    brake_to_hold = mode == MODE_HOLD_BRAKE
+    if mode == MODE_HOLD or brake_to_hold:
         if v0 <= 0.0:
             mode = MODE_TRACTION
         else:
@@ -102,11 +106,13 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
             landed = u1 > target * target
         else:
             u1, f, w0 = co_u, co_f, co_w
-            landed = u1 < target * target
+            landed = u1 < target * target or brake_to_hold
         if landed:
             fl, w0l, ok = _landing_force(m, v0, target, cell)
             if ok:
                 u1, f, w0 = target * target, fl, w0l
+            elif brake_to_hold and u1 >= target * target:  # too steep to hold: full braking
+                u1, f, w0 = br_u, br_f, br_w
     elif mode == MODE_TRACTION:
         u1, f, w0 = tr_u, tr_f, tr_w
     elif mode == MODE_BRAKE:
@@ -134,16 +140,27 @@ def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
 
 
 @njit(cache=True)
-def interp_value(v_next, top_u, u, bias):
-    """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
-    k_max = v_next.shape[0] - 1
+def value_position(top_u, u, k_max, bias):
+    """Where kinetic energy ``u`` falls among the speed nodes over ``[0, top_u]``: a fractional index.
+
+    ``-1`` above the top node (beyond rounding: no cost-to-go there), ``k_max`` on it. Depends on
+    the grid only, not on the price of time: the solver computes it once per transition.
+    """
     if u > top_u:
         if u <= top_u * (1.0 + _TOP_RTOL) + 1e-12:
-            return v_next[k_max]
-        return INF
+            return float(k_max)
+        return -1.0
     if top_u <= 0.0:
-        return v_next[0]
-    p = node_position(top_u, u, k_max, bias)
+        return 0.0
+    return node_position(top_u, u, k_max, bias)
+
+
+@njit(cache=True, inline="always")
+def interp_at(v_next, p):
+    """Cost-to-go at fractional node index ``p`` (from :func:`value_position`), linear in ``u``."""
+    if p < 0.0:
+        return INF
+    k_max = v_next.shape[0] - 1
     k = int(p)
     if k >= k_max:
         return v_next[k_max]
@@ -157,7 +174,16 @@ def interp_value(v_next, top_u, u, bias):
     return a + w * (b - a)
 
 
-N_FIXED = 4  # traction, coast, brake, hold
+@njit(cache=True)
+def interp_value(v_next, top_u, u, bias):
+    """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
+    return interp_at(v_next, value_position(top_u, u, v_next.shape[0] - 1, bias))
+
+
+# traction, coast, brake, hold. Holding is ``hold_brake``: where coasting decelerates it is ``hold``
+# (partial traction), and where coasting accelerates ``hold`` would only coast, which the coast
+# control already is, while ``hold_brake`` holds the speed by partial (regenerative-first) braking.
+N_FIXED = 4
 
 
 @njit(cache=True)
@@ -168,7 +194,7 @@ def _fixed_mode(c):
         return MODE_COAST
     if c == 2:
         return MODE_BRAKE
-    return MODE_HOLD
+    return MODE_HOLD_BRAKE
 
 
 @njit(cache=True)
@@ -277,7 +303,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
                 u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
                 e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                fixed_u1[i, j, c] = u1
+                fixed_u1[i, j, c] = value_position(top1, u1, k_max, bias)
                 fixed_e[i, j, c] = e
                 fixed_dt[i, j, c] = dt
             s = i * n_speeds + j
@@ -291,7 +317,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
                 u1, f, w0 = cell_outcome(m, v0, i, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
                 e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                tgt_u1[p] = u1
+                tgt_u1[p] = value_position(top1, u1, k_max, bias)
                 tgt_e[p] = e
                 tgt_dt[p] = dt
                 p += 1
@@ -301,7 +327,8 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float):
     """Every cell's transitions from every speed node, which do not depend on the price of time.
 
     Returns a tuple ``(fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt)``: for the four
-    fixed controls arrays (n_cells, n_speeds, 4) of the kinetic energy reached, the net energy (J,
+    fixed controls arrays (n_cells, n_speeds, 4) of where the speed reached falls among the next
+    position's speed nodes (:func:`value_position`, computed once here rather than in every sweep), the net energy (J,
     with auxiliary power) and the time of the cell; for partial traction onto speed nodes the same
     in flat arrays, state ``s = i * n_speeds + j`` owning entries ``offsets[s]:offsets[s + 1]``.
     Infeasible transitions (a stop before the platform) have infinite energy. Stored in single
@@ -321,31 +348,32 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float):
 
 
 @njit(cache=True)
-def backward_sweep(envelope_ms, time_price_w, bias, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value):
-    """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the platform backwards.
+def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value):
+    """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
-    ``time_price_w`` is the price of time beyond the auxiliary power (already in the energies).
+    ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
+    the energies; one value everywhere for one running time, one per stretch between timing points);
+    ``fixed_u1`` and ``tgt_u1`` hold node positions (:func:`value_position`).
     """
     n, n_speeds = value.shape
     # at the end of the line: the envelope there is the final speed (0 at a platform: one state);
     # the simulator lands on it, a slower arrival (coasting in) is a run like any other
     value[n - 1, :] = 0.0
     for i in range(n - 2, -1, -1):
-        top1 = envelope_ms[i + 1] ** 2
         v_next = value[i + 1]
         for j in range(n_speeds):
             best = INF
             for c in range(N_FIXED):
                 e = fixed_e[i, j, c]
                 if e < INF:
-                    cost = e + time_price_w * fixed_dt[i, j, c] + interp_value(v_next, top1, fixed_u1[i, j, c], bias)
+                    cost = e + time_price_w[i] * fixed_dt[i, j, c] + interp_at(v_next, fixed_u1[i, j, c])
                     if cost < best:
                         best = cost
             s = i * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w * tgt_dt[p] + interp_value(v_next, top1, tgt_u1[p], bias)
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_at(v_next, tgt_u1[p])
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J else PENALTY_J
@@ -370,17 +398,17 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     time = 0.0
     previous = MODE_TRACTION
     for i in range(n - 1):
-        cost, mode, target = best_control(m, i, v, time_price_w, value[i + 1], max_targets, bias)
+        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time
         tr_u, tr_f, tr_w, _ = _full_step(m, v, i, _KIND_TRACTION)
         co_u, co_f, co_w, _ = _full_step(m, v, i, _KIND_COAST)
         br_u, br_f, br_w, _ = _full_step(m, v, i, _KIND_BRAKE)
         if i > 0 and mode != previous and tie_j > 0.0:
-            keep = MODE_HOLD if previous == MODE_TOWARD else previous
+            keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
                 u1, f, w0 = cell_outcome(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-                c_keep, _ = cell_cost(m, v, u1, f, w0, i, time_price_w)
+                c_keep, _ = cell_cost(m, v, u1, f, w0, i, time_price_w[i])
                 if c_keep < INF:
                     c_keep += interp_value(value[i + 1], m.envelope_ms[i + 1] ** 2, u1, bias)
                     if c_keep <= cost + tie_j:
@@ -397,20 +425,24 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     return n - 1, energy, time
 
 
-def solve(model, tables, lambda_w: float, max_targets: int, bias: float, tie_j: float, value: np.ndarray):
+def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
+
+    ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
+    stretch between them its own price.
 
     ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
     cost-to-go. Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s).
     Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
     energy, and the tables already hold it.
     """
-    backward_sweep(model.envelope_ms, float(lambda_w), float(bias), *tables, value)
     n = model.position_m.shape[0]
+    prices = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,)))
+    backward_sweep(prices, *tables, value)
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)
-    price = float(lambda_w) + model.aux_power_w
+    price = prices + model.aux_power_w
     done, energy, time = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j), modes,
                                          targets, speeds)
     return modes, targets, speeds, done, energy, time

@@ -2,16 +2,20 @@
 
 On level track without binding speed limits the minimum-energy run for a given time is
 maximum traction to a hold speed ``V``, holding ``V``, coasting down to ``W``, maximum braking
-(seed 000 section 2.2.5; Howlett and Pudney). With time priced at ``lambda`` and the Hamiltonian
-over distance ``H = f+/eta + lambda/v + p (f - R(v)) / (m_eff v)``:
+(Liu (2019) section 2.2.5; Howlett and Pudney). With time priced at ``lambda`` (plus the auxiliary
+power ``P_aux``, which costs exactly like time), traction efficiency ``eta`` and regenerative
+braking efficiency ``eta_b``, the Hamiltonian over distance is
+``H = f+/eta - eta_b f- + (lambda + P_aux)/v + p (f+ - f- - R(v)) / (m_eff v)``:
 
 - on the hold arc the traction coefficient vanishes, ``p = -m_eff V / eta``, and ``dp/dx = 0`` gives
-  ``lambda = V^2 R'(V) / eta``;
-- braking begins where ``p = 0``; ``H`` is constant along the run (level track), so
-  ``lambda / W = R(V) / eta + lambda / V``.
+  ``lambda + P_aux = V^2 R'(V) / eta``;
+- braking begins where the braking coefficient vanishes, ``p = -eta_b m_eff W``; ``H`` is constant
+  along the run (level track), so ``(lambda + P_aux) / W + eta_b R(W) = R(V) / eta + (lambda + P_aux) / V``
+  (without regeneration, ``eta_b = 0``, the classical ``lambda / W = R(V) / eta + lambda / V``).
 
-The phases are integrated by quadrature of the equations of motion, independently of the
-simulator and of the DP; ``lambda`` is then found so that the phases add up to the requested time.
+The run starts at the case's initial speed and brakes down to its final speed. The phases are
+integrated by quadrature of the equations of motion, independently of the simulator and of the
+DP; ``lambda`` is then found so that the phases add up to the requested time.
 """
 
 from __future__ import annotations
@@ -44,22 +48,28 @@ def _check_flat(case: Case) -> None:
     if any(g[2] != 0.0 for g in line.gradients) or line.curves or line.tunnels or line.neutral_sections:
         raise ValueError(f"case '{case.name}': the closed form needs level track without curves, tunnels "
                          "or neutral sections")
-    if train.regen_efficiency != 0.0 or train.aux_power_kw != 0.0:
-        raise ValueError(f"case '{case.name}': the closed form assumes no regeneration and no auxiliary power")
+    if train.regen_efficiency != 0.0 and (train.regen_min_speed_kmh != 0.0 or train.regen_max_force_kn is not None
+                                          or train.regen_max_power_kw is not None):
+        raise ValueError(f"case '{case.name}': the closed form with regeneration assumes that all braking "
+                         "regenerates (no regen caps, no cut-off speed)")
 
 
 def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
     """The optimal traction-hold-coast-brake run of a level-track case taking ``running_time_s``.
 
     The hold speed stays below every speed limit (``lambda`` is searched only up to the limit); the
-    train's acceleration and deceleration caps are honoured. Raises ``ValueError`` when the
-    case is not level, or when no hold speed fits the time.
+    train's acceleration and deceleration caps, regenerative braking (all braking electric), the
+    auxiliary power and the boundary speeds are honoured. Raises ``ValueError`` when the case is not
+    level, or when no hold speed fits the time.
     """
     _check_flat(case)
     train = case.train
     m = train.effective_mass_kg
     a, b, c = train.resistance.coefficients_si(train.mass_kg)
     eta = train.traction_efficiency
+    eta_b = train.regen_efficiency
+    aux = train.aux_power_kw * 1000.0
+    v_start, v_end = case.initial_speed_ms, case.final_speed_ms
     a_max = train.max_accel_ms2 if train.max_accel_ms2 is not None else math.inf
     d_max = train.max_decel_ms2 if train.max_decel_ms2 is not None else math.inf
     length = case.line.length_m
@@ -76,21 +86,28 @@ def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
         f = float(train.braking.force_kn(v * 3.6)[0]) * 1000.0
         return min(f, m * d_max - resist(v))
 
+    def brake_speed(hold, price):
+        # (price / W + eta_b R(W)) falls from +inf to below its value at V on (0, V]
+        rhs = resist(hold) / eta + price / hold
+        return brentq(lambda w: price / w + eta_b * resist(w) - rhs, 1e-9 * hold, hold, xtol=1e-14, rtol=1e-15)
+
     def phases(lam):
-        # hold speed from lambda = V^2 R'(V) / eta (increasing in V)
-        hold = brentq(lambda v: v * v * (b + 2 * c * v) / eta - lam, 1e-9, 10 * limit)
-        brake = 1.0 / (1.0 / hold + resist(hold) / (eta * lam))
+        price = lam + aux
+        # hold speed from lambda + P_aux = V^2 R'(V) / eta (increasing in V)
+        hold = brentq(lambda v: v * v * (b + 2 * c * v) / eta - price, 1e-9, 10 * limit)
+        brake = brake_speed(hold, price)
         opts = {"limit": 200, "epsabs": 0.0, "epsrel": 1e-11}
-        s_a = quad(lambda v: m * v / (traction(v) - resist(v)), 0.0, hold, **opts)[0]
-        t_a = quad(lambda v: m / (traction(v) - resist(v)), 0.0, hold, **opts)[0]
-        e_a = quad(lambda v: traction(v) * m * v / (traction(v) - resist(v)), 0.0, hold, **opts)[0] / eta
+        s_a = quad(lambda v: m * v / (traction(v) - resist(v)), v_start, hold, **opts)[0]
+        t_a = quad(lambda v: m / (traction(v) - resist(v)), v_start, hold, **opts)[0]
+        e_a = quad(lambda v: traction(v) * m * v / (traction(v) - resist(v)), v_start, hold, **opts)[0] / eta
         s_c = quad(lambda v: m * v / resist(v), brake, hold, **opts)[0]
         t_c = quad(lambda v: m / resist(v), brake, hold, **opts)[0]
-        s_b = quad(lambda v: m * v / (braking(v) + resist(v)), 0.0, brake, **opts)[0]
-        t_b = quad(lambda v: m / (braking(v) + resist(v)), 0.0, brake, **opts)[0]
+        s_b = quad(lambda v: m * v / (braking(v) + resist(v)), v_end, brake, **opts)[0]
+        t_b = quad(lambda v: m / (braking(v) + resist(v)), v_end, brake, **opts)[0]
+        e_b = quad(lambda v: braking(v) * m * v / (braking(v) + resist(v)), v_end, brake, **opts)[0] * eta_b
         s_h = length - s_a - s_c - s_b
         t = t_a + s_h / hold + t_c + t_b
-        e = e_a + resist(hold) * s_h / eta
+        e = e_a + resist(hold) * s_h / eta - e_b + aux * t
         return hold, brake, s_a, s_h, s_c, t, e
 
     def time_gap(log_lam):
@@ -98,7 +115,7 @@ def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
 
     # lambda from a crawl (1 W) up to the hold speed at the lowest limit, and a hold length >= 0
     lo = math.log(1.0)
-    hi = math.log(limit * limit * (b + 2 * c * limit) / eta)
+    hi = math.log(max(limit * limit * (b + 2 * c * limit) / eta - aux, 2.0))
     if phases(math.exp(hi))[3] < 0.0:
         hi = brentq(lambda x: phases(math.exp(x))[3], lo, hi, xtol=1e-12)
     if not time_gap(lo) > 0.0 > time_gap(hi):
@@ -112,11 +129,14 @@ def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
 
 
 def no_resistance_optimum(case: Case, running_time_s: float) -> tuple[float, float]:
-    """Level track, no resistance, constant forces: accelerate to V, coast, brake.
+    """Level track, no resistance, constant forces, no regeneration: accelerate to V, coast, brake.
 
     Returns ``(V m/s, energy kWh)`` with ``T = V / a + V / d + (L - V^2 / 2a - V^2 / 2d) / V``.
     """
     _check_flat(case)
+    if case.train.regen_efficiency or case.train.aux_power_kw or case.initial_speed_ms or case.final_speed_ms:
+        raise ValueError(f"case '{case.name}': this closed form assumes no regeneration, no auxiliary power "
+                         "and a run from rest to rest")
     train = case.train
     m = train.effective_mass_kg
     acc = float(train.traction.force_kn(0.0)[0]) * 1000.0 / m

@@ -26,6 +26,7 @@ from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim.kernel import (
     MODE_COAST,
     MODE_HOLD,
+    MODE_HOLD_BRAKE,
     MODE_TOWARD,
     MODE_TRACTION,
     OUT_NET_KWH,
@@ -38,6 +39,10 @@ DEFAULT_MAX_TARGETS = 16
 DEFAULT_TIME_TOL_S = 0.05
 DEFAULT_TOP_BIAS = 0.5
 MAX_TIME_ERROR_S = 0.5
+# Once solves on both sides of the requested time are this close to it, the search stops and moves
+# the last switch of the closer run instead (second-order error: E'' dT^2 / 2, far below 1e-4 kWh)
+ADJUST_WITHIN_S = 0.5
+ADJUST_NEAR_S = 0.25  # ... or once one of them is this close
 DEFAULT_TIE_J = 100.0
 LAMBDA_MIN_W = 1.0e2
 LAMBDA_MAX_W = 1.0e10
@@ -92,11 +97,18 @@ class OptimalSolver:
         Controls within this many joules of the best count as tied, and the forward run then keeps
         its regime: it removes chattering between coasting and partial traction at a measured cost
         below 0.02 % (``docs/optimal.md``).
+    certify : bool
+        Give every run an error bound (``summary["energy_bound_kwh"]``, see :meth:`energy_bound_kwh`);
+        costs a second solve on a speed grid of half the nodes.
+    price_shape : array (n_cells,), optional
+        Relative price of time per grid cell, scaled by the ``lambda`` search: a journey's timing
+        points give each stretch between them its own price (:meth:`set_price_shape`).
     """
 
     def __init__(self, case: Case, dx_m: float | None = None, n_speeds: int = DEFAULT_N_SPEEDS,
                  max_targets: int = DEFAULT_MAX_TARGETS, time_tol_s: float = DEFAULT_TIME_TOL_S,
-                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J):
+                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J, certify: bool = True,
+                 price_shape: np.ndarray | None = None):
         if isinstance(n_speeds, bool) or not isinstance(n_speeds, (int, np.integer)) or n_speeds < 3:
             raise ValueError(f"n_speeds = {n_speeds!r}: must be an integer >= 3")
         if isinstance(max_targets, bool) or not isinstance(max_targets, (int, np.integer)) or max_targets < 1:
@@ -116,6 +128,27 @@ class OptimalSolver:
         self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
         self._min_time_s: float | None = None
         self.n_solves = 0  # DP solves so far (for benchmarks)
+        self.certify = bool(certify)
+        self._coarse: OptimalSolver | None = None
+        self._history: list[_Solve] = []  # every solve so far: time depends on lambda alone
+        self.price_shape: np.ndarray | None = None
+        self.set_price_shape(price_shape)
+
+    def set_price_shape(self, price_shape: np.ndarray | None) -> None:
+        """Price time per cell as ``lambda x price_shape`` (None: one price everywhere).
+
+        Earlier solves were made at another shape, so they no longer guide the ``lambda`` search.
+        """
+        if price_shape is not None:
+            shape = np.asarray(price_shape, dtype=float)
+            n_cells = self.simulator.grid.n_nodes - 1
+            if shape.shape != (n_cells,) or not np.all(np.isfinite(shape) & (shape > 0)):
+                raise ValueError(f"price_shape: needs {n_cells} finite values > 0, one per cell")
+            price_shape = shape
+        self.price_shape = price_shape
+        self._history = []
+        if self._coarse is not None:
+            self._coarse.set_price_shape(price_shape)
 
     @property
     def dx_m(self) -> float:
@@ -132,9 +165,12 @@ class OptimalSolver:
         if self._tables is None:
             self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
         self.n_solves += 1
-        run = dp.solve(self.simulator.model, self._tables, lambda_w, self.max_targets, self.top_bias, self.tie_j,
+        prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
+        run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, self.tie_j,
                        self._value)
-        return self._record(lambda_w, run)
+        solution = self._record(lambda_w, run)
+        self._history.append(solution)
+        return solution
 
     def _record(self, lambda_w: float, run: tuple) -> _Solve:
         modes, targets, speeds, done, energy, time = run
@@ -159,13 +195,14 @@ class OptimalSolver:
         """
         program = solution.program
         modes = program[:, 1]
-        powered = np.flatnonzero((modes == MODE_TRACTION) | (modes == MODE_HOLD) | (modes == MODE_TOWARD))
+        powered = np.flatnonzero((modes == MODE_TRACTION) | (modes == MODE_HOLD) | (modes == MODE_HOLD_BRAKE)
+                                 | (modes == MODE_TOWARD))
         if powered.size == 0:
             return None
         last = int(powered[-1])
         n_cells = program.shape[0]
         if solution.time_s > target:  # extend: hold the speed reached (or keep pulling)
-            mode = MODE_TRACTION if modes[last] == MODE_TRACTION else MODE_HOLD
+            mode = MODE_TRACTION if modes[last] == MODE_TRACTION else MODE_HOLD_BRAKE
             slow_end, fast_end = 0, n_cells - 1 - last
 
             def moved(j):
@@ -200,23 +237,61 @@ class OptimalSolver:
         p, energy, time = min((runs[lo], runs[hi]), key=lambda r: abs(r[2] - target))
         return _Solve(solution.lambda_w, p, None, energy, time, solution.value_j)
 
+    def _cold_guess_w(self, target: float) -> float:
+        """A first price of time: the level-track hold condition ``V^2 R'(V) / eta`` at 1.1 x the mean speed."""
+        train = self.case.train
+        _, b, c = train.resistance.coefficients_si(train.mass_kg)
+        v = 1.1 * self.case.line.length_m / target
+        return v * v * (b + 2.0 * c * v) / train.traction_efficiency - train.aux_power_kw * 1000.0
+
+    def _bracket_from_history(self, target: float) -> tuple[_Solve | None, _Solve | None]:
+        """The closest earlier solves on either side of ``target`` (slow: above it, fast: below)."""
+        slow = [h for h in self._history if h.time_s > target]
+        fast = [h for h in self._history if h.time_s < target]
+        return (max(slow, key=lambda h: h.lambda_w) if slow else None,
+                min(fast, key=lambda h: h.lambda_w) if fast else None)
+
     def _search(self, running_time_s: float, lambda_guess_w: float | None) -> _Solve:
-        """Find ``lambda`` whose optimum takes ``running_time_s`` (within ``time_tol_s``)."""
+        """Find ``lambda`` whose optimum takes ``running_time_s`` (within ``time_tol_s``).
+
+        Every solve of this solver is remembered: the running time depends on ``lambda`` alone,
+        so earlier solves (e.g. of a front's neighbouring points) bracket the new target, and the
+        search starts from the interpolated ``log lambda`` instead of a blind guess.
+        """
         target = running_time_s
         tol = self.time_tol_s
-        lam = lambda_guess_w if lambda_guess_w else 5.0e5
-        lam = min(max(lam, LAMBDA_MIN_W), LAMBDA_MAX_W)
-        first = self.solve_price(lam)
-        if abs(first.time_s - target) <= tol:
-            return first
-        # bracket: fast (time below target) at high lambda, slow at low lambda
+        for h in self._history:
+            if abs(h.time_s - target) <= tol:
+                return h
+        slow, fast = self._bracket_from_history(target)
+        if slow is not None and fast is not None and slow.lambda_w < fast.lambda_w:
+            return self._refine(slow, fast, target)
+        if self._history:  # one side known: step on from the earlier solve nearest the target
+            first = min(self._history, key=lambda h: abs(h.time_s - target))
+        else:
+            lam = lambda_guess_w if lambda_guess_w else self._cold_guess_w(target)
+            first = self.solve_price(min(max(lam, LAMBDA_MIN_W), LAMBDA_MAX_W))
+            if abs(first.time_s - target) <= tol:
+                return first
+        # bracket: fast (time below target) at high lambda, slow at low lambda; the step follows
+        # the local slope d(time)/d(log lambda) of the two latest solves when there are two
         fast = slow = None
+
+        def step(a: _Solve) -> float:
+            others = [h for h in self._history if h is not a and h.lambda_w != a.lambda_w]
+            if others:
+                b = min(others, key=lambda h: abs(math.log(h.lambda_w / a.lambda_w)))
+                slope = (a.time_s - b.time_s) / math.log(a.lambda_w / b.lambda_w)
+                if slope < 0.0:
+                    return min(max(1.5 * abs((a.time_s - target) / slope), 0.05), math.log(8.0))
+            return math.log(2.0)  # no slope known yet: a modest step (8x overshoots by far)
+
         if first.time_s > target:
             slow = first
             while fast is None:
                 if slow.lambda_w >= LAMBDA_MAX_W:
                     return self._closest(slow, None, target, "fast")
-                s = self.solve_price(min(slow.lambda_w * 8.0, LAMBDA_MAX_W))
+                s = self.solve_price(min(slow.lambda_w * math.exp(step(slow)), LAMBDA_MAX_W))
                 if abs(s.time_s - target) <= tol:
                     return s
                 if s.time_s > target:
@@ -228,34 +303,54 @@ class OptimalSolver:
             while slow is None:
                 if fast.lambda_w <= LAMBDA_MIN_W:
                     return self._closest(None, fast, target, "slow")
-                s = self.solve_price(max(fast.lambda_w / 8.0, LAMBDA_MIN_W))
+                s = self.solve_price(max(fast.lambda_w / math.exp(step(fast)), LAMBDA_MIN_W))
                 if abs(s.time_s - target) <= tol:
                     return s
                 if s.time_s < target:
                     fast = s
                 else:
                     slow = s
+        return self._refine(slow, fast, target)
+
+    def _refine(self, slow: _Solve, fast: _Solve, target: float) -> _Solve:
+        """Illinois regula falsi on ``log lambda`` inside a bracket (slow: too slow, fast: too fast)."""
+        tol = self.time_tol_s
         # Illinois regula falsi on log(lambda)
         side = 0
-        f_fast, f_slow = fast.time_s - target, slow.time_s - target
+        # the secant works on log(T - T_min) against log(lambda), close to a straight line (the
+        # running time above the minimum falls like a power of the price of time)
+        t_min = self.min_running_time_s() - 1e-6 * target
+
+        def g(t):
+            return math.log(max(t - t_min, 1e-12)) - math.log(max(target - t_min, 1e-12))
+
+        f_fast, f_slow = g(fast.time_s), g(slow.time_s)
+        f_fast_true, f_slow_true = fast.time_s - target, slow.time_s - target  # (Illinois halves f_*)
         lo, hi = math.log(slow.lambda_w), math.log(fast.lambda_w)
+        repeats = 0
         for _ in range(40):
-            if hi - lo < 1e-4:  # a jump of the discrete optimum: lambda cannot hit the time closer
+            if (hi - lo < 1e-4 or repeats >= 2 or max(f_slow_true, -f_fast_true) <= ADJUST_WITHIN_S
+                    or min(f_slow_true, -f_fast_true) <= ADJUST_NEAR_S):
+                # a jump of the discrete optimum, or close enough on both sides: moving the last
+                # switch of the closer run (``_adjust``, simulations only) meets the time
                 break
             x = hi - f_fast * (hi - lo) / (f_fast - f_slow)
             if not (lo < x < hi):
                 x = 0.5 * (lo + hi)
             s = self.solve_price(math.exp(x))
-            f = s.time_s - target
-            if abs(f) <= tol:
+            if abs(s.time_s - target) <= tol:
                 return s
-            if f > 0.0:
-                slow, lo, f_slow = s, x, f
+            f = g(s.time_s)
+            # the same run as the end it replaces: the optimum is constant on this side of a jump
+            same = slow if s.time_s > target else fast
+            repeats = repeats + 1 if abs(s.time_s - same.time_s) <= 1e-9 * target else 0
+            if s.time_s > target:
+                slow, lo, f_slow, f_slow_true = s, x, f, s.time_s - target
                 if side == -1:
                     f_fast *= 0.5
                 side = -1
             else:
-                fast, hi, f_fast = s, x, f
+                fast, hi, f_fast, f_fast_true = s, x, f, s.time_s - target
                 if side == 1:
                     f_slow *= 0.5
                 side = 1
@@ -279,6 +374,31 @@ class OptimalSolver:
                 raise ValueError(f"running_time_s = {target}: longer than the slowest run the speed grid represents "
                                  f"({best.time_s:.1f} s at lambda = {best.lambda_w:.3g} W)")
         return best
+
+    def energy_bound_kwh(self, solution: _Solve) -> float:
+        """Bound on the run's energy above the optimum at its running time (kWh, >= 0).
+
+        The two-grid estimate: the same run solved on a speed grid of half the nodes (same position
+        grid, same controls), moved to this run's time along the front's slope ``lambda``, differs
+        from this run by ``delta``. If the error of the DP falls at least linearly with the node
+        spacing (measured: it does, ``docs/optimal.md``), the error of the finer solve is at most
+        ``|delta|``. The optimum meant is that of the simulator's model on this position grid,
+        the model every optimiser's run is evaluated with.
+        """
+        if self._coarse is None:
+            self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
+                                         self.time_tol_s, self.top_bias, self.tie_j, certify=False,
+                                         price_shape=self.price_shape)
+            self._coarse.simulator = self.simulator  # same grid and model: share them
+            self._coarse._min_time_s = self._min_time_s
+        coarse = self._coarse
+        try:
+            other = coarse._search(solution.time_s, solution.lambda_w)
+        except ValueError:  # the coarse grid cannot reach that time: its closest run at the same price
+            other = coarse.solve_price(solution.lambda_w)
+        slope_w = 0.5 * (solution.lambda_w + other.lambda_w)
+        moved_j = other.energy_j + slope_w * (other.time_s - solution.time_s)
+        return abs(moved_j - solution.energy_j) / _J_PER_KWH
 
     def trajectory(self, solution: _Solve) -> Trajectory:
         """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
@@ -312,9 +432,12 @@ class OptimalSolver:
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
                                    f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
-                                  self.top_bias, self.tie_j)
+                                  self.top_bias, self.tie_j, self.certify, self.price_shape)
             return finer.profile(running_time_s, solution.lambda_w)
-        return self.trajectory(solution)
+        tr = self.trajectory(solution)
+        if self.certify:
+            tr = replace(tr, summary=dict(tr.summary, energy_bound_kwh=self.energy_bound_kwh(solution)))
+        return tr
 
 
 def min_running_time(case: Case, dx_m: float | None = None) -> float:
@@ -338,15 +461,16 @@ def optimal_profile(case: Case, running_time_s: float, **settings) -> Trajectory
         Requested running time; at least :func:`min_running_time`.
     **settings
         Grid and search settings of :class:`OptimalSolver` (``dx_m``, ``n_speeds``, ``max_targets``,
-        ``time_tol_s``, ``top_bias``, ``tie_j``); the defaults are within 0.5 % of the exact optimum
-        (``docs/optimal.md``).
+        ``time_tol_s``, ``top_bias``, ``tie_j``, ``certify``); the accuracy the defaults reach is
+        measured in ``docs/optimal.md``, and every run carries its own bound.
 
     Returns
     -------
     Trajectory
         With ``running_time_s`` within ``time_tol_s`` of the request when the discrete optimum allows
         it, never more than 0.5 s off; ``summary["lambda_w"]`` is the price of time (W) at which it
-        is optimal.
+        is optimal; ``summary["energy_bound_kwh"]`` bounds its energy above the optimum at its
+        running time (:meth:`OptimalSolver.energy_bound_kwh`; absent with ``certify=False``).
 
     Raises
     ------
@@ -375,8 +499,10 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
         One row per requested time, sorted by time: ``running_time_s`` (of the run found) and
         ``energy_kwh`` (net) of the simulated optimal run, ``requested_time_s``, ``traction_kwh``,
         ``regen_kwh``, ``aux_kwh``, ``lambda_kwh_per_s`` (the front's slope ``-dE/dT``: the energy
-        one more second saves) and ``energy_at_request_kwh`` (the energy moved along that slope to
-        the requested time, to first order).
+        one more second saves), ``energy_at_request_kwh`` (the energy moved along that slope to
+        the requested time, to first order) and ``energy_bound_kwh``: a bound on ``energy_kwh``
+        minus the optimum at ``running_time_s`` (kWh, >= 0; :meth:`OptimalSolver.energy_bound_kwh`;
+        NaN with ``certify=False``).
     """
     times = np.atleast_1d(np.asarray(running_times, dtype=float))
     if times.ndim != 1 or times.size == 0:
@@ -394,5 +520,6 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
         rows.append({"running_time_s": tr.running_time_s, "energy_kwh": e.net_kwh, "requested_time_s": float(t),
                      "traction_kwh": e.traction_kwh, "regen_kwh": e.regen_kwh, "aux_kwh": e.aux_kwh,
                      "lambda_kwh_per_s": slope,
-                     "energy_at_request_kwh": e.net_kwh + slope * (tr.running_time_s - float(t))})
+                     "energy_at_request_kwh": e.net_kwh + slope * (tr.running_time_s - float(t)),
+                     "energy_bound_kwh": tr.summary.get("energy_bound_kwh", math.nan)})
     return pd.DataFrame(rows)

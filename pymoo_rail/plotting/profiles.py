@@ -41,6 +41,7 @@ def as_trace(run) -> Trace:
             raise ValueError(f"trajectory table lacks column(s) {missing} (has {list(run.columns)})")
         regime = run["regime"].to_numpy()
         if regime.dtype.kind in "OUS":
+            regime = np.where(regime == "cruise", "hold", regime)  # tables written before "hold"
             unknown = sorted(set(regime) - set(REGIME_NAMES))
             if unknown:
                 raise ValueError(f"trajectory table: regime {unknown[0]!r} is unknown (known: {REGIME_NAMES})")
@@ -128,7 +129,7 @@ def _gradient_panel(ax, line) -> None:
 
 
 def plot_speed_profile(run, case=None, label: str | None = None, others: Sequence = (), other_labels=None,
-                       title: str | None = None, show_line_limits: bool = True):
+                       title: str | None = None, show_line_limits: bool = True, other_linestyle: str = "-"):
     """Speed against distance, coloured by regime, over the line.
 
     Parameters
@@ -142,6 +143,9 @@ def plot_speed_profile(run, case=None, label: str | None = None, others: Sequenc
     others : sequence of runs, optional
         Further runs drawn as thin grey lines for comparison (e.g. the optimal profile).
     title : str, optional
+    show_line_limits : bool
+    other_linestyle : str
+        Matplotlib line style of ``others`` (e.g. ``"--"`` for the optimal profile).
 
     Returns
     -------
@@ -167,7 +171,8 @@ def plot_speed_profile(run, case=None, label: str | None = None, others: Sequenc
     other_labels = list(other_labels) if other_labels is not None else [f"run {i + 2}" for i in range(len(others))]
     for other, other_label in zip(others, other_labels):
         o = as_trace(other)
-        (h,) = ax.plot(o.position_m, o.speed_kmh, color="0.4", lw=1.0, label=other_label, zorder=2)
+        (h,) = ax.plot(o.position_m, o.speed_kmh, color="0.4", lw=1.0, ls=other_linestyle, label=other_label,
+                       zorder=2)
         extra.append(h)
     _regime_line(ax, trace.position_m, trace.speed_kmh, trace.regime)
     top = max(np.nanmax(trace.speed_kmh), np.nanmax(trace.limit_kmh) if trace.limit_kmh is not None else 0.0)

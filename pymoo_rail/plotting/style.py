@@ -12,7 +12,8 @@ OBJECTIVE_LABELS = {
     "energy": "energy (kWh)",
     "running_time": "running time (s)",
     "time_error": "time error |T - T_plan| (s)",
-    "jerk": "jerk, total variation of acceleration (m/s²)",
+    "accel_variation": "total variation of acceleration (m/s²)",
+    "jerk": "jerk: total variation of acceleration (m/s²)",
     "stop_error": "stop error (m)",
 }
 INDICATOR_LABELS = {
@@ -21,7 +22,7 @@ INDICATOR_LABELS = {
     "energy_gap": "energy gap to the optimum (kWh)", "igd_ref": "IGD to the study's reference front",
     "gd_ref": "GD to the study's reference front", "hv_ref": "hypervolume (study reference, normalised)",
 }
-REGIME_NAMES = ("traction", "cruise", "coast", "brake")
+REGIME_NAMES = ("traction", "hold", "coast", "brake")
 REGIME_COLORS = ("tab:red", "tab:blue", "tab:green", "tab:orange")
 LIMIT_COLOR = "black"
 NEUTRAL_COLOR = "gold"

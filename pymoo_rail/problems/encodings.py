@@ -2,27 +2,59 @@
 
 An encoding turns a population of decision vectors into kernel programs. Two families:
 
-- ``SpeedCodes``: one target speed (km/h) per section of a partition of the line (seed 000
+- ``SpeedCodes``: one target speed (km/h) per section of a partition of the line (Liu (2019)
   4.3.3): ``"gradient_limit"`` cuts at every gradient, limit and neutral-section change (the
-  non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``;
+  non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``
+  (by default 1 km on long sparse lines, whose sections average more than 2 km);
   ``"equal"`` cuts ``n_sections`` equal pieces (fig. 4-3). Bounds run from a floor to the highest
   limit in the section; sections inside a neutral section are fixed at the floor (coasting).
-- ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (seeds 002/003),
+- ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (Meng et al. (2017) and Tang et al. (2020)),
   by default ``traction, hold, coast`` per speed-limit zone and a final ``brake``.
+- ``BrakingOnset``: the phases of Meng et al. (2017) (traction, cruise, coast) with the braking
+  onset position and the braking deceleration as decisions. The train brakes at that
+  deceleration and stops where the physics puts it, short of the platform or past it in an
+  overrun zone, so the stop error is a consequence of the decision (with the other encodings the
+  kernel lands every run exactly on the platform and the stop error is always 0).
+
+Speed codes can be integers (``integer=True``: whole km/h, as the on-board codes of Liu (2019)),
+for pymoo's integer operators.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pymoo_rail.model import Case
-from pymoo_rail.sim import equal_partition, gradient_limit_partition, speed_code_programs, switching_programs
-from pymoo_rail.sim.pacing import split_long_sections
+from pymoo_rail.model import Case, Line
+from pymoo_rail.sim import (
+    Simulator,
+    Trajectory,
+    braking_programs,
+    equal_partition,
+    gradient_limit_partition,
+    speed_code_programs,
+    switching_programs,
+)
+from pymoo_rail.sim import kernel as k
 
 KMH_PER_MS = 3.6
 PARTITIONS = ("gradient_limit", "equal")
+# Long sparse lines: a gradient/limit partition whose sections average more than this is cut into
+# sections of at most SPARSE_MAX_SECTION_M unless max_section_m is given (the 48.5 km TTOBench
+# reference would otherwise be one variable: one cruise speed, no coasting).
+SPARSE_MEAN_SECTION_M = 2000.0
+SPARSE_MAX_SECTION_M = 1000.0
+
+
+def _split_long(boundaries: np.ndarray, max_section_m: float | None) -> np.ndarray:
+    if max_section_m is None:
+        return boundaries
+    out = [boundaries[0]]
+    for a, b in zip(boundaries[:-1], boundaries[1:]):
+        pieces = int(np.ceil((b - a) / max_section_m - 1e-9))
+        out.extend(np.linspace(a, b, pieces + 1)[1:])
+    return np.asarray(out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -32,18 +64,33 @@ class SpeedCodes:
     boundaries_m: np.ndarray
     xl: np.ndarray
     xu: np.ndarray
+    integer: bool = False
 
     name = "speed_codes"
+    # every run lands on the platform through the braking envelope
+    constant_objectives = ("stop_error",)
+
+    @property
+    def vtype(self) -> type:
+        """pymoo's variable type: ``int`` for whole-km/h codes."""
+        return int if self.integer else float
 
     @classmethod
     def build(cls, case: Case, partition: str = "gradient_limit", n_sections: int | None = None,
-              max_section_m: float | None = None, floor_kmh: float = 10.0) -> SpeedCodes:
+              max_section_m: float | None = None, floor_kmh: float = 10.0, integer: bool = False) -> SpeedCodes:
+        """Partition the line and bound each code by the limits of its section.
+
+        With ``integer=True`` the codes are whole km/h: the floor rounds up and each section's
+        upper bound rounds down (never above its limit).
+        """
         line = case.line
         if partition == "gradient_limit":
             bounds = gradient_limit_partition(line)
             neutral_points = [p for row in line.neutral_sections for p in row]
             bounds = np.unique(np.concatenate([bounds, neutral_points]))
-            bounds = split_long_sections(bounds, max_section_m)
+            if max_section_m is None and (bounds[-1] - bounds[0]) / (bounds.shape[0] - 1) > SPARSE_MEAN_SECTION_M:
+                max_section_m = SPARSE_MAX_SECTION_M
+            bounds = _split_long(bounds, max_section_m)
         elif partition == "equal":
             bounds = equal_partition(line, n_sections if n_sections is not None else 10)
         else:
@@ -58,7 +105,13 @@ class SpeedCodes:
         for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
             if any(s <= a and b <= e for s, e in line.neutral_sections):
                 xu[k] = xl[k]  # no traction there: the gene cannot matter, so it is fixed
-        return cls(boundaries_m=bounds, xl=xl, xu=xu)
+        if integer:
+            xl, xu = np.ceil(xl - 1e-9), np.floor(xu + 1e-9)
+            if np.any(xl > xu):
+                k = int(np.argmax(xl > xu))
+                raise ValueError(f"floor_kmh = {floor_kmh!r}: section {k} has no whole km/h code "
+                                 f"between {xl[k]} and {xu[k]}")
+        return cls(boundaries_m=bounds, xl=xl, xu=xu, integer=bool(integer))
 
     @property
     def n_var(self) -> int:
@@ -70,6 +123,10 @@ class SpeedCodes:
         if negative.size:  # reported in km/h, the unit it was given in
             idx = tuple(int(i) for i in negative[0])
             raise ValueError(f"speed_codes{list(idx)} = {float(X[idx])} km/h: speed codes must be >= 0 km/h")
+        if self.integer and np.isfinite(X).all() and np.any(X != np.round(X)):
+            idx = tuple(int(i) for i in np.argwhere(X != np.round(X))[0])
+            raise ValueError(f"speed_codes{list(idx)} = {float(X[idx])}: integer codes must be whole km/h "
+                             "(use pymoo's integer operators or RoundingRepair)")
         return speed_code_programs(self.boundaries_m, X / KMH_PER_MS)
 
     def fixed(self) -> np.ndarray:
@@ -87,6 +144,8 @@ class SwitchingPoints:
     xu: np.ndarray
 
     name = "switching_points"
+    constant_objectives = ()
+    vtype = float
 
     @classmethod
     def build(cls, case: Case, regimes: tuple[str, ...] | None = None) -> SwitchingPoints:
@@ -115,4 +174,101 @@ class SwitchingPoints:
         return np.zeros(self.n_var, dtype=bool)
 
 
-ENCODINGS = ("speed_codes", "switching_points")
+def overrun_case(case: Case, overrun_m: float) -> Case:
+    """The case with its line continued ``overrun_m`` past the platform (last gradient and limit).
+
+    The simulated track of :class:`BrakingOnset`: a train that brakes too gently stops in it.
+    """
+    if not (np.isfinite(overrun_m) and overrun_m > 0):
+        raise ValueError(f"overrun_m = {overrun_m!r} must be a positive number")
+    line = case.line
+    end = float(line.length_m) + float(overrun_m)
+
+    def stretch(rows):
+        rows = [list(r) for r in rows]
+        rows[-1][1] = end
+        return tuple(tuple(r) for r in rows)
+
+    longer = Line(length_m=end, gradients=stretch(line.gradients), speed_limits=stretch(line.speed_limits),
+                  curves=line.curves, tunnels=line.tunnels, neutral_sections=line.neutral_sections,
+                  gradient_model=line.gradient_model)
+    return replace(case, line=longer, legs=())
+
+
+@dataclass(frozen=True, eq=False)
+class BrakingOnset:
+    """Phases before braking, the braking onset (m) and the braking deceleration (m/s^2).
+
+    Decision vector: ``len(regimes) - 1`` switching positions between the regimes run before
+    braking, then the braking onset (all sorted together, so the onset is the largest), then the
+    service deceleration. The train is simulated on the line continued ``overrun_m`` past the
+    platform (:func:`overrun_case`): from the onset it brakes at that deceleration and stops where
+    it stops; the stop error is its distance to the platform, either way. The braking envelope of
+    every speed limit still holds over the whole train (a limit ahead brakes the train harder than
+    asked); a train that would run beyond the overrun zone is stopped at its end by the envelope
+    (stop error ``overrun_m``).
+    """
+
+    regimes: tuple[str, ...]
+    platform_m: float
+    overrun_m: float
+    simulator: Simulator
+    xl: np.ndarray
+    xu: np.ndarray
+
+    name = "braking_onset"
+    constant_objectives = ()
+    vtype = float
+
+    @classmethod
+    def build(cls, case: Case, regimes: tuple[str, ...] | None = None,
+              decel_range_ms2: tuple[float, float] | None = None, overrun_m: float = 20.0,
+              dx_m: float | None = None) -> BrakingOnset:
+        """Bounds: positions in [0, platform]; deceleration in ``decel_range_ms2``.
+
+        The default deceleration range is [0.5, d_max] m/s^2 with d_max the train's service
+        deceleration cap (``max_decel_ms2``, 1.0 when the case gives none).
+        """
+        regimes = ("traction", "hold", "coast") if regimes is None else tuple(regimes)
+        if not regimes:
+            raise ValueError("regimes = (): at least one regime must run before braking")
+        if decel_range_ms2 is None:
+            d_max = case.train.max_decel_ms2 if case.train.max_decel_ms2 is not None else 1.0
+            decel_range_ms2 = (min(0.5, d_max), d_max)
+        lo, hi = (float(v) for v in decel_range_ms2)
+        if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi):
+            raise ValueError(f"decel_range_ms2 = {decel_range_ms2!r}: need 0 < low <= high")
+        platform = float(case.line.length_m)
+        simulator = Simulator(overrun_case(case, overrun_m), dx_m)
+        n_pos = len(regimes)
+        xl = np.concatenate([np.zeros(n_pos), [lo]])
+        xu = np.concatenate([np.full(n_pos, platform), [hi]])
+        return cls(regimes=regimes, platform_m=platform, overrun_m=float(overrun_m), simulator=simulator,
+                   xl=xl, xu=xu)
+
+    @property
+    def n_var(self) -> int:
+        return self.xl.shape[0]
+
+    def programs(self, X: np.ndarray) -> np.ndarray:
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        return braking_programs(X[:, :-1], self.regimes, X[:, -1], self.simulator.length_m)
+
+    def fixed(self) -> np.ndarray:
+        return np.zeros(self.n_var, dtype=bool)
+
+    def run_batch(self, programs: np.ndarray) -> np.ndarray:
+        """Summaries with the stop error measured from the platform (short or past it)."""
+        s = self.simulator.run_batch(programs)
+        s[:, k.OUT_STOP_ERROR_M] = np.abs(s[:, k.OUT_STOP_POSITION_M] - self.platform_m)
+        return s
+
+    def run(self, program: np.ndarray) -> Trajectory:
+        """The trajectory of one program, stop error measured from the platform."""
+        tr = self.simulator.run(program)
+        stop = tr.summary["stop_position_m"]
+        error = abs(stop - self.platform_m)
+        return replace(tr, stop_error_m=error, summary={**tr.summary, "stop_error_m": error})
+
+
+ENCODINGS = ("speed_codes", "switching_points", "braking_onset")

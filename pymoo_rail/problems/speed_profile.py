@@ -1,19 +1,29 @@
-"""The single-train speed-profile problem (seed 000 chapter 4, seed 002 section 1, seed 003 section 2)."""
+"""The single-train speed-profile problem (Liu (2019) chapter 4, Meng et al. (2017) section 1, Tang et al. (2020) section 2)."""
 
 from __future__ import annotations
 
+import warnings
 from typing import Sequence
 
 import numpy as np
 from pymoo.core.problem import Problem
 
 from pymoo_rail.model import Case
-from pymoo_rail.problems.encodings import ENCODINGS, SpeedCodes, SwitchingPoints
+from pymoo_rail.problems.encodings import ENCODINGS, BrakingOnset, SpeedCodes, SwitchingPoints
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 
-OBJECTIVES = ("energy", "running_time", "time_error", "jerk", "stop_error")
-DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m"}
+OBJECTIVES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
+# "jerk" is the name Meng et al. (2017) give their comfort figure, sum |a_i - a_(i-1)| (m/s^2): a total
+# variation of acceleration, not a rate of change (m/s^3). "accel_variation" says what it is; "jerk"
+# stays as an alias of the same objective.
+OBJECTIVE_ALIASES = {"jerk": "accel_variation"}
+
+
+def canonical_objective(name: str) -> str:
+    """The objective a name stands for (``"jerk"`` -> ``"accel_variation"``; others unchanged)."""
+    return OBJECTIVE_ALIASES.get(name, name)
+DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m", "braking_onset": "m (last: m/s^2)"}
 
 
 class DecisionError(ValueError):
@@ -30,16 +40,18 @@ def check_decisions(X: np.ndarray, xl: np.ndarray, xu: np.ndarray, unit: str = "
     if X.ndim != 2 or X.shape[1] != xl.shape[0]:
         raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {xl.shape[0]}")
     unit = f" {unit}" if unit else ""
-    for bad, what in ((~np.isfinite(X), "is not a finite number"), ((X < xl) | (X > xu), "is outside its bounds")):
-        rows = np.flatnonzero(bad.any(axis=1))
-        if rows.size:
-            r = int(rows[0])
-            j = int(np.flatnonzero(bad[r])[0])
-            listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
-            raise DecisionError(
-                f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
-                f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
-                "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(X) | (X < xl) | (X > xu)
+    rows = np.flatnonzero(bad.any(axis=1))
+    if rows.size:
+        r = int(rows[0])
+        j = int(np.flatnonzero(bad[r])[0])
+        what = "is not a finite number" if not np.isfinite(X[r, j]) else "is outside its bounds"
+        listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
+        raise DecisionError(
+            f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
+            f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
+            "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
     return X
 SEED_002_WEIGHTS = {"energy": 0.1, "jerk": 0.2, "stop_error": 0.4, "time_error": 0.3}
 
@@ -54,13 +66,26 @@ def objective_values(summaries: np.ndarray, names: Sequence[str], planned_time_s
             columns.append(summaries[:, k.OUT_RUNNING_TIME_S])
         elif name == "time_error":
             columns.append(np.abs(summaries[:, k.OUT_RUNNING_TIME_S] - planned_time_s))
-        elif name == "jerk":
+        elif canonical_objective(name) == "accel_variation":
             columns.append(summaries[:, k.OUT_JERK_MS2])
         elif name == "stop_error":
             columns.append(summaries[:, k.OUT_STOP_ERROR_M])
         else:
             raise ValueError(f"objective {name!r} is unknown (known: {', '.join(OBJECTIVES)})")
     return np.column_stack(columns)
+
+
+class ConstantObjectiveWarning(UserWarning):
+    """An objective cannot vary under the problem's encoding: its front axis is dead."""
+
+
+def warn_constant_objectives(objectives: Sequence[str], encoding) -> None:
+    """Warn, naming them, about objectives the encoding holds constant."""
+    dead = [name for name in objectives if name in encoding.constant_objectives]
+    if dead:
+        warnings.warn(f"objective(s) {', '.join(dead)} are constant under encoding '{encoding.name}' "
+                      "(every run stops exactly at the platform): use encoding='braking_onset' for a "
+                      "live stop error", ConstantObjectiveWarning, stacklevel=3)
 
 
 class SpeedProfileProblem(Problem):
@@ -71,28 +96,38 @@ class SpeedProfileProblem(Problem):
     case : Case
         Train, line and planned time (``load_case("yizhuang")``).
     objectives : sequence of str
-        Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (|T - T_plan| s,
-        seed 000 eq. 4-21), ``"jerk"`` (comfort: sum of |a_i - a_(i-1)|, seed 002 eq. 5, in m/s^2),
-        ``"stop_error"`` (m, seed 002 eq. 6). Several give the Pareto form; one with
-        ``time_tolerance_s`` gives the constrained form of seed 000 4.4; ``weights`` give the
-        weighted sum of seed 002 eq. 9.
-    encoding : {"speed_codes", "switching_points"}
-        Speed codes per section (km/h) or regime switching positions (m); see
-        :mod:`pymoo_rail.problems.encodings`.
+        Any of ``"energy"`` (net kWh), ``"running_time"`` (s), ``"time_error"`` (``|T - T_plan|`` s,
+        Liu (2019) eq. 4-21), ``"accel_variation"`` (comfort: total variation of the
+        acceleration, sum of ``|a_i - a_(i-1)|`` over the grid cells, m/s^2; Meng et al. (2017) eq. 5,
+        where it is called jerk: ``"jerk"`` is an alias of it, not a rate in m/s^3),
+        ``"stop_error"`` (m, Meng et al. (2017) eq. 6). Several give the Pareto form; one with
+        ``time_tolerance_s`` gives the constrained form of Liu (2019) 4.4; ``weights`` give the
+        weighted sum of Meng et al. (2017) eq. 9.
+    encoding : {"speed_codes", "switching_points", "braking_onset"}
+        Speed codes per section (km/h), regime switching positions (m), or the phases of
+        Meng et al. (2017) with the braking onset (m) and deceleration (m/s^2) as decisions (the
+        only one where the stop error varies without ``tracking``); see
+        :mod:`pymoo_rail.problems.encodings`. An objective that cannot vary under the chosen
+        encoding (the stop error of speed codes) triggers a ``ConstantObjectiveWarning``.
     partition : {"gradient_limit", "equal"}
-        Sections of the speed-code encoding (seed 000 figs. 4-4 and 4-3).
+        Sections of the speed-code encoding (Liu (2019) figs. 4-4 and 4-3).
     n_sections : int, optional
         Number of equal sections (``partition="equal"``, default 10).
     max_section_m : float, optional
         Split ``gradient_limit`` sections longer than this (finer control on long sections).
     time_tolerance_s : float, optional
         Adds the constraint ``|T - T_plan| <= time_tolerance_s``.
+    time_window_s : (float, float) or "default", optional
+        Adds the constraint ``lo <= T <= hi`` on the running time: keeps a Pareto front on the
+        times a timetable planner would use. ``"default"`` is
+        :func:`pymoo_rail.problems.reference.default_window` (0.5 % above the minimum running
+        time to 1.3 x the planned time), the range the certified front covers.
     weights : sequence of float, optional
         One weight per objective: minimise ``sum w_i f_i / scale_i`` (a single objective).
     scales : sequence of float, optional
         Normalisation of the weighted sum; by default the flat-out run's energy, 5 % of the planned
-        time (time error, seed 002's punctuality tolerance), the planned time (running time), the
-        flat-out run's jerk, and 0.25 m (stop error, seed 002's tolerance).
+        time (time error, Meng et al.'s (2017) punctuality tolerance), the planned time (running time), the
+        flat-out run's jerk, and 0.25 m (stop error, Meng et al.'s (2017) tolerance).
     stop_tolerance_m : float or None
         Constraint ``stop_error <= stop_tolerance_m`` (default 0.25 m); ``None`` drops it.
     regimes : sequence of str, optional
@@ -102,11 +137,16 @@ class SpeedProfileProblem(Problem):
     dx_m : float, optional
         Simulation grid step.
     tracking : Hysteresis, PID or FuzzyPID, optional
-        Score each decision by the run of this ATO controller tracking its ideal curve (seed 000
+        Score each decision by the run of this ATO controller tracking its ideal curve (Liu (2019)
         optimises the tracked curve, section 5.1.3) instead of the ideal run itself; see
         :mod:`pymoo_rail.control`. ``trajectory(x)`` then returns the tracked run.
     control_period_s : float
         Control period of ``tracking`` (default 0.2 s).
+    integer_codes : bool
+        Whole-km/h speed codes (``vtype=int``), for pymoo's integer operators (e.g.
+        ``IntegerRandomSampling``, ``SBX(repair=RoundingRepair(), vtype=float)``).
+    decel_range_ms2 : (float, float), optional
+        Bounds of the braking deceleration of ``encoding="braking_onset"``.
 
     Notes
     -----
@@ -128,7 +168,8 @@ class SpeedProfileProblem(Problem):
                  weights: Sequence[float] | None = None, scales: Sequence[float] | None = None,
                  stop_tolerance_m: float | None = 0.25, regimes: Sequence[str] | None = None,
                  floor_kmh: float = 10.0, dx_m: float | None = None, tracking=None,
-                 control_period_s: float = 0.2, **kwargs):
+                 control_period_s: float = 0.2, time_window_s=None, integer_codes: bool = False,
+                 decel_range_ms2: tuple[float, float] | None = None, **kwargs):
         if isinstance(objectives, str):
             objectives = (objectives,)
         objectives = tuple(objectives)
@@ -137,12 +178,18 @@ class SpeedProfileProblem(Problem):
         for name in objectives:
             if name not in OBJECTIVES:
                 raise ValueError(f"objective {name!r} is unknown (known: {', '.join(OBJECTIVES)})")
-        if len(set(objectives)) != len(objectives):
-            raise ValueError(f"objectives = {objectives!r} repeats a name")
+        if len({canonical_objective(name) for name in objectives}) != len(objectives):
+            raise ValueError(f"objectives = {objectives!r} repeats an objective (jerk is an alias of accel_variation)")
         if encoding == "speed_codes":
-            self.encoding = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh)
+            self.encoding = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh, integer_codes)
         elif encoding == "switching_points":
             self.encoding = SwitchingPoints.build(case, tuple(regimes) if regimes is not None else None)
+        elif encoding == "braking_onset":
+            if tracking is not None:
+                raise ValueError("encoding = 'braking_onset' with tracking: the controllers track an ideal "
+                                 "curve that ends at the platform; use speed_codes or switching_points")
+            self.encoding = BrakingOnset.build(case, tuple(regimes) if regimes is not None else None,
+                                               decel_range_ms2, dx_m=dx_m)
         else:
             raise ValueError(f"encoding = {encoding!r} is unknown (known: {', '.join(ENCODINGS)})")
         if time_tolerance_s is not None and not (np.isfinite(time_tolerance_s) and time_tolerance_s > 0):
@@ -164,6 +211,9 @@ class SpeedProfileProblem(Problem):
         if "time_error" in objectives or time_tolerance_s is not None:
             self.simulator.check_planned_time()  # raises, naming planned_time_s, when impossible
         self.min_running_time_s = fastest.running_time_s
+        self.time_window_s = self._check_window(time_window_s, case)
+        if tracking is None:
+            warn_constant_objectives(objectives, self.encoding)
 
         self.weights = None
         self.scales = None
@@ -174,18 +224,19 @@ class SpeedProfileProblem(Problem):
                                  f"one per objective {objectives}")
             if scales is None:
                 default = {"energy": fastest.energy.net_kwh, "time_error": 0.05 * case.planned_time_s,
-                           "running_time": case.planned_time_s, "jerk": max(fastest.jerk_ms2, 1e-9),
+                           "running_time": case.planned_time_s,
+                           "accel_variation": max(fastest.accel_variation_ms2, 1e-9),
                            "stop_error": 0.25}
-                scales = [default[name] for name in objectives]
+                scales = [default[canonical_objective(name)] for name in objectives]
             scales = np.asarray(scales, dtype=float)
             if scales.shape != weights.shape or not np.all(scales > 0):
                 raise ValueError(f"scales = {scales.tolist()!r}: need {len(objectives)} positive values")
             self.weights, self.scales = weights, scales
 
         n_obj = 1 if self.weights is not None else len(objectives)
-        n_ieq = 1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None)
+        n_ieq = 1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None) + (self.time_window_s is not None)
         super().__init__(n_var=self.encoding.n_var, n_obj=n_obj, n_ieq_constr=n_ieq,
-                         xl=self.encoding.xl.copy(), xu=self.encoding.xu.copy(), vtype=float, **kwargs)
+                         xl=self.encoding.xl.copy(), xu=self.encoding.xu.copy(), vtype=self.encoding.vtype, **kwargs)
 
     # ------------------------------------------------------------------ evaluation
     def summaries(self, X: np.ndarray) -> np.ndarray:
@@ -196,7 +247,7 @@ class SpeedProfileProblem(Problem):
         programs = self.encoding.programs(np.ascontiguousarray(X))
         if self.tracker is not None:
             return self.tracker.run_batch(programs)
-        return self.simulator.run_batch(programs)
+        return self._runner().run_batch(programs)
 
     def check_decisions(self, X: np.ndarray) -> np.ndarray:
         """``X`` as a float array (N, n_var) after checking it is finite and inside ``[xl, xu]``.
@@ -219,11 +270,78 @@ class SpeedProfileProblem(Problem):
             constraints.append(s[:, k.OUT_STOP_ERROR_M] - self.stop_tolerance_m)
         if self.time_tolerance_s is not None:
             constraints.append(np.abs(s[:, k.OUT_RUNNING_TIME_S] - self.case.planned_time_s) - self.time_tolerance_s)
+        if self.time_window_s is not None:
+            lo, hi = self.time_window_s
+            t = s[:, k.OUT_RUNNING_TIME_S]
+            constraints.append(np.maximum(lo - t, t - hi))
         out["F"] = values
         out["G"] = np.column_stack(constraints)
         out["energy_kwh"] = s[:, k.OUT_NET_KWH]
         out["running_time_s"] = s[:, k.OUT_RUNNING_TIME_S]
         out["stop_error_m"] = s[:, k.OUT_STOP_ERROR_M]
+
+    def _check_window(self, window, case: Case):
+        if window is None:
+            return None
+        if isinstance(window, str):
+            if window != "default":
+                raise ValueError(f"time_window_s = {window!r}: give (lo, hi) in seconds or 'default'")
+            from pymoo_rail.problems.reference import default_window
+
+            return default_window(self.min_running_time_s, case.planned_time_s)
+        try:
+            lo, hi = (float(v) for v in window)
+        except (TypeError, ValueError):
+            raise ValueError(f"time_window_s = {window!r}: give (lo, hi) in seconds or 'default'") from None
+        if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
+            raise ValueError(f"time_window_s = {window!r}: need finite 0 <= lo < hi seconds")
+        if hi < self.min_running_time_s:
+            raise ValueError(f"time_window_s = {window!r}: ends before the minimum running time "
+                             f"{self.min_running_time_s:.2f} s")
+        return lo, hi
+
+    # ------------------------------------------------------------------ known front
+    def certified_front(self):
+        """The case's certified energy / running-time front (:mod:`pymoo_rail.problems.reference`).
+
+        Computed once per case content by the exact solver and cached on disk; raises
+        :class:`~pymoo_rail.problems.reference.NoExactFrontError` for forms that have none.
+        """
+        from pymoo_rail.problems import reference
+
+        reason = self._no_exact_front_reason()
+        if reason:
+            raise reference.NoExactFrontError(f"{self.describe()}: no exact front: {reason}")
+        return reference.certified_front(self.case, self.simulator.grid.dx_m)
+
+    def _no_exact_front_reason(self) -> str:
+        if self.tracker is not None:
+            return "the objectives are those of a tracked run"
+        if self.weights is not None:
+            return "a weighted sum has no certified optimum"
+        names = set(self.objectives)
+        if len(self.objectives) == 1:
+            if self.objectives != ("energy",) or self.time_tolerance_s is None:
+                return "only energy under a running-time tolerance has an exact optimum"
+            return ""
+        if len(self.objectives) > 2 or not (names == {"energy", "running_time"} or names == {"energy", "time_error"}):
+            return (f"objectives {self.objectives} (exact fronts exist for energy with running time or time error; "
+                    "for three or more objectives pymoo_rail.suite offers a best-known front, labelled as such)")
+        if self.time_window_s is None:
+            return ("without a running-time window the front runs on to ever slower, cheaper runs; the certified "
+                    "front covers the planner's times: pass time_window_s='default' (or a (lo, hi) inside it)")
+        return ""
+
+    def _calc_pareto_front(self, n_pareto_points: int = 100, *args, **kwargs):
+        """pymoo's hook: the certified front in this problem's objective space (or the constrained optimum)."""
+        from pymoo_rail.problems import reference
+
+        front = self.certified_front()
+        if len(self.objectives) == 1:
+            energy, _, _ = reference.constrained_optimum(front, self.time_tolerance_s, window_s=self.time_window_s)
+            return np.array([[energy]])
+        F, _ = reference.mirrored(front, self.objectives, n_pareto_points, self.time_window_s)
+        return F
 
     # ------------------------------------------------------------------ inspection
     def trajectory(self, x: np.ndarray) -> Trajectory:
@@ -234,7 +352,11 @@ class SpeedProfileProblem(Problem):
         program = self.encoding.programs(self.check_decisions(x[None, :]))[0]
         if self.tracker is not None:
             return self.tracker.run_program(program)
-        return self.simulator.run(program)
+        return self._runner().run(program)
+
+    def _runner(self):
+        # braking_onset simulates its own (longer) track: the train may stop past the platform
+        return self.encoding if isinstance(self.encoding, BrakingOnset) else self.simulator
 
     def describe(self) -> str:
         form = "weighted sum" if self.weights is not None else (

@@ -2,11 +2,11 @@
 
 Two encodings of the seeds:
 
-- speed codes (seed 000 sections 4.3-4.4): the line is cut into sections, by the gradient and
+- speed codes (Liu (2019) sections 4.3-4.4): the line is cut into sections, by the gradient and
   speed-limit breakpoints (non-equal partition, fig. 4-4) or into equal lengths (fig. 4-3); each
   section carries one target speed, reached by maximum traction or by coasting and then held
   (fig. 4-5); braking onto the platform happens at the latest moment the braking curve allows.
-- switching points (seeds 002, 003): a fixed sequence of regimes (traction, hold, coast, brake)
+- switching points (Meng et al. (2017) and Tang et al. (2020)): a fixed sequence of regimes (traction, hold, coast, brake)
   with the positions where one gives way to the next.
 """
 
@@ -18,6 +18,7 @@ from pymoo_rail.model import CaseError, Line
 from pymoo_rail.sim.kernel import (
     MODE_BRAKE,
     MODE_COAST,
+    MODE_DECEL,
     MODE_HOLD,
     MODE_HOLD_BRAKE,
     MODE_NAMES,
@@ -31,7 +32,7 @@ REGIME_MODES = {"traction": MODE_TRACTION, "hold": MODE_HOLD, "cruise": MODE_HOL
 
 
 def gradient_limit_partition(line: Line, min_length_m: float = 0.0) -> np.ndarray:
-    """Section boundaries at every gradient or limit change (seed 000 fig. 4-4).
+    """Section boundaries at every gradient or limit change (Liu (2019) fig. 4-4).
 
     Sections shorter than ``min_length_m`` are merged into their successor.
     """
@@ -49,7 +50,7 @@ def gradient_limit_partition(line: Line, min_length_m: float = 0.0) -> np.ndarra
 
 
 def equal_partition(line: Line, n_sections: int) -> np.ndarray:
-    """``n_sections`` equal sections (seed 000 fig. 4-3)."""
+    """``n_sections`` equal sections (Liu (2019) fig. 4-3)."""
     if not isinstance(n_sections, (int, np.integer)) or n_sections < 1:
         raise CaseError("n_sections", n_sections, "must be a positive integer")
     return np.linspace(0.0, line.length_m, n_sections + 1)
@@ -87,7 +88,8 @@ def switching_programs(positions_m: np.ndarray, regimes: tuple[str, ...], length
     positions_m : (n_switch,) or (N, n_switch)
         Where regime k gives way to regime k + 1; sorted along each row before use.
     regimes : sequence of str
-        ``n_switch + 1`` names among traction, hold (or cruise), coast, brake.
+        ``n_switch + 1`` names among traction, hold, coast, brake, hold_brake
+        ("cruise" is accepted as an older name of hold).
     length_m : float
         The line length (the last regime runs to the end).
     """
@@ -105,6 +107,34 @@ def switching_programs(positions_m: np.ndarray, regimes: tuple[str, ...], length
     programs[:, -1, 0] = length_m
     programs[:, :, 1] = modes
     programs[:, :, 2] = 0.0
+    return programs
+
+
+def braking_programs(positions_m: np.ndarray, regimes: tuple[str, ...], decel_ms2: np.ndarray,
+                     length_m: float) -> np.ndarray:
+    """Programs whose last regime is braking at a chosen constant deceleration (``MODE_DECEL``).
+
+    Parameters
+    ----------
+    positions_m : (n_switch,) or (N, n_switch)
+        Switching positions of ``regimes`` followed by the braking onset; sorted along each row,
+        so the largest is the onset.
+    regimes : sequence of str
+        ``n_switch`` regimes run before braking (traction, hold, coast ...).
+    decel_ms2 : (N,) or float
+        Service deceleration of the braking phase (m/s^2, > 0).
+    length_m : float
+        Where the braking row ends (the end of the simulated track).
+    """
+    pos = np.atleast_2d(np.asarray(positions_m, dtype=float))
+    decel = np.broadcast_to(np.asarray(decel_ms2, dtype=float), (pos.shape[0],))
+    _check_finite("braking_decel_ms2", decel[:, None])
+    if (decel <= 0).any():
+        idx = int(np.argwhere(decel <= 0)[0, 0])
+        raise ValueError(f"braking_decel_ms2[{idx}] = {float(decel[idx])}: the deceleration must be > 0")
+    programs = switching_programs(pos, tuple(regimes) + ("brake",), length_m)
+    programs[:, -1, 1] = MODE_DECEL
+    programs[:, -1, 2] = decel
     return programs
 
 

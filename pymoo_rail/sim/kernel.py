@@ -9,7 +9,7 @@ A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applie
 cell midpoint passes ``end_m``. Modes:
 
 - ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
-  by partial traction (the speed-code connection strategy of seed 000 fig. 4-5). It never brakes:
+  by partial traction (the speed-code connection strategy of Liu (2019) fig. 4-5). It never brakes:
   where coasting accelerates (a steep descent) the train runs above the target until a limit's
   braking envelope stops it;
 - ``MODE_TRACTION``: maximum traction (speed limits still hold);
@@ -20,6 +20,10 @@ cell midpoint passes ``end_m``. Modes:
 - ``MODE_HOLD_BRAKE``: hold the entry speed by partial traction or, where coasting would
   accelerate, by partial braking (electric first, so it regenerates); maximum braking where even
   that cannot hold it. The cruise control of an ATO on a descent.
+- ``MODE_DECEL``: brake at the constant deceleration ``target`` (m/s^2, resistance and gradient
+  included) until standstill, the service-brake command of a stopping programme (seed 002's
+  braking phase); maximum braking where that is not enough, coasting where the line alone
+  decelerates more. Where it stops is the programme's consequence (short of or past the platform).
 
 Whatever the program says, the train never rises above the braking envelope: it brakes onto every
 lower limit ahead and onto the platform at the latest moment the braking curve allows.
@@ -41,9 +45,12 @@ from pymoo_rail.sim.physics import (
 )
 
 MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
-MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake")
-REGIME_TRACTION, REGIME_CRUISE, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
-REGIME_NAMES = ("traction", "cruise", "coast", "brake")
+MODE_DECEL = 6
+MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake", "decel")
+REGIME_TRACTION, REGIME_HOLD, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
+REGIME_CRUISE = REGIME_HOLD  # the older name of the same regime
+# "hold": the speed is held (partial traction or braking); one word in every output and doc
+REGIME_NAMES = ("traction", "hold", "coast", "brake")
 
 # Columns of a run summary.
 OUT_TRACTION_KWH = 0
@@ -82,7 +89,6 @@ def _full_step(m, v0, cell, kind):
 
     Returns (u1, control force N (+ traction, - braking), W0 N, mean speed m/s).
     """
-    dx = m.dx_m
     wl = m.line_force_n[cell]
     if kind == _KIND_TRACTION:
         f = max_traction(m, v0, cell)
@@ -90,15 +96,36 @@ def _full_step(m, v0, cell, kind):
         f = -max_braking(m, v0, cell)
     else:
         f = 0.0
-    u_half = v0 * v0 + dx * (f - davis_force(m, v0) - wl) / m.effective_mass_kg
+    gain = m.dx_per_mass_m_kg  # dx / M: a multiplication instead of a division on the critical path
+    u_half = v0 * v0 + (f - davis_force(m, v0) - wl) * gain
     v_half = math.sqrt(u_half) if u_half > 0.0 else 0.5 * v0
     if kind == _KIND_TRACTION:
         f = max_traction(m, v_half, cell)
     elif kind == _KIND_BRAKE:
         f = -max_braking(m, v_half, cell)
     w0 = davis_force(m, v_half)
-    u1 = v0 * v0 + 2.0 * dx * (f - w0 - wl) / m.effective_mass_kg
+    u1 = v0 * v0 + 2.0 * ((f - w0 - wl) * gain)
     return u1, f, w0, v_half
+
+
+@njit(cache=True, inline="always")
+def _decel_step(m, v0, cell, decel_ms2):
+    """One cell braking at the constant deceleration ``decel_ms2`` (MODE_DECEL).
+
+    Returns (u1, control force N, W0 N, regime). u1 < 0 means the train stops inside the cell,
+    exactly ``v0^2 / (2 decel)`` after its start (``complete_cell`` measures it).
+    """
+    u1 = v0 * v0 - 2.0 * m.dx_m * decel_ms2
+    v1 = math.sqrt(u1) if u1 > 0.0 else 0.0
+    v_mid = 0.5 * (v0 + v1)
+    w0 = davis_force(m, v_mid)
+    f = -m.effective_mass_kg * decel_ms2 + w0 + m.line_force_n[cell]
+    if f > 0.0:  # resistance and gradient alone decelerate more: coast
+        u1, f, w0, _ = _full_step(m, v0, cell, _KIND_COAST)
+        return u1, f, w0, REGIME_COAST
+    if -f > max_braking(m, v_mid, cell):  # more than the brakes give: brake fully
+        u1, f, w0, _ = _full_step(m, v0, cell, _KIND_BRAKE)
+    return u1, f, w0, REGIME_BRAKE
 
 
 @njit(cache=True, inline="always")
@@ -271,6 +298,67 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
     out[OUT_NEUTRAL_TRACTION_J] = totals[_T_NEUTRAL]
 
 
+@njit(cache=True, inline="always")
+def drive_cell(m, program, totals, i, v, row, hold_speed):
+    """One cell of a driving program: the program's control, the envelope, the accounting.
+
+    ``row`` is the program row in force and ``hold_speed`` the speed a hold row keeps (-1 before
+    it starts). Returns (v1, row, hold_speed, stopped, position reached, acceleration, force,
+    regime, totals). Inlined: the run state stays in registers.
+    """
+    n_rows = program.shape[0]
+    x_mid = m.position_m[i] + 0.5 * m.dx_m
+    while row < n_rows - 1 and x_mid > program[row, 0]:
+        row += 1
+        hold_speed = -1.0
+    mode = int(program[row, 1])
+    target = program[row, 2]
+
+    # what the program asks for
+    brake_to_hold = mode == MODE_HOLD_BRAKE
+    if mode == MODE_HOLD or brake_to_hold:
+        if hold_speed < 0.0:
+            hold_speed = v
+        if hold_speed <= 0.0:
+            mode = MODE_TRACTION  # nothing to hold from standstill
+        else:
+            mode = MODE_TOWARD
+            target = hold_speed
+    if mode == MODE_TOWARD:
+        landed = False
+        if v < target:
+            u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
+            regime = REGIME_TRACTION
+            landed = u1 > target * target
+        else:
+            u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
+            regime = REGIME_COAST
+            landed = u1 < target * target or brake_to_hold  # the second: brake down onto it
+        if landed:
+            fl, w0l, ok = _landing_force(m, v, target, i)
+            if ok:
+                u1, f, w0 = target * target, fl, w0l
+                regime = REGIME_CRUISE
+            elif brake_to_hold and u1 >= target * target:
+                u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)  # the descent is too steep to hold
+                regime = REGIME_BRAKE
+    elif mode == MODE_TRACTION:
+        u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
+        regime = REGIME_TRACTION
+    elif mode == MODE_BRAKE:
+        u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)
+        regime = REGIME_BRAKE
+    elif mode == MODE_DECEL:
+        u1, f, w0, regime = _decel_step(m, v, i, target)
+    else:
+        u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
+        regime = REGIME_COAST
+
+    u1, f, w0, regime, _ = clamp_to_envelope(m, v, i, u1, f, w0, regime)
+    v1, stopped, x1, a_cell, totals = complete_cell(m, totals, i, v, u1, f, w0, regime)
+    return v1, row, hold_speed, stopped, x1, a_cell, f, regime, totals
+
+
 # No reference counting inside: the run allocates nothing, and NRT incref/decref pairs on the
 # model's arrays in every inlined helper call were half the cost of a cell (benchmarks/simulator.py).
 @njit(cache=True, _nrt=False)
@@ -280,7 +368,6 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     Returns the number of trace nodes written (nodes 0..count-1 are valid).
     """
     n = m.position_m.shape[0]
-    n_rows = program.shape[0]
     totals = new_totals()
     v = m.initial_speed_ms
     row = 0
@@ -293,53 +380,8 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
         tr_v[0] = v
         tr_t[0] = 0.0
     for i in range(n - 1):
-        x_mid = m.position_m[i] + 0.5 * m.dx_m
-        while row < n_rows - 1 and x_mid > program[row, 0]:
-            row += 1
-            hold_speed = -1.0
-        mode = int(program[row, 1])
-        target = program[row, 2]
-
-        # what the program asks for
-        brake_to_hold = mode == MODE_HOLD_BRAKE
-        if mode == MODE_HOLD or brake_to_hold:
-            if hold_speed < 0.0:
-                hold_speed = v
-            if hold_speed <= 0.0:
-                mode = MODE_TRACTION  # nothing to hold from standstill
-            else:
-                mode = MODE_TOWARD
-                target = hold_speed
-        if mode == MODE_TOWARD:
-            landed = False
-            if v < target:
-                u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
-                regime = REGIME_TRACTION
-                landed = u1 > target * target
-            else:
-                u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
-                regime = REGIME_COAST
-                landed = u1 < target * target or brake_to_hold  # the second: brake down onto it
-            if landed:
-                fl, w0l, ok = _landing_force(m, v, target, i)
-                if ok:
-                    u1, f, w0 = target * target, fl, w0l
-                    regime = REGIME_CRUISE
-                elif brake_to_hold and u1 >= target * target:
-                    u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)  # the descent is too steep to hold
-                    regime = REGIME_BRAKE
-        elif mode == MODE_TRACTION:
-            u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
-            regime = REGIME_TRACTION
-        elif mode == MODE_BRAKE:
-            u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)
-            regime = REGIME_BRAKE
-        else:
-            u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
-            regime = REGIME_COAST
-
-        u1, f, w0, regime, _ = clamp_to_envelope(m, v, i, u1, f, w0, regime)
-        v, stopped, x1, a_cell, totals = complete_cell(m, totals, i, v, u1, f, w0, regime)
+        v, row, hold_speed, stopped, x1, a_cell, f, regime, totals = drive_cell(
+            m, program, totals, i, v, row, hold_speed)
         if record:
             record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[_T_TIME], a_cell, f, regime)
         count = i + 2
@@ -351,15 +393,82 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     return count
 
 
-@njit(cache=True, parallel=True)
-def simulate_batch(m, programs):
-    """Summaries of many runs, one per program, in parallel. ``programs`` is (N, rows, 3)."""
+# Two runs advanced cell by cell in one loop. A single run is a chain of dependent operations
+# (two square roots and two force-curve evaluations per cell, each waiting for the last), which
+# leaves most of the core idle; the cells of two independent runs interleave in the out-of-order
+# core and nearly halve the time per cell (docs/performance.md). Each run does exactly the
+# arithmetic of ``run_program``, so results are bitwise the same.
+@njit(cache=True, _nrt=False)
+def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
+    """Summaries of two runs, simulated side by side (no traces; ``empty``, ``empty_r``: the
+    empty float and int8 trace arrays ``write_summary`` takes)."""
+    n = m.position_m.shape[0]
+    record = n < 0  # a run-time False: one compiled write_summary for every caller
+    totals_a = new_totals()
+    totals_b = new_totals()
+    v_a = m.initial_speed_ms
+    v_b = m.initial_speed_ms
+    row_a = 0
+    row_b = 0
+    hold_a = -1.0
+    hold_b = -1.0
+    moving_a = True
+    moving_b = True
+    stop_a = m.position_m[n - 1]
+    stop_b = m.position_m[n - 1]
+    for i in range(n - 1):
+        if moving_a:
+            v_a, row_a, hold_a, stopped, x1, _, _, _, totals_a = drive_cell(
+                m, program_a, totals_a, i, v_a, row_a, hold_a)
+            if stopped:
+                moving_a = False
+                stop_a = x1
+        if moving_b:
+            v_b, row_b, hold_b, stopped, x1, _, _, _, totals_b = drive_cell(
+                m, program_b, totals_b, i, v_b, row_b, hold_b)
+            if stopped:
+                moving_b = False
+                stop_b = x1
+        if not (moving_a or moving_b):
+            break
+    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, 0, record, empty, empty, empty_r)
+    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, 0, record, empty, empty, empty_r)
+
+
+@njit(cache=True)
+def simulate_serial(m, programs, out):
+    """Summaries of runs ``programs`` (N, rows, 3) into ``out`` (N, N_OUT), in this thread."""
     n_runs = programs.shape[0]
-    out = np.empty((n_runs, N_OUT))
     empty = np.empty(0)
     empty_r = np.empty(0, dtype=np.int8)
-    for j in prange(n_runs):
-        run_program(m, programs[j], out[j], False, empty, empty, empty, empty, empty, empty_r)
+    for j in range(n_runs // 2):
+        run_two_programs(m, programs[2 * j], programs[2 * j + 1], out[2 * j], out[2 * j + 1], empty, empty_r)
+    if n_runs % 2 == 1:
+        # a run-time False, not the literal: with a literal Numba compiles run_program a second time
+        # (once per value of ``record``), which doubles the first-run compile time
+        record = n_runs < 0
+        run_program(m, programs[n_runs - 1], out[n_runs - 1], record, empty, empty, empty, empty, empty, empty_r)
+
+
+@njit(cache=True, parallel=True)
+def simulate_batch(m, programs):
+    """Summaries of many runs, one per program, in parallel. ``programs`` is (N, rows, 3).
+
+    Runs go to the threads in pairs (:func:`run_two_programs`).
+    """
+    n_runs = programs.shape[0]
+    out = np.empty((n_runs, N_OUT))
+    n_pairs = n_runs // 2
+    for j in prange(n_pairs + n_runs % 2):
+        simulate_serial(m, programs[2 * j: 2 * j + 2], out[2 * j: 2 * j + 2])
+    return out
+
+
+@njit(cache=True)
+def simulate_batch_serial(m, programs):
+    """:func:`simulate_batch` in the calling thread: no thread start-up cost for small batches."""
+    out = np.empty((programs.shape[0], N_OUT))
+    simulate_serial(m, programs, out)
     return out
 
 
@@ -374,5 +483,6 @@ def simulate_trace(m, program):
     a = np.empty(n)
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
-    count = run_program(m, program, out, True, x, v, t, a, f, r)
+    record = n >= 0  # a run-time True: one compiled run_program for both callers (see simulate_batch)
+    count = run_program(m, program, out, record, x, v, t, a, f, r)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]

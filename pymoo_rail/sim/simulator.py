@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
@@ -10,6 +11,11 @@ from pymoo_rail.sim.drivers import flat_out_program
 from pymoo_rail.sim.physics import KernelModel, build_kernel_model
 from pymoo_rail.sim.stall import explain_stall
 from pymoo_rail.sim.trajectory import Trajectory, energy_from_summary, summary_dict
+
+# Below this many cells (runs x grid cells) a batch runs in the calling thread: waking the
+# other threads and waiting for the slowest one costs more than it saves, and waiting threads
+# spin on a busy machine. Measured by ``benchmarks/throughput.py`` (serial vs parallel rows).
+PARALLEL_MIN_CELLS = 50_000
 
 
 class Simulator:
@@ -33,10 +39,17 @@ class Simulator:
         return float(self.case.line.length_m)
 
     def run_batch(self, programs: np.ndarray) -> np.ndarray:
-        """Summaries (N, N_OUT) of programs (N, rows, 3), evaluated in parallel."""
+        """Summaries (N, N_OUT) of programs (N, rows, 3).
+
+        Evaluated on Numba's threads (``numba.set_num_threads``) when the batch has at least
+        :data:`PARALLEL_MIN_CELLS` cells, else in the calling thread; the results are the same.
+        """
         programs = np.ascontiguousarray(programs, dtype=float)
         if programs.ndim != 3 or programs.shape[2] != 3:
             raise ValueError(f"programs must have shape (N, rows, 3), got {programs.shape}")
+        n_cells = programs.shape[0] * (self.model.position_m.shape[0] - 1)
+        if n_cells < PARALLEL_MIN_CELLS or numba.get_num_threads() == 1:
+            return k.simulate_batch_serial(self.model, programs)
         return k.simulate_batch(self.model, programs)
 
     def run(self, program: np.ndarray) -> Trajectory:
@@ -55,8 +68,11 @@ class Simulator:
         return self.run(flat_out_program(self.length_m))
 
     def min_running_time_s(self) -> float:
-        """Running time of the flat-out run, the shortest the train can do on this grid."""
-        return self.flat_out().running_time_s
+        """Running time of the flat-out run, the shortest the train can do on this grid.
+
+        Raises :class:`InfeasibleCaseError` naming the cause when even that run stops short
+        (a time for a run that never arrives would be meaningless)."""
+        return self.check_reachable().running_time_s
 
     def check_reachable(self) -> Trajectory:
         """The flat-out run; :class:`InfeasibleCaseError` naming the cause when it stops short."""

@@ -1,12 +1,12 @@
-"""The subsection driver of seed 001: a run built from per-subsection operating sequences.
+"""The subsection driver of Chen et al. (2017): a run built from per-subsection operating sequences.
 
 Seed 001 (section 1) cuts the run from the station to the braking point P into subsections of one
 gradient and one limit, and gives each subsection an operating sequence (table 1):
 
 - type 2 (cruising needs traction, ``W0 + G >= 0``): traction at ``gamma`` times the maximum force
-  up to a turning speed ``v_a``, traction cruise at ``v_a``, then coasting down to the exit speed;
+  up to a turning speed ``v_a``, traction hold at ``v_a``, then coasting down to the exit speed;
 - type 3 (steep descent, ``W0 + G < 0``): traction at ``gamma`` up to ``v_a``, coasting (which
-  accelerates) up to the exit speed, then brake cruise (regenerative) at the exit speed;
+  accelerates) up to the exit speed, then brake hold (regenerative) at the exit speed;
 - type 1 (from P to the platform): braking at the constant deceleration ``v_m^2 / (2 dS)``.
 
 With the entry speed, the exit speed ``v_k`` and ``gamma_k`` fixed, the subsection time is a

@@ -25,7 +25,7 @@ class Trajectory:
     """A simulated run from the start to standstill.
 
     Arrays are per grid node (``accel_ms2``, ``force_n`` and ``regime`` describe the cell that
-    starts at the node). ``regime`` codes are 0 traction, 1 cruise, 2 coast, 3 brake
+    starts at the node). ``regime`` codes are 0 traction, 1 hold, 2 coast, 3 brake
     (:data:`REGIME_NAMES`). ``summary`` holds every figure of the run by name (see
     :data:`pymoo_rail.sim.kernel.OUT_NAMES`).
     """
@@ -47,9 +47,18 @@ class Trajectory:
         return self.speed_ms * 3.6
 
     @property
-    def jerk_ms2(self) -> float:
-        """Comfort figure: integral of |jerk| over the run (total variation of acceleration)."""
+    def accel_variation_ms2(self) -> float:
+        """Comfort figure: total variation of the acceleration, sum of ``|a_i - a_(i-1)|`` (m/s^2).
+
+        Includes the steps from rest at the start and to rest at the end. Meng et al. (2017) call
+        it jerk; it is the time integral of ``|jerk|``, not a jerk (m/s^3).
+        """
         return self.summary["jerk_ms2"]
+
+    @property
+    def jerk_ms2(self) -> float:
+        """Alias of :attr:`accel_variation_ms2` (the name used by Meng et al. (2017))."""
+        return self.accel_variation_ms2
 
     @property
     def regime_changes(self) -> int:

@@ -23,7 +23,10 @@ def level_solver():
     return OptimalSolver(level_case())
 
 
-@pytest.mark.parametrize("running_time_s", [240.0, 320.0])
+# 260 s and 320 s are solved on the default speed grid (seconds); at 240 s the discrete optimum jumps
+# over the requested time and the solver refines the grid twice (minutes): the same assertions,
+# behind the slow marker
+@pytest.mark.parametrize("running_time_s", [260.0, 320.0, pytest.param(240.0, marks=pytest.mark.slow)])
 def test_level_track_closed_form(level_solver, running_time_s):
     # Pontryagin on level track: maximum traction to V, hold V, coast to W, maximum braking, with
     # lambda = V^2 R'(V) and lambda / W = R(V) + lambda / V (pymoo_rail.optimal.flat, by quadrature)
@@ -32,7 +35,7 @@ def test_level_track_closed_form(level_solver, running_time_s):
     assert at_time(tr, running_time_s) == pytest.approx(exact.energy_kwh, rel=ACCURACY)
     # the same structure: the speed held is V, braking starts at W where the closed form says
     names = np.array(REGIME_NAMES)[tr.regime]
-    held = tr.speed_ms[:-1][names[:-1] == "cruise"]
+    held = tr.speed_ms[:-1][names[:-1] == "hold"]
     assert np.median(held) == pytest.approx(exact.hold_speed_ms, rel=0.01)
     first_brake = np.argmax(names == "brake")
     assert tr.speed_ms[first_brake] == pytest.approx(exact.brake_speed_ms, rel=0.03)

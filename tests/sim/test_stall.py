@@ -31,6 +31,12 @@ def test_an_absurd_mass_is_named():
     assert err.field == "train.mass_t" and err.value == 1e9 and "% of the train's weight" in str(err)
 
 
+def test_no_minimum_running_time_for_a_run_that_never_arrives():
+    slow = _variant(lambda d: d["train"].__setitem__("max_speed_kmh", 1e-200))
+    with pytest.raises(InfeasibleCaseError):
+        Simulator(slow).min_running_time_s()
+
+
 def test_a_descent_the_train_cannot_brake_on_is_not_called_a_stall():
     # -500 permille pulls 332 t x 9.81 x 0.5 = 1628 kN down the hill: far above the ~400 kN of braking
     err = _cause(lambda d: d["line"].__setitem__("gradients", [[0.0, 500.0, -500.0], [500.0, 1000.0, 10.0]]))

@@ -1,0 +1,169 @@
+"""pymoo-rail's exact solver beside the continuous optimal-control solvers, on the same model.
+
+For each case: pymoo-rail's energy at the requested running time, its certificate (the bound on the
+error, ``OptimalSolver.energy_bound_kwh``), the running time of its run and its CPU time (tables,
+lambda search, replay and certificate; ``time.process_time``, so both cores of a parallel sweep
+count), beside
+
+- ms-eetc (Kouzoupis et al., direct multiple shooting with CasADi/IPOPT; not on the package index):
+  run here when ``--mseetc PATH`` gives a checkout and ``--mseetc-python`` an interpreter with its
+  dependencies (casadi, pandas < 2); otherwise its figures recorded on this machine (date below);
+- GPOPS-II (hp-adaptive pseudospectral), the published figure of the ms-eetc paper for the 48.5 km
+  case: 440.14 kWh in 7.0 s;
+- the closed form (Pontryagin, ``pymoo_rail.optimal.flat``) on the level case.
+
+Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--quick]``
+(``--quick``: only the two intercity cases). Writes ``benchmarks/reports/peers.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pandas as pd
+
+HERE = Path(__file__).resolve().parent
+REPORT = HERE / "reports" / "peers.md"
+CASES = [  # (case, running time s, ms-eetc track id or None)
+    (str(HERE / "cases" / "intercity-var-limit-100.toml"), 1541.0, "00_var_speed_limit_100"),
+    (str(HERE / "cases" / "intercity-level-10km.toml"), 400.0, "level_10km"),
+    ("yizhuang", 150.0, None),
+    ("wuguang-crh3", 1050.0, None),
+]
+GPOPS_II = {"intercity-var-limit-100": (440.14, 7.0)}  # published (ms-eetc paper, fig. 10): kWh, s
+# ms-eetc measured on this machine (2 cores shared by eight jobs, load ~20) on 2026-11-24, casadi 3.8.2:
+# IPOPT process time of one solve (the best of 3); ms-eetc's own "CPU time" is IPOPT's wall time.
+MSEETC_RECORDED = {
+    ("intercity-var-limit-100", 300): (441.0839, 3.47), ("intercity-var-limit-100", 1000): (440.3766, 12.45),
+    ("intercity-level-10km", 100): (88.5501, 0.88), ("intercity-level-10km", 300): (88.3277, 3.02),
+    ("intercity-level-10km", 1000): (88.2526, 12.15),
+}
+MSEETC_DATE = "2026-11-24"
+
+# ms-eetc set up as for its fig. 10 (the GPOPS-II comparison); runs inside the checkout
+_DRIVER = """
+import json, os, sys, time
+from pathlib import Path
+sys.path.insert(0, os.getcwd())
+from mseetc.train import Train
+from mseetc.track import Track
+from mseetc.ocp import casadiSolver
+track_id, trip, n_int, tracks = sys.argv[1], float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+train = Train(config={'id': 'NL_Intercity_VIRM6'})
+train.forceMinPn = 0
+train.forceMin = -train.forceMax
+train.powerMax = 3129277
+train.powerMin = -train.powerMax
+train.etaTraction = 0.73
+train.etaRgBrake = 0.73
+track = Track(config={'id': track_id}, pathJSON=Path(tracks))
+opts = json.load(open('simulations/config.json'))
+opts['minimumVelocity'] = 1
+opts['numIntervals'] = n_int
+solver = casadiSolver(train, track, opts)
+best = None
+for _ in range(3):
+    t0 = time.process_time()
+    df, stats = solver.solve(trip, terminalVelocity=1, initialVelocity=1)
+    cpu = time.process_time() - t0
+    best = cpu if best is None else min(best, cpu)
+print(json.dumps({'energy_kwh': float(df['Energy [kWh]'].sum()), 'cpu_s': best}))
+"""
+
+
+def run_mseetc(checkout: Path, python: str, track_id: str, trip_s: float, n_intervals: int) -> tuple[float, float]:
+    """(energy kWh, CPU s) of ms-eetc on one case, run in its checkout."""
+    with tempfile.TemporaryDirectory() as tmp:
+        tracks = Path(tmp)
+        for p in (checkout / "tracks").glob("*.json"):
+            (tracks / p.name).write_text(p.read_text())
+        level = json.loads((checkout / "tracks" / "00_var_speed_limit_100.json").read_text())
+        level["metadata"]["id"] = "level_10km"
+        level["stops"]["values"] = [0.0, 10000.0]
+        level["speed limits"]["values"] = [[0.0, 140]]
+        (tracks / "level_10km.json").write_text(json.dumps(level))
+        driver = tracks / "driver.py"
+        driver.write_text(_DRIVER)
+        out = subprocess.run([python, str(driver), track_id, str(trip_s), str(n_intervals), str(tracks)],
+                             cwd=checkout, capture_output=True, text=True, check=True)
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    return result["energy_kwh"], result["cpu_s"]
+
+
+def pymoo_rail_row(name: str, running_time_s: float) -> dict:
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.optimal import OptimalSolver
+
+    case = load_case(name)
+    start = time.process_time()
+    solver = OptimalSolver(case)
+    tr = solver.profile(running_time_s)
+    cpu = time.process_time() - start
+    lam = tr.summary["lambda_w"]
+    at_request = tr.energy.net_kwh + lam * (tr.running_time_s - running_time_s) / 3.6e6
+    row = {"case": case.name, "requested_s": running_time_s, "run_s": tr.running_time_s,
+           "energy_kwh": tr.energy.net_kwh, "at_request_kwh": at_request,
+           "bound_kwh": tr.summary["energy_bound_kwh"], "cpu_s": cpu, "dp_solves": solver.n_solves}
+    try:
+        from pymoo_rail.optimal.flat import flat_track_optimum
+
+        row["closed_form_kwh"] = flat_track_optimum(case, running_time_s).energy_kwh
+    except ValueError:
+        row["closed_form_kwh"] = float("nan")
+    return row
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mseetc", type=Path, help="an ms-eetc checkout to run here")
+    parser.add_argument("--mseetc-python", default=sys.executable, help="interpreter with ms-eetc's dependencies")
+    parser.add_argument("--quick", action="store_true", help="only the two intercity cases")
+    args = parser.parse_args()
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.optimal import OptimalSolver
+
+    OptimalSolver(load_case("yizhuang"), n_speeds=20).profile(150.0)  # warm-up: load the Numba cache
+    rows, peers = [], []
+    for name, t, track_id in (CASES[:2] if args.quick else CASES):
+        row = pymoo_rail_row(name, t)
+        rows.append(row)
+        print(row, flush=True)
+        if track_id is None:
+            continue
+        for n in (100, 300, 1000):
+            if args.mseetc is not None:
+                energy, cpu = run_mseetc(args.mseetc, args.mseetc_python, track_id, t, n)
+                source = "run here"
+            elif (row["case"], n) in MSEETC_RECORDED:
+                energy, cpu = MSEETC_RECORDED[(row["case"], n)]
+                source = f"recorded {MSEETC_DATE}"
+            else:
+                continue
+            peers.append({"case": row["case"], "solver": f"ms-eetc N={n}", "energy_kwh": energy, "cpu_s": cpu,
+                          "source": source})
+        if row["case"] in GPOPS_II:
+            energy, cpu = GPOPS_II[row["case"]]
+            peers.append({"case": row["case"], "solver": "GPOPS-II", "energy_kwh": energy, "cpu_s": cpu,
+                          "source": "published"})
+    from optimal import markdown  # benchmarks/optimal.py (this script's directory is on sys.path)
+
+    ours = pd.DataFrame(rows)
+    theirs = pd.DataFrame(peers)
+    text = ["# pymoo-rail's exact solver beside continuous optimal-control solvers", "",
+            "Written by `python benchmarks/peers.py`. CPU times are `time.process_time` on a 2-core machine",
+            "shared with other jobs (wall times there are meaningless); pymoo-rail's include building the",
+            "transition tables, the lambda search, the simulator replay and the certificate.", "",
+            "## pymoo-rail", "", markdown(ours), "",
+            "## Peers", "", markdown(theirs) if len(theirs) else "(none)", ""]
+    REPORT.write_text("\n".join(text))
+    print("\n".join(text))
+
+
+if __name__ == "__main__":
+    main()

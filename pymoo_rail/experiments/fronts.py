@@ -1,0 +1,108 @@
+"""The final front of a run, one member per objective vector.
+
+An archive or a survival step can keep several members with the same objective vector (copies of
+one solution, or decision vectors that drive the same run: a speed code above what the train can
+reach on a section changes nothing). Counting them inflates the front size and gives spacing
+zeros, so every front the package writes (``pymoo-rail optimize``, study records) goes through
+:func:`distinct_front`. :func:`choose_member` picks the member to show.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pymoo.core.population import Population
+
+
+def distinct_index(F: np.ndarray, CV: np.ndarray | None = None) -> np.ndarray:
+    """Indices of the members to keep: one per distinct row of ``F``, in their original order.
+
+    Among members with equal objective vectors the one with the least constraint violation is
+    kept (ties: the first). Objective vectors are compared exactly.
+
+    Parameters
+    ----------
+    F : array (n, n_obj)
+        Objective values.
+    CV : array (n,), optional
+        Constraint violation of each member (default: all zero).
+
+    Returns
+    -------
+    numpy.ndarray
+        Sorted integer indices into ``F``.
+    """
+    F = np.asarray(F, dtype=float)
+    if F.ndim != 2:
+        raise ValueError(f"F has shape {F.shape}: expected (n, n_obj)")
+    n = F.shape[0]
+    if n == 0:
+        return np.zeros(0, dtype=int)
+    cv = np.zeros(n) if CV is None else np.asarray(CV, dtype=float).reshape(-1)
+    if cv.shape[0] != n:
+        raise ValueError(f"CV has {cv.shape[0]} values for {n} members")
+    order = np.lexsort((np.arange(n), cv))  # least violation first, then the original order
+    _, first = np.unique(F[order], axis=0, return_index=True)
+    return np.sort(order[first])
+
+
+def distinct_front(opt: Population | None) -> Population:
+    """The members of ``opt`` (e.g. ``res.algorithm.opt``) with distinct objective vectors.
+
+    Parameters
+    ----------
+    opt : pymoo Population or None
+        The final front of an algorithm; ``None`` gives an empty population.
+
+    Returns
+    -------
+    Population
+        A sub-population, in the original order; see :func:`distinct_index`.
+    """
+    if opt is None or len(opt) == 0:
+        return Population.empty()
+    F = np.asarray(opt.get("F"), dtype=float)
+    CV = opt.get("CV")
+    return opt[distinct_index(F, None if CV is None else np.asarray(CV, dtype=float).reshape(-1))]
+
+
+def choose_member(F: np.ndarray, CV: np.ndarray, running_time_s: np.ndarray, energy_kwh: np.ndarray,
+                  planned_time_s: float, window_s: float = 1.0) -> int:
+    """Index of the front member to show (what ``pymoo-rail optimize`` writes to trajectory.csv).
+
+    One objective: the best. Several: the least energy among the members within ``window_s`` of
+    the planned time (what an operator would pick: punctual, then frugal); if none is that close,
+    the one closest to the planned time (ties: least energy). Feasible members first.
+
+    Parameters
+    ----------
+    F : array (n, n_obj)
+        Objective values of the front members.
+    CV : array (n,)
+        Their constraint violations.
+    running_time_s, energy_kwh : array (n,)
+        Their running times (s) and net energies (kWh), e.g. ``opt.get("running_time_s")``.
+    planned_time_s : float
+        The case's planned running time (s).
+    window_s : float
+        How close to the planned time a punctual member is (s).
+
+    Returns
+    -------
+    int
+        Index of the chosen member.
+    """
+    F = np.asarray(F, dtype=float).reshape(len(F), -1)
+    CV = np.asarray(CV, dtype=float).reshape(-1)
+    running_time_s = np.asarray(running_time_s, dtype=float).reshape(-1)
+    energy_kwh = np.asarray(energy_kwh, dtype=float).reshape(-1)
+    candidates = np.flatnonzero(CV <= 0)
+    if len(candidates) == 0:
+        candidates = np.array([int(np.argmin(CV))])
+    if F.shape[1] == 1:
+        return int(candidates[np.argmin(F[candidates, 0])])
+    error = np.abs(running_time_s[candidates] - planned_time_s)
+    punctual = candidates[error <= window_s]
+    if len(punctual):
+        return int(punctual[np.argmin(energy_kwh[punctual])])
+    order = np.lexsort((energy_kwh[candidates], error))
+    return int(candidates[order[0]])

@@ -1,0 +1,367 @@
+"""Certified energy / running-time fronts of a case, from the exact solver, cached on disk.
+
+A rail problem whose objectives are net energy and running time (or time error) has a known
+Pareto front: the minimum energy at each running time, which :mod:`pymoo_rail.optimal` computes.
+This module turns the solver's runs into a front with a certificate and keeps it:
+
+- **Nodes.** The solver is asked for the minimum-energy run at ``n_times`` running times from just
+  above the minimum running time to :data:`FRONT_SPAN` x the planned time (and at the planned time
+  itself). Each node is a real run of the simulator: ``running_time_s``, ``energy_kwh`` (net) and
+  the front's slope ``lambda_kwh_per_s`` there.
+- **Certificate.** ``energy_bound_kwh`` bounds ``|energy_kwh - true optimum|`` at the node's
+  running time. When the solver reports this bound (column ``energy_bound_kwh`` of
+  :func:`~pymoo_rail.optimal.optimal_front`) it is used (``certificate = "solver"``).
+  Otherwise it is the two-grid estimate (``certificate = "two-grid"``): the difference between
+  the default grid and one with half the speed nodes at the same requested time. Either is
+  raised to at least :data:`BOUND_FLOOR_REL` of the energy. The coarse grid errs more than the
+  default one (``docs/optimal.md``), so the difference over-estimates the default grid's error;
+  it is an estimate, not a proof.
+- **Between nodes.** The front is convex and decreasing in time, so the chord between two nodes
+  lies above it by at most ``h (lambda_left - lambda_right) / 4`` (the tangents at both ends
+  bound it from below). :meth:`CertifiedFront.energy_at` interpolates and adds that to the bound.
+- **Cache.** Fronts are keyed by the case's *content* (:func:`case_hash`: train, line, planned
+  time; never the name), the simulation step and :data:`FRONT_VERSION`. They are looked up in the
+  fronts shipped with the package (``pymoo_rail/suite/fronts``), then in the user cache
+  directory (``platformdirs.user_cache_dir("pymoo-rail")/fronts``, or ``$PYMOO_RAIL_CACHE_DIR``),
+  and computed and written there (atomically) otherwise.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail import __version__
+from pymoo_rail.atomic import atomic_write_text
+from pymoo_rail.model import Case, case_to_dict
+
+FRONT_VERSION = "2"
+"""Version of the front computation; bump it when the solver or the node choice changes."""
+FRONT_SPAN = 1.3
+"""Fronts cover running times from the minimum to ``FRONT_SPAN`` x the planned time."""
+DEFAULT_N_TIMES = 17
+"""Nodes of a front on lines up to :data:`LONG_LINE_M`; longer lines get :data:`LONG_LINE_N_TIMES` (DP cost)."""
+LONG_LINE_M = 10_000.0
+LONG_LINE_N_TIMES = 9
+BOUND_FLOOR_REL = 5.0e-4
+"""Least two-grid bound, relative to the energy: the largest error of the default grid measured against
+a direct strategy search and finer grids (``docs/optimal.md``); a small two-grid difference can be luck."""
+COARSE_FACTOR = 2
+"""The two-grid certificate compares the default grid with one of ``n_speeds / COARSE_FACTOR``."""
+SHIPPED_DIR = Path(__file__).resolve().parent.parent / "suite" / "fronts"
+CACHE_ENV = "PYMOO_RAIL_CACHE_DIR"
+COLUMNS = ("requested_time_s", "running_time_s", "energy_kwh", "lambda_kwh_per_s", "energy_bound_kwh")
+
+
+class NoExactFrontError(NotImplementedError):
+    """The problem has no exact front (e.g. three or more objectives); the message says what exists."""
+
+
+def case_hash(case: Case) -> str:
+    """SHA-256 of the case's content (train, line, planned time, dwell, legs): not of its name or prose."""
+    data = case_to_dict(case)
+    for key in ("name", "source", "description"):
+        data.pop(key, None)
+    text = json.dumps(data, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def cache_dir() -> Path:
+    """The user cache directory of computed fronts (``$PYMOO_RAIL_CACHE_DIR`` overrides it)."""
+    override = os.environ.get(CACHE_ENV)
+    if override:
+        return Path(override) / "fronts"
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("pymoo-rail")) / "fronts"
+
+
+def front_key(case: Case, dx_m: float, n_times: int) -> str:
+    """The cache key of a case's front: content hash, step, number of nodes and front version."""
+    return f"{case_hash(case)[:16]}-dx{dx_m:g}-n{n_times}-v{FRONT_VERSION}"
+
+
+@dataclass(frozen=True)
+class CertifiedFront:
+    """The certified energy / running-time front of one case.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        One row per node, sorted by time, with :data:`COLUMNS`.
+    case_hash : str
+        :func:`case_hash` of the case it belongs to.
+    case_name : str
+    planned_time_s : float
+    dx_m : float
+        Simulation step of the solver's grid.
+    certificate : str
+        ``"solver"`` (the solver's own bound) or ``"two-grid"`` (see the module docstring).
+    version : str
+        Package and front version that computed it.
+    """
+
+    table: pd.DataFrame
+    case_hash: str
+    case_name: str
+    planned_time_s: float
+    dx_m: float
+    certificate: str
+    version: str
+
+    @property
+    def time_range_s(self) -> tuple[float, float]:
+        t = self.table["running_time_s"].to_numpy()
+        return float(t[0]), float(t[-1])
+
+    def clip(self, window_s: tuple[float, float] | None) -> tuple[float, float]:
+        """A running-time window cut to the front's range; ends within 0.5 s of the range are moved onto it.
+
+        The nodes are the solver's runs, within 0.05 s of the requested times (never 0.5 s off), so a
+        window built by :func:`default_window` may start a few hundredths of a second before the first node.
+        """
+        lo, hi = self.time_range_s
+        if window_s is None:
+            return lo, hi
+        a, b = (float(v) for v in window_s)
+        if a < lo - 0.5 or b > hi + 0.5 or not a < b:
+            raise ValueError(f"time window {a:.2f}-{b:.2f} s: the front of '{self.case_name}' covers "
+                             f"{lo:.2f}-{hi:.2f} s only")
+        return max(a, lo), min(b, hi)
+
+    def energy_at(self, running_time_s) -> tuple[np.ndarray, np.ndarray]:
+        """Optimal energy (kWh) and its bound (kWh) at running times inside the front's range.
+
+        Linear interpolation between nodes; the bound adds the chord's largest possible excess
+        over the convex front, ``h (lambda_left - lambda_right) / 4``.
+        """
+        t = np.atleast_1d(np.asarray(running_time_s, dtype=float))
+        lo, hi = self.time_range_s
+        if np.any(~np.isfinite(t)) or np.any(t < lo - 1e-9) or np.any(t > hi + 1e-9):
+            raise ValueError(f"running_time_s = {t.tolist()!r}: the front covers {lo:.2f}-{hi:.2f} s only")
+        nodes_t = self.table["running_time_s"].to_numpy()
+        nodes_e = self.table["energy_kwh"].to_numpy()
+        slope = self.table["lambda_kwh_per_s"].to_numpy()
+        bound = self.table["energy_bound_kwh"].to_numpy()
+        energy = np.interp(t, nodes_t, nodes_e)
+        k = np.clip(np.searchsorted(nodes_t, t, side="right") - 1, 0, len(nodes_t) - 2)
+        h = nodes_t[k + 1] - nodes_t[k]
+        chord = np.abs(slope[k] - slope[k + 1]) * h / 4.0
+        total = np.maximum(bound[k], bound[k + 1]) + chord
+        total = np.where(np.isclose(t, nodes_t[k]), bound[k], total)  # a node: its own bound only
+        total = np.where(np.isclose(t, nodes_t[k + 1]), bound[k + 1], total)
+        return energy, total
+
+    def dense(self, n_points: int = 100, window_s: tuple[float, float] | None = None) -> pd.DataFrame:
+        """The front at ``n_points`` running times (nodes included) in ``window_s``, with each point's bound."""
+        lo, hi = self.clip(window_s)
+        t = np.union1d(np.linspace(lo, hi, max(int(n_points), 2)), self.table["running_time_s"].to_numpy())
+        t = t[(t >= lo) & (t <= hi)]
+        energy, bound = self.energy_at(t)
+        return pd.DataFrame({"running_time_s": t, "energy_kwh": energy, "energy_bound_kwh": bound})
+
+    # ------------------------------------------------------------------ file format
+    def to_csv_text(self) -> str:
+        header = [f"# case_hash: {self.case_hash}", f"# case_name: {self.case_name}",
+                  f"# planned_time_s: {self.planned_time_s!r}", f"# dx_m: {self.dx_m!r}",
+                  f"# certificate: {self.certificate}", f"# version: {self.version}",
+                  "# energy_bound_kwh: bound on |energy_kwh - optimum| at running_time_s (kWh)"]
+        return "\n".join(header) + "\n" + self.table.loc[:, list(COLUMNS)].to_csv(index=False, float_format="%.9g")
+
+    @classmethod
+    def read_csv(cls, path: str | Path) -> CertifiedFront:
+        """Read a front written by :meth:`to_csv_text` (raises ValueError naming the file if malformed)."""
+        path = Path(path)
+        meta = {}
+        with open(path, encoding="utf-8") as handle:
+            for line in handle:
+                if not line.startswith("#"):
+                    break
+                key, _, value = line[1:].partition(":")
+                meta[key.strip()] = value.strip()
+        table = pd.read_csv(path, comment="#")
+        missing = [c for c in COLUMNS if c not in table.columns]
+        needed = ("case_hash", "case_name", "planned_time_s", "dx_m", "certificate", "version")
+        if missing or any(k not in meta for k in needed) or len(table) < 2:
+            raise ValueError(f"{path}: not a certified front file (missing columns {missing} or header fields)")
+        return cls(table, meta["case_hash"], meta["case_name"], float(meta["planned_time_s"]), float(meta["dx_m"]),
+                   meta["certificate"], meta["version"])
+
+
+def default_window(min_time_s: float, planned_time_s: float) -> tuple[float, float]:
+    """The running times a front covers and a problem's default window: planner's times around the plan.
+
+    From 0.5 % above the minimum running time (the flat-out run is a single point, not a front) to
+    ``FRONT_SPAN`` x the planned time (at least 1.2 x the minimum).
+    """
+    return min_time_s * 1.005, max(FRONT_SPAN * planned_time_s, 1.2 * min_time_s)
+
+
+def front_times(min_time_s: float, planned_time_s: float, n_times: int = DEFAULT_N_TIMES) -> np.ndarray:
+    """Requested running times of the nodes: across :func:`default_window`, with the planned time.
+
+    Spaced quadratically (denser near the minimum time, where the front is steepest).
+    """
+    lo, hi = default_window(min_time_s, planned_time_s)
+    u = np.linspace(0.0, 1.0, max(int(n_times) - 1, 2))
+    times = lo + (hi - lo) * u ** 2
+    if lo < planned_time_s < hi:
+        times = np.union1d(times, [planned_time_s])
+    return times
+
+
+def n_times_for(case: Case) -> int:
+    """Default number of front nodes of a case (fewer on long lines, where each DP solve costs more)."""
+    return DEFAULT_N_TIMES if case.line.length_m <= LONG_LINE_M else LONG_LINE_N_TIMES
+
+
+def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = None) -> CertifiedFront:
+    """Compute a case's certified front with the exact solver (no cache; see :func:`certified_front`)."""
+    from pymoo_rail.optimal import OptimalSolver, min_running_time, optimal_front
+    from pymoo_rail.optimal.solver import DEFAULT_N_SPEEDS
+
+    t_min = min_running_time(case, dx_m)
+    times = front_times(t_min, case.planned_time_s, n_times or n_times_for(case))
+    fine = optimal_front(case, times, dx_m=dx_m)
+    if "energy_bound_kwh" in fine.columns and fine["energy_bound_kwh"].notna().all():
+        bound = fine["energy_bound_kwh"].to_numpy(dtype=float)
+        certificate = "solver"
+    else:
+        coarse = optimal_front(case, times, dx_m=dx_m, n_speeds=DEFAULT_N_SPEEDS // COARSE_FACTOR)
+        bound = np.abs(fine["energy_at_request_kwh"].to_numpy() - coarse["energy_at_request_kwh"].to_numpy())
+        certificate = "two-grid"
+    bound = np.maximum(bound, BOUND_FLOOR_REL * np.abs(fine["energy_kwh"].to_numpy()))
+    table = pd.DataFrame({"requested_time_s": fine["requested_time_s"], "running_time_s": fine["running_time_s"],
+                          "energy_kwh": fine["energy_kwh"], "lambda_kwh_per_s": fine["lambda_kwh_per_s"],
+                          "energy_bound_kwh": bound})
+    table = table.sort_values("running_time_s", kind="stable").reset_index(drop=True)
+    step = OptimalSolver(case, dx_m).dx_m if dx_m is None else float(dx_m)
+    return CertifiedFront(table, case_hash(case), case.name, float(case.planned_time_s), float(step), certificate,
+                          f"pymoo_rail {__version__} / front {FRONT_VERSION}")
+
+
+def default_dx_m(case: Case) -> float:
+    """The simulator's default step for a case (the step the solver uses when none is given)."""
+    from pymoo_rail.sim import Simulator
+
+    return float(Simulator(case).grid.dx_m)
+
+
+def find_front(case: Case, dx_m: float | None = None, n_times: int | None = None) -> Path | None:
+    """The shipped or cached front file of a case, if any (shipped fronts first)."""
+    step = default_dx_m(case) if dx_m is None else float(dx_m)
+    name = f"{front_key(case, step, n_times or n_times_for(case))}.csv"
+    for directory in (SHIPPED_DIR, cache_dir()):
+        hits = sorted(directory.glob(f"*{name}")) if directory.is_dir() else []
+        if hits:
+            return hits[0]
+    return None
+
+
+_MEMORY: dict[str, CertifiedFront] = {}
+
+
+def forget_fronts() -> None:
+    """Drop the fronts held in memory (the disk cache stays): the next call reads or computes again."""
+    _MEMORY.clear()
+
+
+def certified_front(case: Case, dx_m: float | None = None, n_times: int | None = None,
+                    use_cache: bool = True) -> CertifiedFront:
+    """The certified front of a case: from memory, the shipped fronts, the user cache, or computed.
+
+    A computed front is written to the user cache atomically (a reader never sees half a file),
+    named ``<case name>-<key>.csv`` where the key is :func:`front_key` (content hash, step, nodes, version).
+    """
+    step = default_dx_m(case) if dx_m is None else float(dx_m)
+    n_times = n_times or n_times_for(case)
+    key = front_key(case, step, n_times)
+    if use_cache and key in _MEMORY:
+        return _MEMORY[key]
+    path = find_front(case, step, n_times) if use_cache else None
+    if path is not None:
+        front = CertifiedFront.read_csv(path)
+        if front.case_hash != case_hash(case):
+            raise ValueError(f"{path}: front of case hash {front.case_hash[:16]}, not of this case's content")
+    else:
+        front = compute_front(case, step, n_times)
+        safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in case.name)
+        atomic_write_text(cache_dir() / f"{safe}-{key}.csv", front.to_csv_text())
+    _MEMORY[key] = front
+    return front
+
+
+def mirrored(front: CertifiedFront, objectives: tuple[str, ...], n_points: int = 100,
+             window_s: tuple[float, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The front in a problem's objective space and the energy bound of each point.
+
+    ``objectives`` is ``("energy", "running_time")`` or ``("energy", "time_error")`` in any order.
+    Time error ``e = |T - T_plan|`` mirrors the front about the planned time: the least energy at
+    error ``e`` is the smaller of the optima at ``T_plan + e`` and ``T_plan - e`` (where the front
+    covers them). Dominated points (e.g. energy rising with time under auxiliary power) drop out.
+    ``window_s`` restricts the running times to the problem's window (see :meth:`CertifiedFront.clip`).
+    """
+    from pymoo.util.nds.non_dominated_sorting import find_non_dominated
+
+    if "time_error" in objectives:
+        lo, hi = front.clip(window_s)
+        plan = front.planned_time_s
+        e_max = max(hi - plan, plan - lo)
+        e_min = max(lo - plan, 0.0)  # a plan faster than the front's first node: errors start there
+        nodes = front.table["running_time_s"].to_numpy()
+        nodes = nodes[(nodes >= lo) & (nodes <= hi)]
+        err = np.union1d(np.linspace(e_min, e_max, max(int(n_points), 2)), np.abs(nodes - plan))
+        energy = np.full(err.shape, np.inf)
+        bound = np.zeros(err.shape)
+        for side in (plan + err, plan - err):
+            inside = (side >= lo - 1e-9) & (side <= hi + 1e-9)
+            e, b = front.energy_at(np.clip(side[inside], lo, hi))
+            better = e < energy[inside]
+            energy[np.flatnonzero(inside)[better]] = e[better]
+            bound[np.flatnonzero(inside)[better]] = b[better]
+        ok = np.isfinite(energy)
+        columns = {"energy": energy[ok], "time_error": err[ok]}
+        bound = bound[ok]
+    else:
+        dense = front.dense(n_points, window_s)
+        columns = {"energy": dense["energy_kwh"].to_numpy(), "running_time": dense["running_time_s"].to_numpy()}
+        bound = dense["energy_bound_kwh"].to_numpy()
+    F = np.column_stack([columns[name] for name in objectives])
+    keep = find_non_dominated(F)
+    keep = keep[np.argsort(F[keep, 0], kind="stable")]
+    return F[keep], bound[keep]
+
+
+def constrained_optimum(front: CertifiedFront, tolerance_s: float, n_points: int = 2001,
+                        window_s: tuple[float, float] | None = None) -> tuple[float, float, float]:
+    """Minimum energy with ``|T - T_plan| <= tolerance_s`` (and T in ``window_s``): (kWh, bound kWh, T s).
+
+    Runs faster than the front's first node (0.5 % above the minimum time) are left out: the
+    front falls steeply there, so they cost more than that node.
+    """
+    lo, hi = front.clip(window_s)
+    a = max(front.planned_time_s - tolerance_s, lo)
+    b = front.planned_time_s + tolerance_s
+    if b > hi + 0.5:
+        raise ValueError(f"time_tolerance_s = {tolerance_s}: the window around {front.planned_time_s} s "
+                         f"reaches beyond the front's range {lo:.2f}-{hi:.2f} s")
+    b = min(b, hi)
+    if not a < b:
+        raise ValueError(f"time_tolerance_s = {tolerance_s}: the window around {front.planned_time_s} s "
+                         f"misses the front's range {lo:.2f}-{hi:.2f} s")
+    t = np.union1d(np.linspace(a, b, n_points), front.table["running_time_s"].to_numpy())
+    t = t[(t >= a) & (t <= b)]
+    energy, bound = front.energy_at(t)
+    k = int(np.argmin(energy))
+    return float(energy[k]), float(bound[k]), float(t[k])
+
+
+__all__ = ["CertifiedFront", "NoExactFrontError", "case_hash", "cache_dir", "certified_front", "compute_front",
+           "constrained_optimum", "default_window", "find_front", "forget_fronts", "front_key", "front_times",
+           "mirrored", "FRONT_VERSION"]

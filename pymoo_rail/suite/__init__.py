@@ -1,0 +1,15 @@
+"""A benchmark suite of rail problems with certified exact fronts, in pymoo's style.
+
+>>> from pymoo_rail.suite import get_problem, list_problems
+>>> problem = get_problem("yizhuang-bi")        # energy and running time, the planner's window
+>>> pf = problem.pareto_front()                 # the certified front (shipped, or cached on disk)
+
+See ``docs/suite.md`` for the problems, how their fronts were computed and how exact they are.
+"""
+
+from pymoo_rail.problems.reference import CertifiedFront, NoExactFrontError
+from pymoo_rail.suite.fronts_io import best_known_front, compute_best_known_front, verify
+from pymoo_rail.suite.problems import CASES, SuiteCase, get_problem, list_problems, suite_case, tolerance_s
+
+__all__ = ["get_problem", "list_problems", "suite_case", "tolerance_s", "CASES", "SuiteCase", "verify",
+           "best_known_front", "compute_best_known_front", "CertifiedFront", "NoExactFrontError"]

@@ -1,0 +1,129 @@
+"""The suite's shipped fronts: verification against a fresh solve, and best-known fronts.
+
+Certified fronts are shipped in ``pymoo_rail/suite/fronts/<case>-<key>.csv`` (the key holds the
+case's content hash, see :mod:`pymoo_rail.problems.reference`), so ``pareto_front()`` of a suite
+problem reads them instead of solving. :func:`verify` solves again and fails on any drift beyond
+the certificate. Forms without an exact front (``metro-a-4obj``) ship a *best-known* front: the
+non-dominated union of long optimiser runs, labelled as such and versioned.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.atomic import atomic_write_text
+from pymoo_rail.problems import reference
+from pymoo_rail.suite.problems import CASES, METRO_4OBJ, METRO_4OBJ_OBJECTIVES, get_problem
+
+BEST_KNOWN_VERSION = "1"
+FRONTS_DIR = reference.SHIPPED_DIR
+
+
+def verify(names=None, progress: bool = True) -> pd.DataFrame:
+    """Solve every shipped front again and compare, node by node.
+
+    Parameters
+    ----------
+    names : sequence of str, optional
+        Suite case names (default: all).
+    progress : bool
+        Show a progress bar (one step per case).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per node: ``case``, ``requested_time_s``, ``shipped_kwh``, ``recomputed_kwh``,
+        ``drift_kwh``, ``certificate_kwh`` and ``ok`` (drift within the certificate). A case whose
+        shipped front is missing or was computed for other content gets one row with ``ok = False``
+        and a ``problem`` message.
+    """
+    from tqdm import tqdm
+
+    entries = [c for c in CASES if names is None or c.name in names]
+    unknown = set(names or ()) - {c.name for c in CASES}
+    if unknown:
+        raise ValueError(f"suite cases {sorted(unknown)} are unknown (known: {', '.join(c.name for c in CASES)})")
+    rows = []
+    for entry in tqdm(entries, desc="verify fronts", unit="case", disable=not progress):
+        case = entry.load()
+        path = reference.find_front(case)
+        if path is None or Path(path).parent != FRONTS_DIR:
+            rows.append({"case": entry.name, "ok": False, "problem": "no shipped front for this case's content"})
+            continue
+        shipped = reference.CertifiedFront.read_csv(path)
+        fresh = reference.compute_front(case, shipped.dx_m, len(shipped.table))
+        a, b = shipped.table, fresh.table
+        for k in range(len(a)):
+            drift = abs(b["energy_kwh"][k] - a["energy_kwh"][k])
+            slack = abs(b["running_time_s"][k] - a["running_time_s"][k]) * a["lambda_kwh_per_s"][k]
+            rows.append({"case": entry.name, "requested_time_s": a["requested_time_s"][k],
+                         "shipped_kwh": a["energy_kwh"][k], "recomputed_kwh": b["energy_kwh"][k],
+                         "drift_kwh": drift, "certificate_kwh": a["energy_bound_kwh"][k] + slack,
+                         "ok": bool(drift <= a["energy_bound_kwh"][k] + slack + 1e-9), "problem": ""})
+    return pd.DataFrame(rows)
+
+
+def best_known_path(name: str = METRO_4OBJ) -> Path:
+    return FRONTS_DIR / f"{name}-best-known-v{BEST_KNOWN_VERSION}.csv"
+
+
+def best_known_front(name: str = METRO_4OBJ) -> pd.DataFrame:
+    """The best-known front of a suite problem without an exact one (labelled, versioned).
+
+    Returns a DataFrame with one column per objective; ``attrs`` holds ``label`` ("best-known:
+    non-dominated union of ... runs, not certified"), ``version`` and ``runs``.
+    """
+    path = best_known_path(name)
+    if not path.is_file():
+        raise FileNotFoundError(f"{name}: no best-known front shipped ({path.name}); "
+                                f"compute one with pymoo_rail.suite.compute_best_known_front({name!r})")
+    meta = {}
+    with open(path, encoding="utf-8") as handle:
+        for line in handle:
+            if not line.startswith("#"):
+                break
+            key, _, value = line[1:].partition(":")
+            meta[key.strip()] = value.strip()
+    table = pd.read_csv(path, comment="#")
+    table.attrs.update(meta)
+    return table
+
+
+def compute_best_known_front(name: str = METRO_4OBJ, seeds=range(1, 6), pop_size: int = 100,
+                             n_gen: int = 300, write: bool = False) -> pd.DataFrame:
+    """Non-dominated union of NSGA-III and NSGA-II runs (feasible members) on a many-objective problem.
+
+    Each seed runs both algorithms (pymoo's, default operators) for ``n_gen`` generations.
+    ``write=True`` stores the result as the shipped best-known front.
+    """
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.algorithms.moo.nsga3 import NSGA3
+    from pymoo.optimize import minimize
+    from pymoo.util.nds.non_dominated_sorting import find_non_dominated
+    from pymoo.util.ref_dirs import get_reference_directions
+
+    if name != METRO_4OBJ:
+        raise ValueError(f"name = {name!r}: only {METRO_4OBJ!r} has no exact front in the suite")
+    problem = get_problem(name)
+    seeds = list(seeds)
+    ref_dirs = get_reference_directions("energy", problem.n_obj, pop_size, seed=1)
+    points = []
+    for seed in seeds:
+        for algorithm in (NSGA3(ref_dirs=ref_dirs), NSGA2(pop_size=pop_size)):
+            res = minimize(problem, algorithm, ("n_gen", n_gen), seed=seed)
+            feasible = res.pop.get("CV")[:, 0] <= 0
+            points.append(res.pop.get("F")[feasible])
+    F = np.unique(np.vstack(points), axis=0)
+    F = F[find_non_dominated(F)]
+    table = pd.DataFrame(F, columns=list(METRO_4OBJ_OBJECTIVES)).sort_values("energy").reset_index(drop=True)
+    label = (f"best-known: non-dominated union of the feasible final populations of NSGA-III and NSGA-II "
+             f"(pymoo defaults, population {pop_size}, {n_gen} generations, seeds {seeds[0]}-{seeds[-1]}); "
+             "not certified")
+    table.attrs.update(label=label, version=BEST_KNOWN_VERSION, case_hash=reference.case_hash(problem.case))
+    if write:
+        header = "".join(f"# {k}: {v}\n" for k, v in table.attrs.items())
+        atomic_write_text(best_known_path(name), header + table.to_csv(index=False, float_format="%.9g"))
+    return table

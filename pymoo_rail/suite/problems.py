@@ -1,0 +1,161 @@
+"""The named problems of the benchmark suite: which case, which form, which encoding.
+
+Every case gives two problems: ``<case>-bi``, energy and running time inside the planner's
+running-time window (:func:`pymoo_rail.problems.reference.default_window`), whose Pareto front is
+the certified front of the exact solver; and ``<case>-single``, energy under
+``|T - T_plan| <= 1 % of T_plan`` (at least 1 s), whose optimum is the front's least energy in that
+window. ``metro-a-4obj`` is the four-objective metro form of Meng et al. (2017) (energy, time
+error, jerk, stop error): no exact front exists; a best-known front is offered, labelled as such.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+from pymoo_rail.cases import load_case
+from pymoo_rail.model import Case
+
+TOLERANCE_REL = 0.01
+"""Running-time tolerance of the single-objective forms, relative to the planned time."""
+SECTIONS_PER_LINE = 12
+"""Speed-code sections of a suite problem: gradient/limit sections split to at most length / 12."""
+
+
+@dataclass(frozen=True)
+class SuiteCase:
+    """One case of the suite: a built-in case, or a section of a real TTOBench line.
+
+    Attributes
+    ----------
+    name : str
+        Suite name of the case (the problems are ``<name>-bi`` and ``<name>-single``).
+    builtin : str, optional
+        Built-in case name (:func:`pymoo_rail.cases.load_case`).
+    ttobench_stops : (str, str), optional
+        Departure and arrival stop of the TTOBench Yizhuang line with the Beijing subway train.
+    planned_time_s : float, optional
+        Planned time of a TTOBench section (TTOBench has no timetable).
+    summary : str
+        One line on what the case is, for ``list_problems`` and the docs.
+    """
+
+    name: str
+    summary: str
+    builtin: str | None = None
+    ttobench_stops: tuple[str, str] | None = None
+    planned_time_s: float | None = None
+
+    def load(self) -> Case:
+        """The case itself."""
+        if self.builtin is not None:
+            return load_case(self.builtin)
+        from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
+
+        a, b = self.ttobench_stops
+        case = from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, a, b, self.planned_time_s,
+                             stop_names=YIZHUANG_STOP_NAMES, name=self.name)
+        return case
+
+
+_TTOBENCH_PLAN = ("planned time reconstructed: 10 % above the minimum running time of this model, "
+                  "rounded up to 5 s (TTOBench has no timetable)")
+
+CASES: tuple[SuiteCase, ...] = (
+    SuiteCase("yizhuang", "Beijing Yizhuang line, Tongjinan Rd -> Jinghai Rd, 2265 m, 150 s "
+              "(Liu 2019, seed data of the ABC thesis)", builtin="yizhuang"),
+    SuiteCase("yizhuang-ttobench", "the same run with TTOBench's line and Beijing subway train, 150 s",
+              builtin="yizhuang-ttobench"),
+    SuiteCase("metro-a", "A-type metro, 1000 m, -5 / +10 permille, 70 s (Meng et al. 2017)", builtin="metro-a"),
+    SuiteCase("ttobench-songjiazhuang-xiaocun", "TTOBench Yizhuang line, Songjiazhuang -> Xiaocun, 2631 m, "
+              "+10.4 / -8 permille, 170 s; " + _TTOBENCH_PLAN,
+              ttobench_stops=("Songjiazhuang", "Xiaocun"), planned_time_s=170.0),
+    SuiteCase("ttobench-xiaohongmen-jiugong", "TTOBench Yizhuang line, Xiaohongmen -> Jiugong, 2366 m, "
+              "-20.4 / -24 permille descents, 145 s; " + _TTOBENCH_PLAN,
+              ttobench_stops=("Xiaohongmen", "Jiugong"), planned_time_s=145.0),
+    SuiteCase("ttobench-wanyuan-rongjing", "TTOBench Yizhuang line, Wanyuan St -> Rongjing East St, 1280 m, 90 s; "
+              + _TTOBENCH_PLAN, ttobench_stops=("Wanyuan St", "Rongjing East St"), planned_time_s=90.0),
+    SuiteCase("ttobench-ref", "48.5 km TTOBench reference, level, 100 km/h on 25-35 km, 391 t intercity, 1541 s "
+              "(reconstructed from the public TTOBench reference)", builtin="ttobench-ref"),
+    SuiteCase("ttobench-ref-uphill", "the reference with a +5 permille climb on 25-35 km", builtin="ttobench-ref-uphill"),
+    SuiteCase("ttobench-ref-downhill", "the reference with a -5 permille descent on 25-35 km",
+              builtin="ttobench-ref-downhill"),
+    SuiteCase("ttobench-ref-limit120", "the reference with 120 km/h (not 100) on 25-35 km",
+              builtin="ttobench-ref-limit120"),
+)
+
+METRO_4OBJ = "metro-a-4obj"
+METRO_4OBJ_OBJECTIVES = ("energy", "time_error", "jerk", "stop_error")
+
+
+@lru_cache(maxsize=None)
+def _cases() -> dict[str, SuiteCase]:
+    return {c.name: c for c in CASES}
+
+
+def list_problems() -> list[str]:
+    """Names of the suite's problems (``<case>-bi``, ``<case>-single`` and ``metro-a-4obj``)."""
+    names = []
+    for c in CASES:
+        names += [f"{c.name}-bi", f"{c.name}-single"]
+    return names + [METRO_4OBJ]
+
+
+def split(name: str) -> tuple[SuiteCase, str]:
+    """The suite case and the form (``"bi"``, ``"single"`` or ``"4obj"``) of a problem name."""
+    if not isinstance(name, str):
+        raise ValueError(f"problem name {name!r}: must be a string (see list_problems())")
+    if name == METRO_4OBJ:
+        return _cases()["metro-a"], "4obj"
+    base, _, form = name.rpartition("-")
+    if form not in ("bi", "single") or base not in _cases():
+        raise ValueError(f"problem name {name!r} is unknown (known: {', '.join(list_problems())})")
+    return _cases()[base], form
+
+
+def suite_case(name: str) -> Case:
+    """The case behind a problem name (or a suite case name)."""
+    if name in _cases():
+        return _cases()[name].load()
+    return split(name)[0].load()
+
+
+def tolerance_s(case: Case) -> float:
+    """Running-time tolerance of the single-objective form: 1 % of the planned time, at least 1 s."""
+    return max(1.0, TOLERANCE_REL * case.planned_time_s)
+
+
+def get_problem(name: str, **kwargs):
+    """A suite problem by name, in pymoo's style (``pymoo.problems.get_problem``).
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_problems`.
+    **kwargs
+        Passed on to :class:`~pymoo_rail.problems.SpeedProfileProblem` (e.g. ``encoding``);
+        they override the suite's defaults, and the problem is then no longer the suite's.
+
+    Returns
+    -------
+    SpeedProfileProblem
+        ``problem.pareto_front()`` is the certified front (``-bi``), the certified optimum
+        (``-single``); ``metro-a-4obj`` raises :class:`~pymoo_rail.problems.reference.NoExactFrontError`
+        and :func:`pymoo_rail.suite.best_known_front` gives its best-known front.
+    """
+    from pymoo_rail.problems import SpeedProfileProblem
+
+    entry, form = split(name)
+    case = entry.load()
+    settings = dict(encoding="speed_codes", partition="gradient_limit",
+                    max_section_m=case.line.length_m / SECTIONS_PER_LINE)
+    if form == "bi":
+        settings.update(objectives=("energy", "running_time"), time_window_s="default")
+    elif form == "single":
+        settings.update(objectives=("energy",), time_tolerance_s=tolerance_s(case))
+    else:
+        settings.update(objectives=METRO_4OBJ_OBJECTIVES)
+    settings.update(kwargs)
+    problem = SpeedProfileProblem(case, **settings)
+    problem.suite_name = name
+    return problem

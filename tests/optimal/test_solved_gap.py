@@ -1,0 +1,45 @@
+"""Exact gaps: each optimiser point against the optimum solved at its own running time."""
+
+import numpy as np
+import pytest
+from pymoo.optimize import minimize
+
+from pymoo_rail.algorithms import MOABC
+from pymoo_rail.optimal import ReferenceAtTime, solved_energy_gap
+from pymoo_rail.problems import SpeedProfileProblem
+
+
+@pytest.fixture(scope="module")
+def reference(yizhuang):
+    return ReferenceAtTime(yizhuang, n_speeds=100)
+
+
+def test_no_optimiser_point_lies_below_the_reference_by_more_than_its_certificate(yizhuang, reference):
+    problem = SpeedProfileProblem(yizhuang, objectives=("energy", "running_time"))
+    res = minimize(problem, MOABC(pop_size=20), ("n_gen", 15), seed=3)
+    front = res.F[np.argsort(res.F[:, 1])][:, ::-1]  # (running time, energy)
+    picks = front[np.linspace(0, front.shape[0] - 1, min(4, front.shape[0])).astype(int)]
+    result = solved_energy_gap(picks, reference)
+    points = result["points"]
+    assert points["in_range"].all()
+    assert (points["energy_bound_kwh"] >= 0).all()
+    # a point below the optimum by more than the certificate would be a defect of the reference
+    assert result["n_below_reference"] == 0, points
+    assert (points["gap_kwh"] >= -points["energy_bound_kwh"]).all()
+
+
+def test_a_point_below_the_certified_optimum_is_flagged(reference):
+    at = reference.at(150.0)
+    below = at["optimal_kwh"] - 2.0 * at["energy_bound_kwh"] - 1e-3
+    within = at["optimal_kwh"] - 0.5 * at["energy_bound_kwh"]
+    result = solved_energy_gap(np.array([[150.0, below], [150.0, within], [100.0, 30.0]]), reference)
+    assert list(result["points"]["below_reference"]) == [True, False, False]
+    assert list(result["points"]["in_range"]) == [True, True, False]  # 100 s is below the minimum time
+    assert result["n_below_reference"] == 1 and result["n_out_of_range"] == 1
+
+
+def test_the_solved_optimum_lies_on_or_below_the_interpolated_front(yizhuang, reference):
+    # convexity: the chord between two solved points lies above the optimum between them
+    a, b, mid = reference.at(140.0), reference.at(180.0), reference.at(160.0)
+    chord = 0.5 * (a["optimal_kwh"] + b["optimal_kwh"])
+    assert mid["optimal_kwh"] <= chord + mid["energy_bound_kwh"]

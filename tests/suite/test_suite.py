@@ -1,0 +1,135 @@
+"""The rail benchmark suite: names, shipped certified fronts, pareto_front(), the done-when check."""
+
+import numpy as np
+import pytest
+from pymoo.algorithms.moo.nsga2 import NSGA2
+from pymoo.indicators.igd import IGD
+from pymoo.operators.sampling.rnd import FloatRandomSampling
+from pymoo.optimize import minimize
+from pymoo.util.nds.non_dominated_sorting import find_non_dominated
+
+from pymoo_rail.problems import reference as ref
+from pymoo_rail.suite import CASES, NoExactFrontError, best_known_front, get_problem, list_problems, suite_case
+from pymoo_rail.suite.problems import tolerance_s
+
+
+def test_names_in_pymoos_style():
+    names = list_problems()
+    assert len(names) >= 12 and len(set(names)) == len(names)
+    assert sum(n.endswith("-bi") for n in names) == sum(n.endswith("-single") for n in names) == len(CASES)
+    assert "metro-a-4obj" in names
+    with pytest.raises(ValueError, match="yizhuang-bi"):
+        get_problem("zdt1")
+
+
+@pytest.mark.parametrize("entry", CASES, ids=lambda c: c.name)
+def test_every_case_ships_a_front_of_its_current_content(entry):
+    """A shipped front belongs to the case's content: editing a case without recomputing is caught."""
+    case = entry.load()
+    path = ref.find_front(case)
+    assert path is not None and path.parent == ref.SHIPPED_DIR, f"{entry.name}: no shipped front"
+    front = ref.CertifiedFront.read_csv(path)
+    assert front.case_hash == ref.case_hash(case)
+    t = front.table
+    assert np.all(np.diff(t["running_time_s"]) > 0) and np.all(np.diff(t["energy_kwh"]) < 0)
+    assert (t["energy_bound_kwh"] > 0).all()
+    # the single-objective form's window lies inside the front
+    lo, hi = front.time_range_s
+    assert case.planned_time_s + tolerance_s(case) <= hi
+
+
+def test_pareto_front_is_read_not_solved(monkeypatch):
+    """pareto_front() of a suite problem reads the shipped file: solving would raise here."""
+    def no_solver(*args, **kwargs):
+        raise AssertionError("the solver ran although the front is shipped")
+
+    monkeypatch.setattr(ref, "compute_front", no_solver)
+    ref.forget_fronts()
+    problem = get_problem("metro-a-bi")
+    pf = problem.pareto_front()
+    assert pf.shape == (pf.shape[0], 2) and pf.shape[0] >= 100
+    assert problem.pareto_front() is pf  # pymoo's own cache on the second call
+    (best,), = get_problem("metro-a-single").pareto_front()
+    e, b, t = ref.constrained_optimum(problem.certified_front(), tolerance_s(problem.case))
+    assert best == e
+
+
+def test_four_objectives_offer_a_labelled_best_known_front():
+    problem = get_problem("metro-a-4obj")
+    with pytest.raises(NoExactFrontError, match="best-known"):
+        problem.pareto_front()
+    front = best_known_front("metro-a-4obj")
+    assert list(front.columns) == ["energy", "time_error", "jerk", "stop_error"]
+    assert front.attrs["label"].startswith("best-known") and "not certified" in front.attrs["label"]
+    assert front.attrs["version"] and front.attrs["case_hash"] == ref.case_hash(problem.case)
+    F = front.to_numpy()
+    assert len(find_non_dominated(F)) == len(F)
+
+
+def _nsga2_vs_random(name: str) -> tuple[float, float, int]:
+    problem = get_problem(name)
+    pf = problem.pareto_front()
+    res = minimize(problem, NSGA2(pop_size=100), ("n_gen", 200), seed=1)
+    X = FloatRandomSampling()(problem, 100 * 200, random_state=np.random.default_rng(1)).get("X")
+    out = problem.evaluate(X, return_as_dictionary=True)
+    F = out["F"][np.all(out["G"] <= 0, axis=1)]
+    F = F[find_non_dominated(F)]
+    # no feasible member below the certified front by more than its certificate
+    front = problem.certified_front()
+    t = res.pop.get("running_time_s")[res.pop.get("CV")[:, 0] <= 0]
+    e = res.pop.get("energy_kwh")[res.pop.get("CV")[:, 0] <= 0]
+    lo, hi = front.time_range_s
+    inside = (t >= lo) & (t <= hi)
+    optimum, bound = front.energy_at(t[inside])
+    return float(IGD(pf)(res.F)), float(IGD(pf)(F)) if len(F) else np.inf, int(np.sum(e[inside] < optimum - bound))
+
+
+def test_nsga2_beats_random_sampling_against_the_certified_front():
+    nsga2, random, below = _nsga2_vs_random("metro-a-bi")
+    assert np.isfinite(nsga2) and nsga2 < random
+    assert below == 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [n for n in list_problems() if n.endswith("-bi")])
+def test_every_problem_nsga2_beats_random_sampling(name):
+    nsga2, random, below = _nsga2_vs_random(name)
+    assert np.isfinite(nsga2) and nsga2 < random
+    assert below == 0
+
+
+def test_study_registry_builds_suite_problems():
+    from pymoo_rail.experiments import problem as problem_spec
+    from pymoo_rail.experiments.registry import build_problem
+    from pymoo_rail.experiments.spec import StudyError
+
+    built = build_problem(problem_spec("rail_suite", suite_problem="metro-a-single"))
+    assert built.objectives == ("energy",) and built.time_tolerance_s == pytest.approx(1.0)
+    with pytest.raises(StudyError, match="atlantis"):
+        build_problem(problem_spec("rail_suite", suite_problem="atlantis-bi"))
+
+
+def test_cli_suite_list(capsys):
+    from pymoo_rail.cli import main
+
+    assert main(["suite", "list"]) == 0
+    out = capsys.readouterr().out
+    assert "metro-a-bi" in out and "certified front" in out and "best-known" in out
+    assert main(["suite", "verify", "atlantis"]) == 2
+
+
+def test_cli_optimize_draws_the_optimum_and_prints_the_gap(capsys, tmp_path, monkeypatch):
+    from pymoo_rail.cli import main
+
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    code = main(["optimize", "metro-a", "--pop-size", "12", "--n-gen", "3", "--out", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert code == 0 and "gap to the optimum at" in out and "certified within" in out
+    assert (tmp_path / "front.png").is_file() and (tmp_path / "profile.png").is_file()
+    import pandas as pd
+
+    front = pd.read_csv(tmp_path / "front.csv")
+    problem = get_problem("metro-a-bi")
+    lo, hi = problem.time_window_s
+    feasible = front[front["feasible"]]
+    assert ((feasible["running_time_s"] >= lo - 1e-6) & (feasible["running_time_s"] <= hi + 1e-6)).all()

@@ -1,0 +1,163 @@
+"""What a newcomer meets first: CLI messages and defaults, distinct fronts, names, the compile notice."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from numba import njit
+from pymoo.core.population import Population
+
+from pymoo_rail.cli import main
+from pymoo_rail.experiments import distinct_front, distinct_index
+from pymoo_rail.problems import SpeedProfileProblem
+from pymoo_rail.sim import REGIME_NAMES
+from pymoo_rail.sim.jit import compile_notice
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+# ---------------------------------------------------------------- CLI
+
+
+def test_one_objective_without_tolerance_gets_a_time_constraint(capsys, tmp_path):
+    code, out, err = run(capsys, "optimize", "yizhuang", "--objectives", "energy", "--algorithm", "ga",
+                         "--pop-size", 8, "--n-gen", 2, "--out", tmp_path, "-q")
+    assert code == 0, err
+    # stop, limits and |T - T_plan| <= 1 s: three constraints, and the user is told
+    assert "3 constraints" in out and "|T - T_plan| <= 1 s" in out
+    front = pd.read_csv(tmp_path / "front.csv")
+    ok = front[front["feasible"]]
+    assert np.all(np.abs(ok["running_time_s"] - 150.0) <= 1.0 + 1e-9)
+    assert "front: 1 solution (" in out  # one objective: one member, in the singular
+
+
+def test_reference_with_an_impossible_time_exits_2_before_computing(capsys, tmp_path):
+    out_dir = tmp_path / "ref"
+    code, out, err = run(capsys, "reference", "yizhuang", "--times", 20, 150, "--out", out_dir)
+    assert code == 2
+    assert "argument --times" in err and "20 s is below the minimum running time" in err
+    assert not out_dir.exists()  # nothing computed, nothing written
+
+
+def test_plot_front_keeps_the_figure_optimize_wrote(capsys, tmp_path):
+    pd.DataFrame({"chosen": [True, False], "f_energy": [12.0, 11.0], "f_time_error": [0.5, 3.0],
+                  "running_time_s": [150.5, 153.0], "energy_kwh": [12.0, 11.0]}).to_csv(tmp_path / "front.csv",
+                                                                                      index=False)
+    sentinel = b"the figure optimize wrote"
+    (tmp_path / "front.png").write_bytes(sentinel)
+    code, out, err = run(capsys, "plot", "front", tmp_path / "front.csv")
+    assert code == 0, err
+    assert (tmp_path / "front.png").read_bytes() == sentinel
+    assert (tmp_path / "front_plot.png").stat().st_size > 500 and "front_plot.png" in out
+
+
+@pytest.mark.parametrize("command", ["optimize", "reference", "study", "warmup"])
+def test_help_states_each_default_once(capsys, command):
+    code, out, _ = run(capsys, command, "--help")
+    assert code == 0
+    options = out.split("options:\n", 1)[1].split("\n\n", 1)[0]  # the option list, not the description
+    text = " ".join(options.split())
+    assert "(default: None)" not in text and "(default: False)" not in text
+    for option in text.split(" --")[1:]:
+        assert option.count("default") <= 1, option
+
+
+def test_outputs_say_hold(capsys, tmp_path):
+    assert "hold" in REGIME_NAMES and "cruise" not in REGIME_NAMES
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.sim import Simulator
+
+    table = Simulator(load_case("yizhuang")).flat_out().to_frame()
+    assert set(table["regime"]) <= set(REGIME_NAMES)
+    # tables written before "hold" still plot
+    table["regime"] = table["regime"].replace({"traction": "cruise"})
+    table.to_csv(tmp_path / "old.csv", index=False)
+    code, _, err = run(capsys, "plot", "trajectory", tmp_path / "old.csv", "--out", tmp_path / "old.png")
+    assert code == 0, err
+
+
+def test_warmup_command(capsys):
+    code, out, err = run(capsys, "warmup")
+    assert code == 0, err
+    assert "simulator: ready" in out
+    code, _, err = run(capsys, "warmup", "--all", "--bogus")
+    assert code == 2
+
+
+# ---------------------------------------------------------------- distinct fronts
+
+
+def test_distinct_index_keeps_one_member_per_objective_vector():
+    F = np.array([[1.0, 2.0], [0.5, 3.0], [1.0, 2.0], [0.5, 3.0], [2.0, 1.0]])
+    CV = np.array([0.3, 0.0, 0.0, 0.0, 0.0])
+    keep = distinct_index(F, CV)
+    np.testing.assert_array_equal(keep, [1, 2, 4])  # the feasible copy of [1, 2], the first of [0.5, 3]
+    assert len(np.unique(F[keep], axis=0)) == len(keep)
+    pop = Population.new(X=np.arange(10.0).reshape(5, 2), F=F, CV=CV[:, None])
+    front = distinct_front(pop)
+    np.testing.assert_array_equal(front.get("X")[:, 0], [2.0, 4.0, 8.0])
+    assert len(distinct_front(None)) == 0
+
+
+def test_moabc_front_written_by_the_cli_has_distinct_objective_vectors(capsys, tmp_path):
+    code, out, err = run(capsys, "optimize", "yizhuang", "--algorithm", "moabc", "--pop-size", 10, "--n-gen", 4,
+                         "--out", tmp_path, "-q")
+    assert code == 0, err
+    F = pd.read_csv(tmp_path / "front.csv")[["f_energy", "f_time_error"]].to_numpy()
+    assert len(np.unique(F, axis=0)) == len(F)
+
+
+def test_study_records_have_distinct_objective_vectors():
+    from pymoo_rail.experiments import Budget, RunSpec, algorithm, execute_run, problem
+
+    run_ = RunSpec(problem("zdt1", n_var=4), algorithm("moabc", pop_size=10), 1, Budget("n_gen", 5))
+    F = np.asarray(execute_run(run_)["front"]["F"])
+    assert len(F) and len(np.unique(F, axis=0)) == len(F)
+
+
+# ---------------------------------------------------------------- names
+
+
+def test_accel_variation_is_the_objective_jerk_names(yizhuang):
+    by_jerk = SpeedProfileProblem(yizhuang, objectives=("energy", "jerk"))
+    by_name = SpeedProfileProblem(yizhuang, objectives=("energy", "accel_variation"))
+    X = by_name.xl + (by_name.xu - by_name.xl) * np.random.default_rng(3).uniform(0.3, 1.0, (5, by_name.n_var))
+    np.testing.assert_array_equal(by_jerk.evaluate(X, return_values_of=["F"]),
+                                  by_name.evaluate(X, return_values_of=["F"]))
+    with pytest.raises(ValueError, match="alias"):
+        SpeedProfileProblem(yizhuang, objectives=("jerk", "accel_variation"))
+    tr = by_name.trajectory(X[0])
+    # what it measures: the total variation of the acceleration from rest to rest, in m/s^2
+    a = np.concatenate([[0.0], tr.accel_ms2[:-1], [0.0]])
+    assert tr.accel_variation_ms2 == pytest.approx(np.abs(np.diff(a)).sum(), rel=1e-9)
+    assert tr.jerk_ms2 == tr.accel_variation_ms2
+    weighted = SpeedProfileProblem(yizhuang, objectives=("energy", "jerk"), weights=(1.0, 1.0))
+    assert weighted.scales[1] == pytest.approx(max(by_name.simulator.flat_out().accel_variation_ms2, 1e-9))
+
+
+# ---------------------------------------------------------------- first run
+
+
+def test_compile_notice_says_once_and_sums_up():
+    def probe(x):
+        return x + 1.0
+
+    probe.__module__ = "pymoo_rail.probe"  # the notice is for the package's kernels only
+    lines = []
+    with compile_notice(say=lines.append) as watch:
+        fast = njit(probe)
+        fast(1.0)
+        fast(2)  # a second specialisation: compiled, not announced again
+    assert lines[0].startswith("compiling the simulator") and "first run only" in lines[0]
+    assert len(lines) == 2 and lines[1].startswith("compiled 2 simulator functions")
+    assert watch.n_compiled == 2 and watch.compile_s > 0
+    lines.clear()
+    with compile_notice(say=lines.append):
+        fast(3.0)  # already compiled: silent
+        njit(lambda x: x * 2)(1.0)  # not ours: silent
+    assert lines == []
