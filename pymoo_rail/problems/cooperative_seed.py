@@ -5,7 +5,7 @@ decision vector, with the paper's repair and nested GA; it needs them (random ve
 only 2-4 % of the time), which the paced encoding of ``CooperativeTrainsProblem`` does not.
 
 Train A runs leg 0 of a two-leg case (station 1 -> 2), train B leg 1 (station 2 -> 3); B leaves
-station 2 ``offset_s`` seconds after A leaves station 1 (the seed's x; negative: B leaves first).
+station 2 ``offset_s`` seconds after A leaves station 1 (the paper's x; negative: B leaves first).
 Both legs lie in one power-supply section, so while one train brakes the other can draw the
 regenerated power (with utilisation eta, the case's ``regen_efficiency``). B runs ahead of A on
 the line, so A is the following train of the separation rule (eq. 9).
@@ -20,7 +20,7 @@ Decision vector (Chen et al. 2017 section 3.1, one flat vector):
   (eq. 1). Subsections beyond the braking point are ignored; the one holding it ends there.
   ``v_k`` is, by default, the position of the exit speed in the range the operating sequence
   can reach from the entry speed (0: the lowest, 1: the highest); ``speed_genes="absolute"``
-  makes it a speed in km/h, moved into that range when outside it (the seed's repair).
+  makes it a speed in km/h, moved into that range when outside it (the paper's repair).
 
 Decoding (:mod:`pymoo_rail.sim.subsections`) follows the operating sequences of table 1 and the
 time allotment of eq. 1. Energies are per train: traction drawn ``F v / eta_traction``;
@@ -29,8 +29,8 @@ the total net energy (eq. 6). Constraints (``G <= 0``): each train's running tim
 ``time_tolerance_s`` of its plan, speed limits (eq. 7), comfort at gradient changes (eq. 8),
 separation (eq. 9), and the physical feasibility of the decoded sequences.
 
-:class:`SubsectionProblem` is the same model for one train alone (the seed's encoding of the
-uncoordinated case); :class:`PunctualityRepair` is the seed's repair as a pymoo ``Repair``;
+:class:`SubsectionProblem` is the same model for one train alone (the paper's encoding of the
+uncoordinated case); :class:`PunctualityRepair` is the paper's repair as a pymoo ``Repair``;
 :func:`nested_minimize` is the nested GA of section 3.
 """
 
@@ -116,7 +116,7 @@ def _train_setup(case: Case, start_m: float, model: KernelModel, decel_ms2: floa
     change = np.zeros(sub_start.shape[0], dtype=np.bool_)
     for j in range(1, sub_start.shape[0]):
         change[j] = grade_at(pos[sub_start[j]] - 0.5 * dx) != grade_at(pos[sub_start[j]] + 0.5 * dx)
-    # the seed's range: braking at b from the approach limit, times r (section 3.2)
+    # the paper's range: braking at b from the approach limit, times r (section 3.2)
     v_end = caps[-1]
     upper = min(range_factor * v_end * v_end / (2.0 * decel_ms2), 0.9 * line.length_m)
     return TrainSetup(case=case, model=model, start_m=start_m, sub_start=sub_start, sub_end=sub_end,
@@ -268,7 +268,7 @@ class _SubsectionModel(Problem):
 
 
 class SubsectionProblem(_SubsectionModel):
-    """One train alone in the seed's subsection model: least traction energy, on time.
+    """One train alone in the paper's subsection model: least traction energy, on time.
 
     The uncoordinated case of Chen et al. (2017) in its own encoding. Decision vector
     ``[dS, gamma_1, v_1, q_1, ..., gamma_m, v_m, q_m]``; parameters as in
@@ -446,7 +446,7 @@ class CooperativeSeedProblem(_SubsectionModel):
                 f"B {b.n_sub} subsections, {self.n_var} variables, {self.n_ieq_constr} constraints)")
 
 
-# ---------------------------------------------------------------------- the seed's repair
+# ---------------------------------------------------------------------- the paper's repair
 class PunctualityRepair(Repair):
     """The repair of Chen et al. (2017) section 3.2, step 1, as a pymoo ``Repair`` (Lamarckian: genes are rewritten).
 
@@ -572,8 +572,8 @@ def nested_minimize(problem: CooperativeSeedProblem, *, outer_pop_size: int = 24
     """The nested GA of Chen et al. (2017) section 3: an outer pymoo GA on the braking distances whose every
     evaluation runs an inner pymoo GA on the traction coefficients, exit speeds and time shares.
 
-    Defaults are the seed's sizes (section 4.1: outer 24 x 20, inner 100 x 80); pymoo's GA
-    operators (SBX, polynomial mutation, elitist survival) stand in for the seed's roulette wheel
+    Defaults are the paper's sizes (section 4.1: outer 24 x 20, inner 100 x 80); pymoo's GA
+    operators (SBX, polynomial mutation, elitist survival) stand in for the paper's roulette wheel
     and one/two-point operators. Returns ``(x, F, outer_result)`` with ``x`` the full best vector.
     """
     from pymoo.algorithms.soo.nonconvex.ga import GA

@@ -387,7 +387,7 @@ def time_window(m, sub_start, sub_end, sub_kind, sub_cap, brake_dist_m, gamma, v
 @njit(cache=True)
 def repair_one(m, sub_start, sub_end, sub_kind, sub_cap, brake_dist_m, gamma, v_rel, planned_time_s, service_decel_ms2,
                v_floor_ms, gamma_out, v_out, iterations):
-    """The seed's repair (section 3.2, step 1) for relative speed genes: move the exit speeds until
+    """The paper's repair (section 3.2, step 1) for relative speed genes: move the exit speeds until
     the planned time lies in the window of eq. 10.
 
     Too slow: every exit speed and traction coefficient moves the same fraction lam toward 1 (the
