@@ -223,6 +223,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
 
     p = sub.add_parser(
+        "timetable", help="several trains sharing braking energy: departures and driving", formatter_class=_Formatter,
+        description="Optimise a timetable of trains on a case (pymoo_rail.problems.TimetableProblem): departures "
+                    "free within a window around a regular headway, every train's driving shape paced to its "
+                    "planned time, regenerated energy shared within one power-supply section. NSGA-II on net "
+                    "substation energy and mean passenger waiting time; writes front.csv (with the reference "
+                    "of every train exactly optimal alone when --reference is given).",
+        epilog="examples:\n  pymoo-rail timetable cooperative-pair --trains 4 --headway 120 --out out/tt\n"
+               "  pymoo-rail timetable cooperative-pair --trains 8 --headway 90 --n-eval 4000 --reference")
+    p.add_argument("case", metavar="CASE", help="built-in case name or a .toml case file")
+    p.add_argument("--trains", type=_positive_int, default=4, metavar="N", help="number of trains (>= 2)")
+    p.add_argument("--headway", type=_positive_float, default=120.0, metavar="S", help="nominal headway (s)")
+    p.add_argument("--window", type=float, default=30.0, metavar="S", help="departure window +- (s)")
+    p.add_argument("--efficiency", type=_positive_float, default=0.9, metavar="ETA",
+                   help="transmission efficiency of the supply between trains")
+    p.add_argument("--pop-size", type=_positive_int, default=40, metavar="N")
+    p.add_argument("--n-eval", type=_positive_int, default=2000, metavar="N", help="evaluations")
+    p.add_argument("--seed", type=_seed, default=1)
+    p.add_argument("--reference", action="store_true",
+                   help="also compute every train's exact optimum alone (about a CPU minute per leg)")
+    p.add_argument("--out", default="out", metavar="DIR", help="output directory")
+
+    p = sub.add_parser(
         "warmup", help="compile the simulator's kernels now (container images, clusters)", formatter_class=_Formatter,
         description="Compile the Numba kernels a command uses and store them in Numba's cache (next to the "
                     "installed package, or in NUMBA_CACHE_DIR), so that the first real run starts at once. Run "
@@ -672,6 +694,44 @@ def cmd_reference(args) -> int:
     return 0
 
 
+def cmd_timetable(args) -> int:
+    import numpy as np
+    import pandas as pd
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.optimize import minimize
+
+    from pymoo_rail.problems import TimetableProblem
+
+    case = _load_case("CASE", args.case)
+    if args.trains < 2:
+        raise UsageError("--trains", f"needs at least 2 trains, got {args.trains}")
+    problem = TimetableProblem(case, args.trains, args.headway, window_s=args.window,
+                               transmission_efficiency=args.efficiency)
+    _say(problem.describe())
+    res = minimize(problem, NSGA2(pop_size=args.pop_size), ("n_eval", args.n_eval), seed=args.seed)
+    opt = res.algorithm.opt
+    front = pd.DataFrame({"net_kwh": opt.get("net_kwh"), "waiting_time_s": opt.get("waiting_time_s"),
+                          "traction_kwh": opt.get("traction_kwh"), "shared_kwh": opt.get("shared_kwh"),
+                          "cv": opt.get("CV")[:, 0]})
+    for i in range(args.trains - 1):
+        front[f"shift_{i + 1}_s"] = opt.get("X")[:, i]
+    if args.reference:
+        from pymoo_rail.problems.cooperative_baseline import exact_baseline
+
+        reference = args.trains * exact_baseline(case).energy_kwh
+        front["reference_kwh"] = reference
+        front["saving_pct"] = 100.0 * (1.0 - front["net_kwh"] / reference)
+        _say(f"reference (every train exactly optimal alone, nothing shared): {reference:.3f} kWh")
+    out = _out_dir(args.out)
+    front = front.sort_values("net_kwh").reset_index(drop=True)
+    front.to_csv(out / "front.csv", index=False)
+    best = front.iloc[0]
+    _say(f"{len(front)} solutions; least energy {best['net_kwh']:.3f} kWh ({best['shared_kwh']:.3f} kWh shared, "
+         f"mean wait {best['waiting_time_s']:.1f} s); regular timetable wait {args.headway / 2:.1f} s")
+    _say(f"wrote {out / 'front.csv'}")
+    return 0 if np.all(front["cv"] <= 0) else 1
+
+
 def _study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool) -> list[Path]:
     from pymoo_rail.experiments import load_results
     from pymoo_rail.experiments.stats import write_tables
@@ -787,7 +847,7 @@ def _objective_of_column(column: str) -> str:
 
 
 def cmd_warmup(args) -> int:
-    from pymoo_rail.sim.jit import WARMUP_PARTS, warmup
+    from pymoo_rail.warmup import WARMUP_PARTS, warmup
 
     parts = WARMUP_PARTS if args.all else ("simulator",)
     for part, seconds in warmup(parts).items():
@@ -848,7 +908,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 2
     commands = {"cases": cmd_cases, "optimize": cmd_optimize, "optimise": cmd_optimize, "reference": cmd_reference,
-                "study": cmd_study, "warmup": cmd_warmup, "suite": cmd_suite, "journey": cmd_journey}
+                "study": cmd_study, "warmup": cmd_warmup, "suite": cmd_suite, "journey": cmd_journey, "timetable": cmd_timetable}
     subparser = parser._subparsers._group_actions[0].choices[args.command]  # for its usage line
     try:
         if args.command not in COMPILING_COMMANDS:

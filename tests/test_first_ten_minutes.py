@@ -60,7 +60,8 @@ def test_plot_front_keeps_the_figure_optimize_wrote(capsys, tmp_path):
 def test_help_states_each_default_once(capsys, command):
     code, out, _ = run(capsys, command, "--help")
     assert code == 0
-    text = " ".join(out.split())
+    options = out.split("options:\n", 1)[1].split("\n\n", 1)[0]  # the option list, not the description
+    text = " ".join(options.split())
     assert "(default: None)" not in text and "(default: False)" not in text
     for option in text.split(" --")[1:]:
         assert option.count("default") <= 1, option

@@ -165,6 +165,8 @@ class MOABC(BeeColony):
       the constraint-non-dominated ones and, above ``archive_size``, drops the most crowded
       point one at a time (:func:`truncate_by_crowding`). ``opt``, and therefore
       ``res.X``/``res.F``, is this archive; ``pop`` holds the current food sources.
+      ``archive_X``, ``archive_F`` and ``archive_CV`` hold its decisions, objectives and
+      violations as arrays, row by row; sorting and truncation work on them.
     """
 
     def __init__(

@@ -83,6 +83,21 @@ def _cooperative_trains(case: Any = "cooperative-pair", **params):
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
 
 
+def _cooperative_scaled(case: Any = "cooperative-pair", phi: float = 1.0, **params):
+    """``CooperativeTrainsProblem`` on a case with every gradient times ``phi`` (Chen et al. 2017, fig. 6)."""
+    from pymoo_rail.problems import CooperativeTrainsProblem
+    from pymoo_rail.problems.cooperative import scale_gradients
+
+    return CooperativeTrainsProblem(scale_gradients(_case(case), phi), **_tuples(params))
+
+
+def _timetable(case: Any = "cooperative-pair", **params):
+    """``pymoo_rail.problems.TimetableProblem``: several trains sharing braking energy."""
+    from pymoo_rail.problems import TimetableProblem
+
+    return TimetableProblem(_case(case), **_tuples(params))
+
+
 def _kinematic_phases(case: Any = "metro-a", **params):
     """``pymoo_rail.problems.KinematicPhasesProblem`` (the four-phase model of Meng et al. 2017)."""
     from pymoo_rail.problems import KinematicPhasesProblem
@@ -118,6 +133,8 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "kinematic_phases": _kinematic_phases,
     "controller_tuning": _controller_tuning,
     "rail_suite": _rail_suite,
+    "cooperative_trains_scaled": _cooperative_scaled,
+    "timetable": _timetable,
 }
 
 # ------------------------------------------------------------------------------- algorithms

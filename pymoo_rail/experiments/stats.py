@@ -328,7 +328,7 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
     baseline ``ranksum.csv`` / ``ranksum.md`` (every test) and ``verdicts.md`` (+/=/- counts).
     Returns the paths written.
     """
-    from pymoo_rail.experiments.store import atomic_write_text
+    from pymoo_rail.atomic import atomic_write_text
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
@@ -366,3 +366,27 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
 __all__ = ["summarize", "rank_sum", "rank_sum_tests", "indicator_table", "verdict_counts", "reference_fronts",
            "add_reference_indicators", "add_energy_gap", "to_markdown", "write_tables", "nondominated",
            "gd_van_veldhuizen"]
+
+
+def signed_rank_vs(sample: Sequence[float], reference: float, lower_better: bool = True,
+                   alpha: float = 0.05) -> tuple[float, str]:
+    """One-sample Wilcoxon signed-rank test of ``sample`` against a fixed ``reference`` value: ``(p, verdict)``.
+
+    For results compared with an exact reference (e.g. a baseline computed once, not sampled).
+    The verdict is ``"+"`` (sample significantly better than the reference), ``"-"`` (worse),
+    ``"="``, or ``"n/a"`` with fewer than 2 finite values (p NaN).
+    """
+    from scipy.stats import wilcoxon
+
+    a = np.asarray(sample, dtype=float)
+    a = a[np.isfinite(a)]
+    if len(a) < 2:
+        return float("nan"), "n/a"
+    d = a - float(reference)
+    if np.all(d == 0):
+        return 1.0, "="
+    p = float(wilcoxon(d, alternative="two-sided").pvalue)
+    if p >= alpha:
+        return p, "="
+    better = np.median(d) < 0 if lower_better else np.median(d) > 0
+    return p, "+" if better else "-"

@@ -78,6 +78,6 @@ def study_to_toml(study: Study) -> str:
 
 def write_study(study: Study, path: str | Path) -> Path:
     """Write a study file atomically (temp file + rename)."""
-    from pymoo_rail.experiments.store import atomic_write_text
+    from pymoo_rail.atomic import atomic_write_text
 
     return atomic_write_text(Path(path), study_to_toml(study))

@@ -1,67 +1,51 @@
-"""Two trains sharing regenerative braking energy (Chen et al. (2017)): ``CooperativeTrainsProblem``.
+"""Two trains sharing regenerative braking energy (Chen et al. 2017): ``CooperativeTrainsProblem``.
 
 Train A runs leg 0 of a two-leg case (station 1 -> 2), train B leg 1 (station 2 -> 3); B leaves
-station 2 ``offset_s`` seconds after A leaves station 1 (the seed's x; negative: B leaves first).
+station 2 ``offset_s`` seconds after A leaves station 1 (the paper's x; negative: B leaves first).
 Both legs lie in one power-supply section, so while one train brakes the other can draw the
 regenerated power (with utilisation eta, the case's ``regen_efficiency``). B runs ahead of A on
 the line, so A is the following train of the separation rule (eq. 9).
 
-Decision vector (Chen et al. (2017) section 3.1, one flat vector):
+Decision vector: each train's driving *shape*, speed codes as fractions of each section's limit
+(sections cut at every gradient and limit change, at most ``max_section_m`` long), A's sections
+first. The running time is not a decision: each shape is paced (:mod:`pymoo_rail.sim.pacing`) so
+that the train runs exactly its planned time, whatever the vector. Every vector in the box is
+punctual, so any pymoo algorithm (GA, DE, PSO, NSGA2, ...) works on it without a repair.
 
-``[dS_A, dS_B, gamma_1, v_1, q_1, ..., gamma_m, v_m, q_m, gamma'_1, v'_1, q'_1, ...]``
+Both runs are the main simulator's (:class:`~pymoo_rail.sim.Simulator`); their power on the common
+clock and the shared energy come from its traces (:mod:`pymoo_rail.sim.cooperation`). Objective:
+the total net energy of eq. 6, traction of both minus what one draws from the other's braking
+(kWh). A train's own regeneration is never credited. Constraints (``G <= 0``): separation (eq. 9)
+and, as a guard, the running-time error of the pace solve (never active on the built-in case).
 
-- ``dS_A``, ``dS_B`` (m): braking distance before each train's next station (the outer chromosome);
-- per subsection of the run (cut at every gradient and limit change, section 1.1): the traction
-  coefficient ``gamma_k`` in [0, 1], the exit speed ``v_k`` and the time share ``q_k`` in [0, 1]
-  (eq. 1). Subsections beyond the braking point are ignored; the one holding it ends there.
-  ``v_k`` is, by default, the position of the exit speed in the range the operating sequence
-  can reach from the entry speed (0: the lowest, 1: the highest); ``speed_genes="absolute"``
-  makes it a speed in km/h, moved into that range when outside it (the seed's repair).
-
-Decoding (:mod:`pymoo_rail.sim.subsections`) follows the operating sequences of table 1 and the
-time allotment of eq. 1. Energies are per train: traction drawn ``F v / eta_traction``;
-regeneration only counts where the other train uses it at the same time (eq. 5). Objective:
-the total net energy (eq. 6). Constraints (``G <= 0``): each train's running time within
-``time_tolerance_s`` of its plan, speed limits (eq. 7), comfort at gradient changes (eq. 8),
-separation (eq. 9), and the physical feasibility of the decoded sequences.
-
-:class:`SubsectionProblem` is the same model for one train alone (the seed's encoding of the
-uncoordinated case); :class:`PunctualityRepair` is the seed's repair as a pymoo ``Repair``;
-:func:`nested_minimize` is the nested GA of section 3.
+The paper's own encoding (subsections, traction coefficients, time shares) and its nested GA are
+in :mod:`pymoo_rail.problems.cooperative_seed`; the exact uncoordinated baseline is in
+:mod:`pymoo_rail.problems.cooperative_baseline`.
 """
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, replace
-from typing import Sequence
 
 import numpy as np
 import pandas as pd
 from pymoo.core.problem import Problem
-from pymoo.core.repair import Repair
 
-from pymoo_rail.model import Case, CaseError, Train
+from pymoo_rail.model import Case, CaseError
+from pymoo_rail.problems.speed_profile import check_decisions
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import cooperation as coop
-from pymoo_rail.sim import subsections as sub
-from pymoo_rail.sim.physics import KernelModel, davis_force
-from pymoo_rail.sim.trajectory import EnergyBreakdown
+from pymoo_rail.sim.kernel import OUT_TRACTION_KWH
+from pymoo_rail.sim.pacing import DEFAULT_TIME_TOL_S, PacedRuns, PacedSpeedCodes, solve_pace
 
-KMH_PER_MS = 3.6
-J_PER_KWH = 3.6e6
-CONSTRAINTS = ("time_a", "time_b", "speed_limit", "comfort", "separation", "feasibility")
-SOLO_CONSTRAINTS = ("time", "speed_limit", "comfort", "feasibility")
-# Seed 001 sections 4.2-4.4.
+# Chen et al. (2017) sections 4.2-4.4.
 SEED_001_OFFSETS_S = (-45.0, 0.0, 45.0, 90.0, 135.0)
-SPEED_GENES = ("relative", "absolute")
-# eq. 8 compares the acceleration before and after a gradient change: each side's is the mean over
-# this distance (about a second of running), so the measure does not depend on the grid step
-COMFORT_WINDOW_M = 10.0
+CONSTRAINTS = ("separation", "time")
 
 
-def _finite(name: str, value, *, positive: bool = False, nonneg: bool = False) -> float:
+def finite_number(name: str, value, *, positive: bool = False, nonneg: bool = False) -> float:
+    """``value`` as a float, or a ``ValueError`` naming ``name`` and the value."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
             or not math.isfinite(float(value)):
         raise ValueError(f"{name} = {value!r}: must be a finite number")
@@ -74,258 +58,82 @@ def _finite(name: str, value, *, positive: bool = False, nonneg: bool = False) -
 
 
 def scale_gradients(case: Case, phi: float) -> Case:
-    """The same case with every gradient multiplied by ``phi`` (Chen et al. (2017) section 4.4, fig. 6)."""
-    phi = _finite("phi", phi)
+    """The same case with every gradient multiplied by ``phi`` (Chen et al. 2017, section 4.4, fig. 6)."""
+    phi = finite_number("phi", phi)
     line = replace(case.line, gradients=tuple((s, e, g * phi) for s, e, g in case.line.gradients))
     return replace(case, line=line, name=f"{case.name} (gradients x {phi:g})")
 
 
 @dataclass(frozen=True, eq=False)
-class TrainSetup:
-    """One train's run on the grid: its subsections and the bounds of its genes."""
+class PacedTrain:
+    """One train on one stop-to-stop run: simulator, shape encoding and place on the common line."""
 
     case: Case
-    model: KernelModel
-    start_m: float             # where the run starts on the common line
-    sub_start: np.ndarray      # node index of each subsection start
-    sub_end: np.ndarray
-    sub_kind: np.ndarray       # 2 or 3 (table 1)
-    sub_cap_ms: np.ndarray
-    sub_grade_change: np.ndarray
-    brake_bounds_m: tuple[float, float]
+    simulator: Simulator
+    encoding: PacedSpeedCodes
+    start_m: float
+
+    @classmethod
+    def build(cls, case: Case, start_m: float = 0.0, max_section_m: float | None = 200.0,
+              dx_m: float | None = None) -> PacedTrain:
+        simulator = Simulator(case, dx_m)
+        simulator.check_planned_time()  # raises, naming planned_time_s, when the run cannot be on time
+        return cls(case=case, simulator=simulator, encoding=PacedSpeedCodes.build(case, max_section_m),
+                   start_m=float(start_m))
 
     @property
-    def n_sub(self) -> int:
-        return self.sub_start.shape[0]
+    def n_var(self) -> int:
+        return self.encoding.n_var
 
-    @property
-    def planned_time_s(self) -> float:
-        return self.case.planned_time_s
+    def paced(self, shapes: np.ndarray, time_tol_s: float = DEFAULT_TIME_TOL_S) -> PacedRuns:
+        return solve_pace(self.simulator, self.encoding, shapes, time_tol_s)
 
-
-def _train_setup(case: Case, start_m: float, model: KernelModel, decel_ms2: float, range_factor: float) -> TrainSetup:
-    line = case.line
-    pos = model.position_m
-    dx = model.dx_m
-    nodes = sorted({int(round(p / dx)) for p in line.breakpoints_m()})
-    sub_start = np.asarray(nodes[:-1], dtype=np.int64)
-    sub_end = np.asarray(nodes[1:], dtype=np.int64)
-    caps = np.array([model.limit_ms[s:e + 1].min() for s, e in zip(sub_start, sub_end)])
-    kinds = np.empty(sub_start.shape[0], dtype=np.int64)
-    for j, (s, e) in enumerate(zip(sub_start, sub_end)):
-        # type 3 when coasting accelerates the train on this subsection even at its highest speed
-        # (the line force is the one the train feels: averaged over its length, curves included)
-        line_force = float(np.mean(model.line_force_n[s:e]))
-        kinds[j] = 3 if davis_force(model, caps[j]) + line_force < 0.0 else 2
-
-    def grade_at(x: float) -> float:
-        for s, e, g in line.gradients:
-            if s <= x < e:
-                return g
-        return line.gradients[-1][2]
-
-    change = np.zeros(sub_start.shape[0], dtype=np.bool_)
-    for j in range(1, sub_start.shape[0]):
-        change[j] = grade_at(pos[sub_start[j]] - 0.5 * dx) != grade_at(pos[sub_start[j]] + 0.5 * dx)
-    # the seed's range: braking at b from the approach limit, times r (section 3.2)
-    v_end = caps[-1]
-    upper = min(range_factor * v_end * v_end / (2.0 * decel_ms2), 0.9 * line.length_m)
-    return TrainSetup(case=case, model=model, start_m=start_m, sub_start=sub_start, sub_end=sub_end,
-                      sub_kind=kinds, sub_cap_ms=caps, sub_grade_change=change,
-                      brake_bounds_m=(0.02 * upper, upper))
+    def clocked(self, program: np.ndarray, departure_s: float) -> coop.ClockedRun:
+        """The traced run of one program at ``departure_s``."""
+        return coop.clocked_run(self.simulator.model, self.simulator.run(program), departure_s, self.start_m)
 
 
-@dataclass(frozen=True, eq=False)
-class TrainRun:
-    """One train of a decoded solution: its trajectory, its subsections as decoded, its figures."""
-
-    trajectory: Trajectory
-    subsections: pd.DataFrame
-    summary: dict
-    traction_kwh: float
-    regen_kwh: float
+def check_vectors(X, n_var: int, names=None) -> np.ndarray:
+    """Decision vectors (N, n_var) as floats; a ``ValueError`` naming the first bad entry (by ``names``)."""
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    if X.ndim != 2 or X.shape[1] != n_var:
+        raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {n_var}")
+    bad = np.argwhere(~np.isfinite(X))
+    if bad.size:
+        r, c = (int(i) for i in bad[0])
+        name = names[c] if names is not None else c
+        raise ValueError(f"decision vector {r}, variable {name} = {X[r, c]}: must be finite")
+    return X
 
 
 @dataclass(frozen=True, eq=False)
 class CooperativeSolution:
     """A decoded decision vector: both runs, the shared energy and the constraint values."""
 
-    a: TrainRun
-    b: TrainRun
+    a: Trajectory
+    b: Trajectory
     offset_s: float
-    shared_a_from_b_kwh: float
-    shared_b_from_a_kwh: float
-    net_kwh: float
+    pace: tuple[float, float]
+    traction_a_kwh: float
+    traction_b_kwh: float
+    shared_kwh: float
     constraints: dict
 
     @property
-    def shared_kwh(self) -> float:
-        return self.shared_a_from_b_kwh + self.shared_b_from_a_kwh
+    def traction_kwh(self) -> float:
+        return self.traction_a_kwh + self.traction_b_kwh
 
     @property
-    def traction_kwh(self) -> float:
-        return self.a.traction_kwh + self.b.traction_kwh
+    def net_kwh(self) -> float:
+        return self.traction_kwh - self.shared_kwh
 
     @property
     def feasible(self) -> bool:
         return all(v <= 0.0 for v in self.constraints.values())
 
 
-class _SubsectionModel(Problem):
-    """What the single-train and the two-train forms share: settings, genes, decoding, constraints."""
-
-    def _setup(self, legs: Sequence[tuple[Case, float, str]], *, separation_decel_ms2: float,
-               max_accel_change_ms2: float | None, brake_range_factor: float, time_tolerance_s: float,
-               min_exit_speed_kmh: float, speed_genes: str, dx_m: float | None) -> tuple[list, list, list]:
-        self.separation_decel_ms2 = _finite("separation_decel_ms2", separation_decel_ms2, positive=True)
-        self.max_accel_change_ms2 = (None if max_accel_change_ms2 is None
-                                     else _finite("max_accel_change_ms2", max_accel_change_ms2, positive=True))
-        self.brake_range_factor = _finite("brake_range_factor", brake_range_factor, positive=True)
-        self.time_tolerance_s = _finite("time_tolerance_s", time_tolerance_s, positive=True)
-        self.min_exit_speed_ms = _finite("min_exit_speed_kmh", min_exit_speed_kmh, positive=True) / KMH_PER_MS
-        self.comfort_window_m = COMFORT_WINDOW_M
-        if speed_genes not in SPEED_GENES:
-            raise ValueError(f"speed_genes = {speed_genes!r} is unknown (known: {', '.join(SPEED_GENES)})")
-        self.speed_genes = speed_genes
-        self.relative_speeds = speed_genes == "relative"
-        trains = []
-        for leg_case, start_m, _ in legs:
-            simulator = Simulator(leg_case, dx_m)
-            simulator.check_planned_time()  # raises, naming planned_time_s, when the leg cannot be run on time
-            trains.append(_train_setup(leg_case, start_m, simulator.model, self.separation_decel_ms2,
-                                       self.brake_range_factor))
-        self.trains = tuple(trains)
-        xl = [tr.brake_bounds_m[0] for tr in trains]
-        xu = [tr.brake_bounds_m[1] for tr in trains]
-        names = [f"brake{label}_m" for _, _, label in legs]
-        self._blocks = []
-        for k, (tr, (_, _, label)) in enumerate(zip(trains, legs)):
-            self._blocks.append((k, len(xl)))
-            for j in range(tr.n_sub):
-                xl += [0.0, 0.0, 0.0]
-                xu += [1.0, 1.0 if self.relative_speeds else tr.sub_cap_ms[j] * KMH_PER_MS, 1.0]
-                speed = f"v{label}{j + 1}" + ("_rel" if self.relative_speeds else "_kmh")
-                names += [f"gamma{label}{j + 1}", speed, f"q{label}{j + 1}"]
-        self.variable_names = tuple(names)
-        return xl, xu, names
-
-    # ------------------------------------------------------------------ decision vectors
-    def check_x(self, X: np.ndarray) -> np.ndarray:
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        if X.shape[1] != self.n_var:
-            raise ValueError(f"decision vectors have {X.shape[1]} values: this problem has n_var = {self.n_var}")
-        bad = np.argwhere(~np.isfinite(X))
-        if bad.size:
-            r, c = (int(i) for i in bad[0])
-            raise ValueError(f"decision vector {r}, variable {self.variable_names[c]} = {X[r, c]}: must be finite")
-        return X
-
-    def split(self, X: np.ndarray) -> list[tuple]:
-        """Per train, (brake_m, gamma, v_exit, q) from decision vectors (N, n_var); v_exit in m/s or relative."""
-        X = self.check_x(X)
-        out = []
-        for (brake_col, first), tr in zip(self._blocks, self.trains):
-            genes = X[:, first:first + 3 * tr.n_sub].reshape(X.shape[0], tr.n_sub, 3)
-            speed = genes[:, :, 1] if self.relative_speeds else genes[:, :, 1] / KMH_PER_MS
-            out.append((np.ascontiguousarray(X[:, brake_col]), np.ascontiguousarray(genes[:, :, 0]),
-                        np.ascontiguousarray(speed), np.ascontiguousarray(genes[:, :, 2])))
-        return out
-
-    def with_genes(self, X: np.ndarray, k: int, gamma: np.ndarray, v_exit: np.ndarray) -> np.ndarray:
-        """A copy of X with train k's traction coefficients and exit-speed genes replaced."""
-        X = np.array(X, dtype=float, copy=True)
-        _, first = self._blocks[k]
-        n_sub = self.trains[k].n_sub
-        block = X[:, first:first + 3 * n_sub].reshape(X.shape[0], n_sub, 3)
-        block[:, :, 0] = gamma
-        block[:, :, 1] = v_exit if self.relative_speeds else v_exit * KMH_PER_MS
-        X[:, first:first + 3 * n_sub] = block.reshape(X.shape[0], -1)
-        return X
-
-    def _drive(self, tr: TrainSetup, genes: tuple):
-        brake, gamma, v_exit, q = genes
-        return sub.drive_batch(tr.model, tr.sub_start, tr.sub_end, tr.sub_kind, tr.sub_cap_ms, tr.sub_grade_change,
-                               brake, gamma, v_exit, q, tr.planned_time_s, self.separation_decel_ms2,
-                               self.min_exit_speed_ms, self.relative_speeds, self.comfort_window_m)
-
-    def _train_constraints(self, s: np.ndarray, tr: TrainSetup) -> tuple[np.ndarray, ...]:
-        """(time, limit, comfort, feasibility) of one train's summaries."""
-        g_time = np.abs(s[:, sub.RUN_RUNNING_TIME_S] - tr.planned_time_s) - self.time_tolerance_s
-        g_limit = s[:, sub.RUN_LIMIT_EXCESS_MS] - 1e-6
-        if self.max_accel_change_ms2 is None:
-            g_comfort = np.full(s.shape[0], -1.0)
-        else:
-            g_comfort = s[:, sub.RUN_ACCEL_CHANGE_MS2] - self.max_accel_change_ms2
-        # forces beyond the train's limits (m/s^2; 1e-3 absorbs the two integration schemes) and
-        # exit speeds no repair could place (m/s)
-        g_feasible = np.maximum(s[:, sub.RUN_FORCE_EXCESS_MS2] - 1e-3, s[:, sub.RUN_DECODE_EXCESS_MS] - 1e-9)
-        return g_time, g_limit, g_comfort, g_feasible
-
-    def _train_run(self, tr: TrainSetup, run: tuple) -> TrainRun:
-        """The first run of a batch as a :class:`TrainRun`."""
-        v, t, f, _, _, regime, subs, summ = (r[0] for r in run)
-        n_active = int(summ[sub.RUN_N_ACTIVE])
-        table = pd.DataFrame(subs[:n_active], columns=sub.SUB_NAMES).drop(columns="active")
-        table["type"] = table["type"].astype(int)
-        summary = {name: float(summ[i]) for i, name in enumerate(sub.RUN_NAMES)}
-        accel = np.append((v[1:] ** 2 - v[:-1] ** 2) / (2.0 * tr.model.dx_m), 0.0)
-        energy = EnergyBreakdown(traction_kwh=summary["traction_kwh"], regen_kwh=0.0, aux_kwh=0.0,
-                                 net_kwh=summary["traction_kwh"])
-        traj = Trajectory(position_m=tr.model.position_m.copy(), speed_ms=v.copy(), time_s=t.copy(), accel_ms2=accel,
-                          force_n=np.append(f, 0.0), regime=np.append(regime, np.int8(3)),
-                          limit_ms=tr.model.limit_ms.copy(), energy=energy, running_time_s=summary["running_time_s"],
-                          stop_error_m=0.0, summary=dict(summary, reached=1.0))
-        return TrainRun(trajectory=traj, subsections=table, summary=summary, traction_kwh=summary["traction_kwh"],
-                        regen_kwh=summary["regen_kwh"])
-
-    def _one(self, x: np.ndarray) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
-        if x.ndim != 1 or x.shape[0] != self.n_var:
-            raise ValueError(f"x must be one decision vector of length n_var = {self.n_var}, got shape {x.shape}")
-        return x[None, :]
-
-
-class SubsectionProblem(_SubsectionModel):
-    """One train alone in the seed's subsection model: least traction energy, on time.
-
-    The uncoordinated case of Chen et al. (2017) in its own encoding. Decision vector
-    ``[dS, gamma_1, v_1, q_1, ..., gamma_m, v_m, q_m]``; parameters as in
-    :class:`CooperativeTrainsProblem`. ``case`` is a single-run case (e.g. ``pair.leg(0)``).
-    """
-
-    def __init__(self, case: Case, *, separation_decel_ms2: float = 1.0, max_accel_change_ms2: float | None = 0.8,
-                 brake_range_factor: float = 1.5, time_tolerance_s: float = 1.0, min_exit_speed_kmh: float = 3.6,
-                 speed_genes: str = "relative", dx_m: float | None = None, **kwargs):
-        if not isinstance(case, Case):
-            raise TypeError(f"case = {case!r}: must be a pymoo_rail Case")
-        if case.legs:
-            raise CaseError("run.legs", f"{len(case.legs)} legs", "SubsectionProblem needs a single-run case "
-                            "(use case.leg(k))", case.name)
-        self.case = case
-        xl, xu, names = self._setup([(case, 0.0, "")], separation_decel_ms2=separation_decel_ms2,
-                                    max_accel_change_ms2=max_accel_change_ms2, brake_range_factor=brake_range_factor,
-                                    time_tolerance_s=time_tolerance_s, min_exit_speed_kmh=min_exit_speed_kmh,
-                                    speed_genes=speed_genes, dx_m=dx_m)
-        super().__init__(n_var=len(names), n_obj=1, n_ieq_constr=len(SOLO_CONSTRAINTS), xl=np.asarray(xl, dtype=float),
-                         xu=np.asarray(xu, dtype=float), vtype=float, **kwargs)
-
-    def _evaluate(self, x, out, *args, **kwargs):
-        (genes,) = self.split(x)
-        run = self._drive(self.trains[0], genes)
-        s = run[-1]
-        out["F"] = s[:, sub.RUN_TRACTION_KWH][:, None]
-        out["G"] = np.column_stack(self._train_constraints(s, self.trains[0]))
-        out["running_time_s"] = s[:, sub.RUN_RUNNING_TIME_S]
-        out["regen_kwh"] = s[:, sub.RUN_REGEN_KWH]
-
-    def decode(self, x: np.ndarray) -> TrainRun:
-        """The trajectory, the subsections as decoded and the figures of one decision vector."""
-        (genes,) = self.split(self._one(x))
-        return self._train_run(self.trains[0], self._drive(self.trains[0], genes))
-
-
-class CooperativeTrainsProblem(_SubsectionModel):
-    """Cooperative timed driving of two trains sharing regenerative energy (Chen et al. (2017)).
+class CooperativeTrainsProblem(Problem):
+    """Cooperative timed driving of two trains sharing regenerative energy (Chen et al. 2017).
 
     Parameters
     ----------
@@ -334,41 +142,35 @@ class CooperativeTrainsProblem(_SubsectionModel):
         leg 0, train B leg 1.
     offset_s : float
         B's departure from the start of leg 1 minus A's departure from the start of leg 0 (the
-        seed's x, sections 4.2-4.4: -45, 0, 45, 90, 135 s).
+        paper's x, sections 4.2-4.4: -45, 0, 45, 90, 135 s).
+    max_section_m : float or None
+        Longest section of a shape (200 m): sections are cut at gradient and limit changes and
+        split further down to this length.
     safety_margin_m : float
-        L_s of eq. 9 (Chen et al. (2017) table 3: 40 m).
+        L_s of eq. 9 (table 3: 40 m).
     separation_decel_ms2 : float
-        b of eq. 9 and the largest deceleration of the braking phase (table 3: 1.0 m/s^2).
-    max_accel_change_ms2 : float or None
-        delta of eq. 8 (table 3: 0.8 m/s^2); ``None`` drops the comfort constraint.
-    brake_range_factor : float
-        r of section 3.2 (1.5): the braking distance ranges up to r times the distance to brake at b
-        from the approach limit (down to 2 % of that).
-    time_tolerance_s : float
-        Each train must arrive within this of its planned time (1 s).
+        b of eq. 9 (table 3: 1.0 m/s^2).
     share_energy : bool
         False gives the uncoordinated objective (traction of both, nothing shared).
     time_step_s : float
         Bin width of the common clock for power profiles and separation (0.1 s).
-    min_exit_speed_kmh : float
-        Lowest exit speed of a subsection (the trains do not stop between stations).
-    speed_genes : {"relative", "absolute"}
-        How the exit speeds are encoded (see the module docstring).
+    time_tol_s : float
+        Tolerance of the pace solve (0.02 s).
+    max_time_error_s : float
+        The guard constraint: a run further than this from its plan is infeasible (0.5 s).
     dx_m : float, optional
         Simulation grid step (default of :class:`~pymoo_rail.sim.Simulator`).
 
     Notes
     -----
-    Extra outputs per solution: ``traction_a_kwh``, ``traction_b_kwh``, ``regen_a_kwh`` and
-    ``regen_b_kwh`` (usable by the other train, whether it uses it or not), ``shared_kwh``,
-    ``running_time_a_s``, ``running_time_b_s``. ``decode(x)`` gives both trajectories;
-    ``power_profiles(x)`` the power on the common clock.
+    Extra outputs per solution: ``traction_a_kwh``, ``traction_b_kwh``, ``shared_kwh``,
+    ``running_time_a_s``, ``running_time_b_s``, ``pace_a``, ``pace_b``. ``decode(x)`` gives both
+    trajectories; ``power_profiles(x)`` the power on the common clock.
     """
 
-    def __init__(self, case: Case, offset_s: float, *, safety_margin_m: float = 40.0,
-                 separation_decel_ms2: float = 1.0, max_accel_change_ms2: float | None = 0.8,
-                 brake_range_factor: float = 1.5, time_tolerance_s: float = 1.0, share_energy: bool = True,
-                 time_step_s: float = 0.1, min_exit_speed_kmh: float = 3.6, speed_genes: str = "relative",
+    def __init__(self, case: Case, offset_s: float, *, max_section_m: float | None = 200.0,
+                 safety_margin_m: float = 40.0, separation_decel_ms2: float = 1.0, share_energy: bool = True,
+                 time_step_s: float = 0.1, time_tol_s: float = DEFAULT_TIME_TOL_S, max_time_error_s: float = 0.5,
                  dx_m: float | None = None, **kwargs):
         if not isinstance(case, Case):
             raise TypeError(f"case = {case!r}: must be a pymoo_rail Case")
@@ -376,448 +178,85 @@ class CooperativeTrainsProblem(_SubsectionModel):
             raise CaseError("run.legs", f"{len(case.legs)} legs",
                             "CooperativeTrainsProblem needs a case with exactly two legs (A on leg 0, B on leg 1)",
                             case.name)
-        self.offset_s = _finite("offset_s", offset_s)
-        self.safety_margin_m = _finite("safety_margin_m", safety_margin_m, nonneg=True)
-        self.time_step_s = _finite("time_step_s", time_step_s, positive=True)
-        self.share_energy = bool(share_energy)
         self.case = case
-        legs = [(case.leg(0), case.legs[0].start_m, "_a"), (case.leg(1), case.legs[1].start_m, "_b")]
-        xl, xu, names = self._setup(legs, separation_decel_ms2=separation_decel_ms2,
-                                    max_accel_change_ms2=max_accel_change_ms2, brake_range_factor=brake_range_factor,
-                                    time_tolerance_s=time_tolerance_s, min_exit_speed_kmh=min_exit_speed_kmh,
-                                    speed_genes=speed_genes, dx_m=dx_m)
-        a, b = self.trains
-        # the common clock: from the first departure to well after the later planned arrival
-        self.t0_s = min(0.0, self.offset_s)
-        t_end = max(a.planned_time_s, self.offset_s + b.planned_time_s) + max(a.planned_time_s, b.planned_time_s)
-        self.n_bins = int(math.ceil((t_end - self.t0_s) / self.time_step_s))
-        self._baseline = None
-        super().__init__(n_var=len(names), n_obj=1, n_ieq_constr=len(CONSTRAINTS), xl=np.asarray(xl, dtype=float),
-                         xu=np.asarray(xu, dtype=float), vtype=float, **kwargs)
+        self.offset_s = finite_number("offset_s", offset_s)
+        self.safety_margin_m = finite_number("safety_margin_m", safety_margin_m, nonneg=True)
+        self.separation_decel_ms2 = finite_number("separation_decel_ms2", separation_decel_ms2, positive=True)
+        self.time_step_s = finite_number("time_step_s", time_step_s, positive=True)
+        self.time_tol_s = finite_number("time_tol_s", time_tol_s, positive=True)
+        self.max_time_error_s = finite_number("max_time_error_s", max_time_error_s, positive=True)
+        self.share_energy = bool(share_energy)
+        self.trains = tuple(PacedTrain.build(case.leg(k), case.legs[k].start_m, max_section_m, dx_m) for k in (0, 1))
+        n_a = self.trains[0].n_var
+        self.slices = (slice(0, n_a), slice(n_a, n_a + self.trains[1].n_var))
+        names = [f"shape_{label}{j + 1}" for tr, label in zip(self.trains, "ab") for j in range(tr.n_var)]
+        self.variable_names = tuple(names)
+        super().__init__(n_var=len(names), n_obj=1, n_ieq_constr=len(CONSTRAINTS), xl=np.zeros(len(names)),
+                         xu=np.ones(len(names)), vtype=float, **kwargs)
+
+    @property
+    def departures_s(self) -> tuple[float, float]:
+        return 0.0, self.offset_s
 
     def simulate(self, X: np.ndarray) -> dict:
-        """Both runs and their interaction for decision vectors (N, n_var), as arrays by name."""
-        genes_a, genes_b = self.split(X)
+        """Paced runs of both trains, their traces on the common clock and their interaction."""
+        X = check_decisions(X, self.xl, self.xu)
+        paced = [tr.paced(X[:, s], self.time_tol_s) for tr, s in zip(self.trains, self.slices)]
+        n = X.shape[0]
+        shared = np.zeros(n)
+        separation = np.zeros(n)
+        clocked = []
         a, b = self.trains
-        run_a = self._drive(a, genes_a)
-        run_b = self._drive(b, genes_b)
-        v_a, t_a, _, tr_a, rg_a, _, _, s_a = run_a
-        v_b, t_b, _, tr_b, rg_b, _, _, s_b = run_b
-        shared = coop.cooperation_batch(t_a, tr_a, rg_a, t_b, tr_b, rg_b, self.offset_s, self.t0_s,
-                                        self.time_step_s, self.n_bins) / J_PER_KWH
-        separation = coop.separation_batch(t_a, a.model.position_m, v_a, 0.0, a.start_m, t_b, b.model.position_m,
-                                           self.offset_s, b.start_m, a.case.train.length_m + self.safety_margin_m,
-                                           self.separation_decel_ms2, self.t0_s, self.time_step_s, self.n_bins)
-        return {"run_a": run_a, "run_b": run_b, "summary_a": s_a, "summary_b": s_b, "shared_kwh": shared,
-                "separation_m": separation}
+        gap_m = a.case.train.length_m + self.safety_margin_m
+        for i in range(n):
+            runs = [tr.clocked(p.programs[i], dep) for tr, p, dep in zip(self.trains, paced, self.departures_s)]
+            if self.share_energy:
+                shared[i] = coop.shared_energy_kwh(runs, 1.0, self.time_step_s)
+            separation[i] = coop.separation_m(runs[0], runs[1], gap_m, self.separation_decel_ms2, self.time_step_s)
+            clocked.append(runs)
+        return {"paced": paced, "clocked": clocked, "shared_kwh": shared, "separation_m": separation}
+
+    def _constraints(self, paced: list[PacedRuns], separation_m: np.ndarray) -> np.ndarray:
+        err = np.max([np.abs(p.running_time_s - tr.case.planned_time_s) for p, tr in zip(paced, self.trains)], axis=0)
+        return np.column_stack([separation_m, err - self.max_time_error_s])
 
     def _evaluate(self, x, out, *args, **kwargs):
         sim = self.simulate(x)
-        s_a, s_b, shared = sim["summary_a"], sim["summary_b"], sim["shared_kwh"]
-        traction = s_a[:, sub.RUN_TRACTION_KWH] + s_b[:, sub.RUN_TRACTION_KWH]
-        used = shared.sum(axis=1) if self.share_energy else np.zeros(traction.shape[0])
-        out["F"] = (traction - used)[:, None]
-        out["G"] = self._constraints(s_a, s_b, sim["separation_m"])
-        out["traction_a_kwh"] = s_a[:, sub.RUN_TRACTION_KWH]
-        out["traction_b_kwh"] = s_b[:, sub.RUN_TRACTION_KWH]
-        out["regen_a_kwh"] = s_a[:, sub.RUN_REGEN_KWH]
-        out["regen_b_kwh"] = s_b[:, sub.RUN_REGEN_KWH]
-        out["shared_kwh"] = used
-        out["running_time_a_s"] = s_a[:, sub.RUN_RUNNING_TIME_S]
-        out["running_time_b_s"] = s_b[:, sub.RUN_RUNNING_TIME_S]
-
-    def _constraints(self, s_a: np.ndarray, s_b: np.ndarray, separation_m: np.ndarray) -> np.ndarray:
-        time_a, limit_a, comfort_a, feasible_a = self._train_constraints(s_a, self.trains[0])
-        time_b, limit_b, comfort_b, feasible_b = self._train_constraints(s_b, self.trains[1])
-        return np.column_stack([time_a, time_b, np.maximum(limit_a, limit_b), np.maximum(comfort_a, comfort_b),
-                                separation_m, np.maximum(feasible_a, feasible_b)])
+        pa, pb = sim["paced"]
+        trac_a, trac_b = pa.summaries[:, OUT_TRACTION_KWH], pb.summaries[:, OUT_TRACTION_KWH]
+        out["F"] = (trac_a + trac_b - sim["shared_kwh"])[:, None]
+        out["G"] = self._constraints(sim["paced"], sim["separation_m"])
+        out["traction_a_kwh"] = trac_a
+        out["traction_b_kwh"] = trac_b
+        out["shared_kwh"] = sim["shared_kwh"]
+        out["running_time_a_s"] = pa.running_time_s
+        out["running_time_b_s"] = pb.running_time_s
+        out["pace_a"] = pa.pace
+        out["pace_b"] = pb.pace
 
     # ------------------------------------------------------------------ inspection
     def decode(self, x: np.ndarray) -> CooperativeSolution:
-        """Both trajectories, the subsections as decoded, the shared energy and the constraints of one vector."""
-        sim = self.simulate(self._one(x))
-        run_a = self._train_run(self.trains[0], sim["run_a"])
-        run_b = self._train_run(self.trains[1], sim["run_b"])
-        g = self._constraints(sim["summary_a"], sim["summary_b"], sim["separation_m"])[0]
-        shared = sim["shared_kwh"][0] if self.share_energy else np.zeros(2)
-        return CooperativeSolution(a=run_a, b=run_b, offset_s=self.offset_s, shared_a_from_b_kwh=float(shared[0]),
-                                   shared_b_from_a_kwh=float(shared[1]),
-                                   net_kwh=run_a.traction_kwh + run_b.traction_kwh - float(shared.sum()),
+        """Both trajectories, the shared energy and the constraints of one vector."""
+        x = check_decisions(x, self.xl, self.xu)
+        if x.shape[0] != 1:
+            raise ValueError(f"decode takes one decision vector, got {x.shape[0]}")
+        sim = self.simulate(x)
+        pa, pb = sim["paced"]
+        g = self._constraints(sim["paced"], sim["separation_m"])[0]
+        trajs = [tr.simulator.run(p.programs[0]) for tr, p in zip(self.trains, sim["paced"])]
+        return CooperativeSolution(a=trajs[0], b=trajs[1], offset_s=self.offset_s,
+                                   pace=(float(pa.pace[0]), float(pb.pace[0])),
+                                   traction_a_kwh=trajs[0].energy.traction_kwh,
+                                   traction_b_kwh=trajs[1].energy.traction_kwh,
+                                   shared_kwh=float(sim["shared_kwh"][0]),
                                    constraints=dict(zip(CONSTRAINTS, (float(v) for v in g))))
 
     def power_profiles(self, x: np.ndarray) -> pd.DataFrame:
         """Power of both trains on the common clock (kW per bin): traction, usable regeneration, shared."""
-        sol = self.decode(x)
-        return power_profiles(sol.a.trajectory, sol.b.trajectory, self.offset_s, self.case.train, self.time_step_s)
-
-    # ------------------------------------------------------------------ the uncoordinated case
-    @property
-    def baseline_energy_kwh(self) -> float:
-        """Traction energy of both trains each driven alone energy-optimally, on time, nothing shared.
-
-        Computed on first use with :func:`uncoordinated_baseline` (its defaults) and kept; see
-        :meth:`set_baseline` to reuse one computed elsewhere.
-        """
-        if self._baseline is None:
-            self._baseline = uncoordinated_baseline(self.case)
-        return self._baseline.energy_kwh
-
-    @property
-    def baseline(self) -> "Baseline":
-        """The uncoordinated runs behind :attr:`baseline_energy_kwh`."""
-        if self._baseline is None:
-            self._baseline = uncoordinated_baseline(self.case)
-        return self._baseline
-
-    def set_baseline(self, baseline: "Baseline") -> None:
-        """Use a baseline computed elsewhere (e.g. once for all offsets of the same case)."""
-        if not isinstance(baseline, Baseline):
-            raise TypeError(f"baseline = {baseline!r}: must be a Baseline")
-        self._baseline = baseline
+        runs = self.simulate(x)["clocked"][0]
+        return coop.power_profiles(runs, ("a", "b"), 1.0, self.time_step_s)
 
     def describe(self) -> str:
         a, b = self.trains
-        return (f"CooperativeTrainsProblem({self.case.name}, offset {self.offset_s:g} s: A {a.n_sub} subsections, "
-                f"B {b.n_sub} subsections, {self.n_var} variables, {self.n_ieq_constr} constraints)")
-
-
-# ---------------------------------------------------------------------- the seed's repair
-class PunctualityRepair(Repair):
-    """The repair of Chen et al. (2017) section 3.2, step 1, as a pymoo ``Repair`` (Lamarckian: genes are rewritten).
-
-    When a train's planned time lies outside the window eq. 1 can reach (eq. 10), its exit-speed
-    genes (and, to speed up, its traction coefficients) move together toward the fastest or the
-    slowest sequence until the plan lies inside; see :func:`pymoo_rail.sim.subsections.repair_one`.
-    Works with :class:`CooperativeTrainsProblem`, :class:`SubsectionProblem` and the inner problem of
-    the nested GA, with ``speed_genes="relative"``: ``DE(..., repair=PunctualityRepair())``.
-    """
-
-    def __init__(self, iterations: int = 10):
-        super().__init__()
-        if int(iterations) < 1:
-            raise ValueError(f"iterations = {iterations!r}: must be >= 1")
-        self.iterations = int(iterations)
-
-    def apply(self, problem, X: np.ndarray) -> np.ndarray:
-        """The repaired copy of decision vectors X (N, n_var)."""
-        return self._do(problem, np.atleast_2d(np.asarray(X, dtype=float)))
-
-    def _do(self, problem, X, **kwargs):
-        if isinstance(problem, PartialProblem):
-            return self._do(problem.problem, problem.full(X))[:, problem.free]
-        if not isinstance(problem, _SubsectionModel) or not problem.relative_speeds:
-            raise ValueError(f"PunctualityRepair needs a subsection problem with speed_genes='relative', "
-                             f"got {type(problem).__name__}")
-        X = np.asarray(X, dtype=float)
-        for k, (tr, genes) in enumerate(zip(problem.trains, problem.split(X))):
-            brake, gamma, v_rel, _ = genes
-            g_new, v_new, _ = sub.repair_batch(tr.model, tr.sub_start, tr.sub_end, tr.sub_kind, tr.sub_cap_ms, brake,
-                                               gamma, v_rel, tr.planned_time_s, problem.separation_decel_ms2,
-                                               problem.min_exit_speed_ms, self.iterations)
-            X = problem.with_genes(X, k, g_new, v_new)
-        return np.clip(X, problem.xl, problem.xu)
-
-
-# ---------------------------------------------------------------------- power on a common clock
-def trajectory_energies(traj: Trajectory, train: Train) -> tuple[np.ndarray, np.ndarray]:
-    """Per-cell traction energy drawn and regenerated energy usable by another train (J) of a trace.
-
-    Traction is ``F dx / eta_traction``. Braking is regenerative within the train's regen force and
-    power caps and above its cut-off speed (Chen et al. (2017) eq. 3), times ``regen_efficiency`` (eta, the
-    share the other train can use).
-    """
-    dx = np.diff(traj.position_m)
-    f = traj.force_n[:-1]
-    v0, v1 = traj.speed_ms[:-1], traj.speed_ms[1:]
-    trac = np.where(f > 0, f * dx / train.traction_efficiency, 0.0)
-    brake = np.where(f < 0, -f, 0.0)
-    v_mid = 0.5 * (v0 + v1)
-    if train.regen_max_force_kn is not None:
-        brake = np.minimum(brake, train.regen_max_force_kn * 1000.0)
-    if train.regen_max_power_kw is not None:
-        brake = np.minimum(brake, train.regen_max_power_kw * 1000.0 / np.maximum(v_mid, 1e-9))
-    cut = train.regen_min_speed_kmh / KMH_PER_MS
-    hi, lo = np.maximum(v0, v1), np.minimum(v0, v1)
-    span = np.where(hi > lo, hi ** 2 - lo ** 2, 1.0)
-    share = np.where(lo >= cut, 1.0, np.where(hi <= cut, 0.0, (hi ** 2 - cut ** 2) / span))
-    regen = brake * dx * train.regen_efficiency * share
-    return trac, regen
-
-
-def power_profiles(traj_a: Trajectory, traj_b: Trajectory, offset_s: float, train: Train,
-                   time_step_s: float = 0.1) -> pd.DataFrame:
-    """Binned power (kW) of two runs of ``train`` on the common clock, A leaving at 0 and B at ``offset_s``.
-
-    Columns: ``time_s`` (bin start), ``traction_a_kw``, ``regen_a_kw`` (usable by B),
-    ``traction_b_kw``, ``regen_b_kw``, ``shared_kw`` (min of one's traction and the other's
-    regeneration, both ways).
-    """
-    offset_s = _finite("offset_s", offset_s)
-    t0 = min(0.0, offset_s)
-    t_end = max(traj_a.time_s[-1], offset_s + traj_b.time_s[-1])
-    n_bins = int(math.ceil((t_end - t0) / time_step_s)) + 1
-    cols = {}
-    for label, traj, shift in (("a", traj_a, 0.0), ("b", traj_b, offset_s)):
-        trac, regen = trajectory_energies(traj, train)
-        for name, e in (("traction", trac), ("regen", regen)):
-            bins = np.zeros(n_bins)
-            coop.bin_energy(np.ascontiguousarray(traj.time_s), np.ascontiguousarray(e), shift, t0, time_step_s, bins)
-            cols[f"{name}_{label}_kw"] = bins / time_step_s / 1000.0
-    frame = pd.DataFrame({"time_s": t0 + time_step_s * np.arange(n_bins), **cols})
-    frame["shared_kw"] = (np.minimum(frame["traction_a_kw"], frame["regen_b_kw"])
-                          + np.minimum(frame["traction_b_kw"], frame["regen_a_kw"]))
-    return frame
-
-
-def shared_energy_kwh(traj_a: Trajectory, traj_b: Trajectory, offset_s: float, train: Train,
-                      time_step_s: float = 0.1) -> float:
-    """Regenerated energy one train's traction takes from the other's braking, both ways (kWh)."""
-    frame = power_profiles(traj_a, traj_b, offset_s, train, time_step_s)
-    return float(frame["shared_kw"].sum() * time_step_s / 3600.0)
-
-
-# ---------------------------------------------------------------------- the uncoordinated baseline
-@dataclass(frozen=True, eq=False)
-class SoloRun:
-    """One train driven alone: the best of the single-train methods tried.
-
-    ``by_method`` holds each method's energy (kWh), ``xs`` its decision vector and ``trajectories``
-    its trajectory.
-    """
-
-    energy_kwh: float
-    running_time_s: float
-    method: str
-    trajectory: Trajectory
-    x: np.ndarray
-    by_method: dict
-    xs: dict
-    trajectories: dict
-
-
-@dataclass(frozen=True, eq=False)
-class Baseline:
-    """The uncoordinated case: each train energy-optimal alone, on time, nothing shared."""
-
-    a: SoloRun
-    b: SoloRun
-
-    @property
-    def energy_kwh(self) -> float:
-        return self.a.energy_kwh + self.b.energy_kwh
-
-
-SOLO_METHODS = {
-    # the seed's uncoordinated strategy: traction, cruise, coast, brake over the whole run
-    "four_phase": dict(encoding="switching_points", regimes=("traction", "hold", "coast", "brake")),
-    # speed codes on the gradient/limit partition (Liu (2019)), at most 200 m per section
-    "speed_codes": dict(encoding="speed_codes", max_section_m=200.0),
-    # the seed's own subsection model for one train (SubsectionProblem, with the seed's repair)
-    "subsections": None,
-}
-
-
-def solo_problem(leg: Case, method: str, time_tolerance_s: float = 0.1, dx_m: float | None = None) -> Problem:
-    """The single-train problem of one method: least traction energy, no regeneration credited."""
-    if method not in SOLO_METHODS:
-        raise ValueError(f"method {method!r} is unknown (known: {', '.join(SOLO_METHODS)})")
-    if method == "subsections":
-        return SubsectionProblem(leg, time_tolerance_s=max(time_tolerance_s, 1e-6), dx_m=dx_m)
-    from pymoo_rail.problems.speed_profile import SpeedProfileProblem
-
-    no_regen = replace(leg, train=replace(leg.train, regen_efficiency=0.0))
-    return SpeedProfileProblem(no_regen, objectives=("energy",), time_tolerance_s=time_tolerance_s, dx_m=dx_m,
-                               **SOLO_METHODS[method])
-
-
-def solo_run(leg: Case, methods: Sequence[str] = tuple(SOLO_METHODS), *, pop_size: int = 40, n_evals: int = 6000,
-             seed: int = 1, time_tolerance_s: float = 0.1, dx_m: float | None = None) -> SoloRun:
-    """The least traction energy of one train alone on ``leg``, within ``time_tolerance_s`` of its plan.
-
-    Every method is solved with pymoo DE (``solo_problem``); the train's own regeneration is never
-    credited (in Chen et al. (2017) regenerated energy only counts when another train uses it). The default
-    tolerance is 0.1 s, not 1 s: the cooperative problem runs both trains exactly on their plans,
-    and on ``cooperative-pair`` one second more is worth 0.3-0.8 kWh per train.
-    """
-    from pymoo.algorithms.soo.nonconvex.de import DE
-    from pymoo.optimize import minimize
-
-    energies, xs, trajs = {}, {}, {}
-    for name in methods:
-        problem = solo_problem(leg, name, time_tolerance_s, dx_m)
-        if name == "subsections":
-            algorithm = DE(pop_size=pop_size, variant="DE/best/1/bin", CR=0.3, F=0.5, repair=PunctualityRepair())
-        else:
-            algorithm = DE(pop_size=pop_size)
-        res = minimize(problem, algorithm, ("n_evals", n_evals), seed=seed)
-        if res.X is None:
-            continue
-        x = np.asarray(res.X, dtype=float)
-        traj = problem.decode(x).trajectory if name == "subsections" else problem.trajectory(x)
-        energies[name] = float(res.F[0])
-        xs[name] = x
-        trajs[name] = traj
-    if not energies:
-        raise RuntimeError(f"no single-train method found a feasible run of {leg.name}")
-    best = min(energies, key=energies.get)
-    return SoloRun(energy_kwh=energies[best], running_time_s=trajs[best].running_time_s, method=best,
-                   trajectory=trajs[best], x=xs[best], by_method=energies, xs=xs, trajectories=trajs)
-
-
-def uncoordinated_baseline(case: Case, **kwargs) -> Baseline:
-    """:func:`solo_run` for both legs of a two-leg case (A on leg 0, B on leg 1)."""
-    if len(case.legs) != 2:
-        raise CaseError("run.legs", f"{len(case.legs)} legs", "the baseline needs a case with exactly two legs",
-                        case.name)
-    return Baseline(a=solo_run(case.leg(0), **kwargs), b=solo_run(case.leg(1), **kwargs))
-
-
-# ---------------------------------------------------------------------- the nested GA of section 3
-class PartialProblem(Problem):
-    """A subsection problem with some genes held at reference values: only the ``free`` ones vary.
-
-    Evaluating a partial vector evaluates the full one; :class:`PunctualityRepair` repairs the full
-    vector and keeps the free part. Used by the nested GA and by :func:`alternating_minimize`.
-    """
-
-    def __init__(self, problem: _SubsectionModel, free: np.ndarray, x_ref: np.ndarray):
-        free = np.asarray(free, dtype=bool)
-        x_ref = np.asarray(x_ref, dtype=float)
-        if free.shape != (problem.n_var,) or x_ref.shape != (problem.n_var,) or not free.any():
-            raise ValueError(f"free and x_ref must have n_var = {problem.n_var} entries, with at least one free gene")
-        self.problem = problem
-        self.free = free
-        self.x_ref = x_ref
-        super().__init__(n_var=int(free.sum()), n_obj=problem.n_obj, n_ieq_constr=problem.n_ieq_constr,
-                         xl=problem.xl[free].copy(), xu=problem.xu[free].copy(), vtype=float)
-
-    def full(self, x: np.ndarray) -> np.ndarray:
-        x = np.atleast_2d(np.asarray(x, dtype=float))
-        X = np.repeat(self.x_ref[None, :], x.shape[0], axis=0)
-        X[:, self.free] = x
-        return X
-
-    def _evaluate(self, x, out, *args, **kwargs):
-        res = self.problem.evaluate(self.full(x), return_as_dictionary=True)
-        out["F"] = res["F"]
-        out["G"] = res["G"]
-
-
-class FixedBrakingProblem(PartialProblem):
-    """The inner problem of the nested GA: the cooperative problem with both braking distances fixed."""
-
-    def __init__(self, problem: CooperativeTrainsProblem, brake_m: Sequence[float]):
-        free = np.ones(problem.n_var, dtype=bool)
-        free[:2] = False
-        x_ref = np.concatenate([np.asarray(brake_m, dtype=float), problem.xl[2:]])
-        super().__init__(problem, free, x_ref)
-        self.brake_m = np.asarray(brake_m, dtype=float)
-
-
-class BrakingDistanceProblem(Problem):
-    """The outer problem of the nested GA: braking distances, each evaluated by an inner pymoo run.
-
-    The value of a pair of braking distances is the best the inner algorithm finds for the rest of
-    the vector (Chen et al. (2017) section 3.1); its constraint is that solution's violation. Inner runs are
-    seeded from the outer algorithm's ``random_state``.
-    """
-
-    def __init__(self, problem: CooperativeTrainsProblem, inner_algorithm, inner_termination):
-        self.problem = problem
-        self.inner_algorithm = inner_algorithm
-        self.inner_termination = inner_termination
-        super().__init__(n_var=2, n_obj=1, n_ieq_constr=1, xl=problem.xl[:2].copy(), xu=problem.xu[:2].copy(),
-                         vtype=float)
-
-    def _evaluate(self, x, out, *args, algorithm=None, **kwargs):
-        from pymoo.optimize import minimize
-
-        rng = algorithm.random_state if algorithm is not None else np.random.default_rng(0)
-        f = np.empty(x.shape[0])
-        g = np.empty(x.shape[0])
-        inner = np.empty((x.shape[0], self.problem.n_var - 2))
-        for i, brake in enumerate(x):
-            res = minimize(FixedBrakingProblem(self.problem, brake), copy.deepcopy(self.inner_algorithm),
-                           self.inner_termination, seed=int(rng.integers(2**31 - 1)))
-            best = res.algorithm.opt[0]  # the best found, or the least infeasible
-            f[i] = best.F[0]
-            g[i] = best.CV[0]
-            inner[i] = best.X
-        out["F"] = f[:, None]
-        out["G"] = g[:, None]
-        out["inner_X"] = inner
-
-
-def nested_minimize(problem: CooperativeTrainsProblem, *, outer_pop_size: int = 24, outer_n_gen: int = 20,
-                    inner_pop_size: int = 100, inner_n_gen: int = 80, inner_algorithm=None, seed: int = 1,
-                    verbose: bool = False):
-    """The nested GA of Chen et al. (2017) section 3: an outer pymoo GA on the braking distances whose every
-    evaluation runs an inner pymoo GA on the traction coefficients, exit speeds and time shares.
-
-    Defaults are the seed's sizes (section 4.1: outer 24 x 20, inner 100 x 80); pymoo's GA
-    operators (SBX, polynomial mutation, elitist survival) stand in for the seed's roulette wheel
-    and one/two-point operators. Returns ``(x, F, outer_result)`` with ``x`` the full best vector.
-    """
-    from pymoo.algorithms.soo.nonconvex.ga import GA
-    from pymoo.optimize import minimize
-
-    if inner_algorithm is None:
-        repair = PunctualityRepair() if problem.relative_speeds else None
-        inner_algorithm = GA(pop_size=inner_pop_size, eliminate_duplicates=True, repair=repair)
-    outer = BrakingDistanceProblem(problem, inner_algorithm, ("n_gen", inner_n_gen))
-    res = minimize(outer, GA(pop_size=outer_pop_size, eliminate_duplicates=True), ("n_gen", outer_n_gen), seed=seed,
-                   verbose=verbose)
-    best = res.algorithm.opt[0]  # the best found, or the least infeasible
-    x = np.concatenate([best.X, best.get("inner_X")])
-    return x, float(best.F[0]), res
-
-
-def train_genes(problem: CooperativeTrainsProblem, k: int) -> np.ndarray:
-    """Mask of train k's genes (its braking distance and its subsection triples)."""
-    mask = np.zeros(problem.n_var, dtype=bool)
-    brake_col, first = problem._blocks[k]
-    mask[brake_col] = True
-    mask[first:first + 3 * problem.trains[k].n_sub] = True
-    return mask
-
-
-def alternating_minimize(problem: CooperativeTrainsProblem, x0: np.ndarray, *, rounds: int = 2,
-                         n_evals: Sequence[int] = (4000, 3000), pop_size: int = 40, seed: int = 1,
-                         algorithm=None):
-    """Train-by-train optimisation: A and B take turns, each optimised with the other held fixed.
-
-    Each turn is a pymoo run (by default DE/best/1/bin, CR 0.3, with :class:`PunctualityRepair`)
-    on a :class:`PartialProblem` holding one train's genes free, started from the current vector
-    plus random vectors. A turn keeps its result only when it is at least as good, so the objective
-    never rises. The single-train searches are much easier than the joint one, and each turn can
-    still move one train's traction onto the other's braking. Returns ``(x, F)``.
-    """
-    from pymoo.algorithms.soo.nonconvex.de import DE
-    from pymoo.core.evaluator import Evaluator
-    from pymoo.core.population import Population
-    from pymoo.optimize import minimize
-
-    x = np.asarray(x0, dtype=float).copy()
-
-    def score(vec):
-        pop = Population.new(X=np.atleast_2d(vec))
-        Evaluator().eval(problem, pop)
-        return float(pop.get("F")[0, 0]), float(pop.get("CV")[0, 0])
-
-    best = score(x)
-    rng = np.random.default_rng(seed)
-    for r in range(rounds):
-        for k in (0, 1):
-            sub_problem = PartialProblem(problem, train_genes(problem, k), x)
-            X = sub_problem.xl + rng.random((pop_size, sub_problem.n_var)) * (sub_problem.xu - sub_problem.xl)
-            X[0] = x[sub_problem.free]
-            algo = copy.deepcopy(algorithm) if algorithm is not None else DE(
-                pop_size=pop_size, variant="DE/best/1/bin", CR=0.3, F=0.5, repair=PunctualityRepair())
-            algo.initialization.sampling = X
-            res = minimize(sub_problem, algo, ("n_evals", n_evals[k % len(n_evals)]),
-                           seed=int(rng.integers(2**31 - 1)))
-            cand = sub_problem.full(res.algorithm.opt[0].X)[0]
-            cand_score = score(cand)
-            if (cand_score[1], cand_score[0]) <= (best[1], best[0]):
-                x, best = cand, cand_score
-    return x, best[0]
+        return (f"CooperativeTrainsProblem({self.case.name}, offset {self.offset_s:g} s: shapes of {a.n_var} + "
+                f"{b.n_var} sections, paced to {a.case.planned_time_s:g} s and {b.case.planned_time_s:g} s)")

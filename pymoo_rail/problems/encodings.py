@@ -37,6 +37,7 @@ from pymoo_rail.sim import (
     switching_programs,
 )
 from pymoo_rail.sim import kernel as k
+from pymoo_rail.sim.pacing import split_long_sections
 
 KMH_PER_MS = 3.6
 PARTITIONS = ("gradient_limit", "equal")
@@ -45,16 +46,6 @@ PARTITIONS = ("gradient_limit", "equal")
 # reference would otherwise be one variable: one cruise speed, no coasting).
 SPARSE_MEAN_SECTION_M = 2000.0
 SPARSE_MAX_SECTION_M = 1000.0
-
-
-def _split_long(boundaries: np.ndarray, max_section_m: float | None) -> np.ndarray:
-    if max_section_m is None:
-        return boundaries
-    out = [boundaries[0]]
-    for a, b in zip(boundaries[:-1], boundaries[1:]):
-        pieces = int(np.ceil((b - a) / max_section_m - 1e-9))
-        out.extend(np.linspace(a, b, pieces + 1)[1:])
-    return np.asarray(out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,7 +81,7 @@ class SpeedCodes:
             bounds = np.unique(np.concatenate([bounds, neutral_points]))
             if max_section_m is None and (bounds[-1] - bounds[0]) / (bounds.shape[0] - 1) > SPARSE_MEAN_SECTION_M:
                 max_section_m = SPARSE_MAX_SECTION_M
-            bounds = _split_long(bounds, max_section_m)
+            bounds = split_long_sections(bounds, max_section_m)
         elif partition == "equal":
             bounds = equal_partition(line, n_sections if n_sections is not None else 10)
         else:

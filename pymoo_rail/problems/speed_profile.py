@@ -23,7 +23,9 @@ OBJECTIVE_ALIASES = {"jerk": "accel_variation"}
 def canonical_objective(name: str) -> str:
     """The objective a name stands for (``"jerk"`` -> ``"accel_variation"``; others unchanged)."""
     return OBJECTIVE_ALIASES.get(name, name)
-DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m", "braking_onset": "m (last: m/s^2)"}
+
+
+DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m", "braking_onset": "m"}
 
 
 class DecisionError(ValueError):
@@ -34,12 +36,11 @@ class DecisionError(ValueError):
         super().__init__(message)
 
 
-def check_decisions(X: np.ndarray, xl: np.ndarray, xu: np.ndarray, unit: str = "") -> np.ndarray:
+def check_decisions(X: np.ndarray, xl: np.ndarray, xu: np.ndarray, units: str | Sequence[str] = "") -> np.ndarray:
     """``X`` (N, n_var) as floats after checking it is finite and within ``[xl, xu]``; else :class:`DecisionError`."""
     X = np.atleast_2d(np.asarray(X, dtype=float))
     if X.ndim != 2 or X.shape[1] != xl.shape[0]:
         raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {xl.shape[0]}")
-    unit = f" {unit}" if unit else ""
     with np.errstate(invalid="ignore"):
         bad = ~np.isfinite(X) | (X < xl) | (X > xu)
     rows = np.flatnonzero(bad.any(axis=1))
@@ -47,12 +48,16 @@ def check_decisions(X: np.ndarray, xl: np.ndarray, xu: np.ndarray, unit: str = "
         r = int(rows[0])
         j = int(np.flatnonzero(bad[r])[0])
         what = "is not a finite number" if not np.isfinite(X[r, j]) else "is outside its bounds"
+        unit = units if isinstance(units, str) else units[j]
+        unit = f" {unit}" if unit else ""
         listed = ", ".join(str(int(i)) for i in rows[:10]) + (", ..." if rows.size > 10 else "")
         raise DecisionError(
             f"decision row {r}, variable {j} = {float(X[r, j])!r}{unit} {what} ([{xl[j]:g}, {xu[j]:g}]{unit}); "
             f"{rows.size} of {X.shape[0]} rows are bad (rows {listed}). Nothing was evaluated: decisions must "
             "be finite and inside [xl, xu] (clip or repair them first)", [int(i) for i in rows])
     return X
+
+
 SEED_002_WEIGHTS = {"energy": 0.1, "jerk": 0.2, "stop_error": 0.4, "time_error": 0.3}
 
 
@@ -257,7 +262,10 @@ class SpeedProfileProblem(Problem):
         DecisionError
             Naming the bad rows, and the first bad variable, value and bounds in the encoding's unit.
         """
-        return check_decisions(X, self.xl, self.xu, DECISION_UNITS.get(self.encoding.name, ""))
+        units = [DECISION_UNITS.get(self.encoding.name, "")] * self.n_var
+        if self.encoding.name == "braking_onset":
+            units[-1] = "m/s^2"  # positions, then the service deceleration
+        return check_decisions(X, self.xl, self.xu, units)
 
     def _evaluate(self, x, out, *args, **kwargs):
         s = self.summaries(self.check_decisions(x))

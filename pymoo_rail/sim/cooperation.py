@@ -1,16 +1,19 @@
-"""Two trains on a common clock: power profiles, shared regenerative energy, separation.
+"""Trains on a common clock: power profiles, shared regenerative energy, separation.
 
-Seed 001 eqs. 4-6: while train A draws traction power ``P_A(t)`` and train B brakes with usable
-regenerative power ``eta P_B(t)``, A takes ``min(P_A, eta P_B)`` from B instead of the
-substation (and the other way round); the total net energy is the traction energy of both
-minus what was shared.
+Seed 001 eqs. 4-6 (Chen et al. 2017): while train A draws traction power ``P_A(t)`` and train B
+brakes with usable regenerative power ``eta P_B(t)``, A takes ``min(P_A, eta P_B)`` from B instead
+of the substation (and the other way round); the total net energy is the traction energy of both
+minus what was shared. For several trains in one power-supply section, any train's regenerated
+power can feed any other train's traction through the supply, with a transmission efficiency
+(:func:`shared_energy_bins`); for a pair that is eq. 5.
 
-A run is given per grid cell: the times of its nodes (from its own departure) and the energy of
-each cell (J). Each cell's energy is spread evenly over the cell's duration and collected into
-bins of ``dt`` seconds on the common clock, so a bin holds exactly the energy drawn (or
-regenerated) in it and the totals are preserved. The shared energy of a bin is the smaller of
-the two bin energies: never more than either train drew or regenerated there. (Within a bin
-this is an upper bound on the integral of the pointwise minimum; with 0.1 s bins against
+Runs come from the simulator's own traces (:class:`ClockedRun`): the times of their nodes (from
+their own departure) and the energy of each cell from the kernel's accounting
+(:func:`pymoo_rail.sim.kernel.trace_cell_energies`). Each cell's energy is spread evenly over the
+cell's duration and collected into bins of ``dt`` seconds on the common clock, so a bin holds
+exactly the energy drawn (or regenerated) in it and the totals are preserved. The shared energy of
+a bin is the smaller of the bin energies: never more than was drawn or regenerated there. (Within
+a bin this is an upper bound on the integral of the pointwise minimum; with 0.1 s bins against
 traction and braking phases of tens of seconds the difference is immaterial.)
 
 Separation (eq. 9): the following train may not run faster than it could stop, at the service
@@ -23,9 +26,17 @@ Everything here is SI and free of pymoo.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
+import pandas as pd
+from numba import njit
+
+from pymoo_rail.sim.kernel import trace_cell_energies
+from pymoo_rail.sim.physics import KernelModel
+from pymoo_rail.sim.trajectory import Trajectory
+
+J_PER_KWH = 3.6e6
 
 
 @njit(cache=True)
@@ -62,24 +73,43 @@ def bin_energy(t_nodes, e_cells, shift_s, t0_s, dt_s, out):
 
 
 @njit(cache=True)
-def shared_energy(trac_a, regen_a, trac_b, regen_b):
-    """(energy A takes from B's braking, energy B takes from A's braking), J, from binned profiles."""
-    a_from_b = 0.0
-    b_from_a = 0.0
-    for k in range(trac_a.shape[0]):
-        a_from_b += min(trac_a[k], regen_b[k])
-        b_from_a += min(trac_b[k], regen_a[k])
-    return a_from_b, b_from_a
+def shared_energy_bins(trac, regen, transmission_efficiency):
+    """Energy (J) the trains' traction takes from the other trains' braking, per bin of the common clock.
+
+    ``trac`` and ``regen`` are (n_trains, n_bins): traction energy drawn and regenerated energy
+    delivered (already times each train's utilisation eta) per bin. In a bin every train's
+    regenerated energy, times ``transmission_efficiency`` (the supply's losses), can feed any
+    *other* train's traction. The most that can be shared is a maximum flow from the braking to
+    the drawing trains; its minimum cut is ``min(R, T, min_j (R - r_j + T - t_j))`` with ``R``, ``T``
+    the sums. For two trains this is exactly seed 001 eq. 5 both ways,
+    ``min(t_A, r_B) + min(t_B, r_A)``, and a train alone shares nothing with itself.
+    """
+    n_trains, n_bins = trac.shape
+    out = np.zeros(n_bins)
+    for k in range(n_bins):
+        t_sum = 0.0
+        r_sum = 0.0
+        for j in range(n_trains):
+            t_sum += trac[j, k]
+            r_sum += transmission_efficiency * regen[j, k]
+        best = t_sum if t_sum < r_sum else r_sum
+        for j in range(n_trains):
+            cut = r_sum - transmission_efficiency * regen[j, k] + t_sum - trac[j, k]
+            if cut < best:
+                best = cut
+        out[k] = best if best > 0.0 else 0.0
+    return out
 
 
 @njit(cache=True)
 def separation_excess(t_f, x_f, v_f, shift_f, start_f, t_l, x_l, shift_l, start_l, gap_m, decel_ms2, t0_s, dt_s,
-                      n_steps):
+                      n_steps, clear_s=math.inf):
     """Largest ``v_f^2 / (2 b) - (dS - L_t - L_s)`` (m) of the following train while it runs.
 
     ``x_*`` are node positions on each train's own line, placed on a common line at ``start_*``;
     ``t_*`` node times from each departure at ``shift_*`` on the common clock. The leading train
-    stands at its start before departing and at its end after arriving. Checked every ``dt_s``
+    stands at its start before departing and at its end after arriving, until ``clear_s`` on the
+    common clock, when it leaves the line (a terminus cleared). Checked every ``dt_s``
     from ``t0_s`` and at the follower's arrival (> 0: the follower runs too close).
     """
     worst = -1e300
@@ -111,6 +141,8 @@ def separation_excess(t_f, x_f, v_f, shift_f, start_f, t_l, x_l, shift_l, start_
             x = x_f[i_f + 1]
         pos_f = start_f + x
         tau_l = t - shift_l
+        if t >= clear_s:
+            continue
         if tau_l <= 0.0:
             pos_l = start_l
         elif tau_l >= t_l[n_l - 1]:
@@ -127,33 +159,124 @@ def separation_excess(t_f, x_f, v_f, shift_f, start_f, t_l, x_l, shift_l, start_
     return worst
 
 
-@njit(cache=True, parallel=True)
-def cooperation_batch(t_a, e_trac_a, e_regen_a, t_b, e_trac_b, e_regen_b, shift_b_s, t0_s, dt_s, n_bins):
-    """Shared energy (N, 2) in J for a population: column 0 A from B, column 1 B from A."""
-    n_runs = t_a.shape[0]
-    out = np.empty((n_runs, 2))
-    for r in prange(n_runs):
-        ta = np.zeros(n_bins)
-        ra = np.zeros(n_bins)
-        tb = np.zeros(n_bins)
-        rb = np.zeros(n_bins)
-        bin_energy(t_a[r], e_trac_a[r], 0.0, t0_s, dt_s, ta)
-        bin_energy(t_a[r], e_regen_a[r], 0.0, t0_s, dt_s, ra)
-        bin_energy(t_b[r], e_trac_b[r], shift_b_s, t0_s, dt_s, tb)
-        bin_energy(t_b[r], e_regen_b[r], shift_b_s, t0_s, dt_s, rb)
-        a_from_b, b_from_a = shared_energy(ta, ra, tb, rb)
-        out[r, 0] = a_from_b
-        out[r, 1] = b_from_a
-    return out
+# ------------------------------------------------------------------ runs on the common clock
+@dataclass(frozen=True, eq=False)
+class ClockedRun:
+    """A simulated run (or a journey of runs and dwells) placed on the common clock and line.
+
+    Arrays are per node (``time_s`` from the departure, ``position_m`` from ``start_m``,
+    ``speed_ms``) and per cell (``traction_j`` drawn, ``regen_j`` delivered), the energies from
+    the kernel's own accounting (:func:`pymoo_rail.sim.kernel.trace_cell_energies`).
+    """
+
+    time_s: np.ndarray
+    position_m: np.ndarray
+    speed_ms: np.ndarray
+    traction_j: np.ndarray
+    regen_j: np.ndarray
+    departure_s: float
+    start_m: float
+
+    @property
+    def arrival_s(self) -> float:
+        return self.departure_s + float(self.time_s[-1])
+
+    @property
+    def traction_kwh(self) -> float:
+        return float(self.traction_j.sum() / J_PER_KWH)
+
+    @property
+    def regen_kwh(self) -> float:
+        return float(self.regen_j.sum() / J_PER_KWH)
 
 
-@njit(cache=True, parallel=True)
-def separation_batch(t_f, x_f, v_f, shift_f, start_f, t_l, x_l, shift_l, start_l, gap_m, decel_ms2, t0_s, dt_s,
-                     n_steps):
-    """:func:`separation_excess` for a population (rows of ``t_f``, ``v_f``, ``t_l``; shared positions)."""
-    n_runs = t_f.shape[0]
-    out = np.empty(n_runs)
-    for r in prange(n_runs):
-        out[r] = separation_excess(t_f[r], x_f, v_f[r], shift_f, start_f, t_l[r], x_l, shift_l, start_l, gap_m,
-                                   decel_ms2, t0_s, dt_s, n_steps)
-    return out
+def clocked_run(model: KernelModel, trajectory: Trajectory, departure_s: float = 0.0,
+                start_m: float = 0.0) -> ClockedRun:
+    """Place a simulator run (of the case behind ``model``) at ``departure_s`` and ``start_m``."""
+    if not (math.isfinite(departure_s) and math.isfinite(start_m)):
+        raise ValueError(f"departure_s = {departure_s!r}, start_m = {start_m!r}: must be finite")
+    x = np.ascontiguousarray(trajectory.position_m)
+    v = np.ascontiguousarray(trajectory.speed_ms)
+    trac, regen = trace_cell_energies(model, x, v, np.ascontiguousarray(trajectory.force_n))
+    return ClockedRun(time_s=np.ascontiguousarray(trajectory.time_s), position_m=x, speed_ms=v, traction_j=trac,
+                      regen_j=regen, departure_s=float(departure_s), start_m=float(start_m))
+
+
+def chain_runs(runs) -> ClockedRun:
+    """One journey of consecutive runs (each placed on its own): standing still between them."""
+    first = runs[0]
+    t, x, v, trac, regen = [first.time_s], [first.position_m], [first.speed_ms], [first.traction_j], [first.regen_j]
+    for prev, r in zip(runs[:-1], runs[1:]):
+        if r.departure_s < prev.arrival_s - 1e-9:
+            raise ValueError(f"a run departs at {r.departure_s} s, before the previous one arrives at "
+                             f"{prev.arrival_s} s")
+        # the dwell is one cell of no distance and no energy, then the run
+        t.append(r.time_s + (r.departure_s - first.departure_s))
+        x.append(r.position_m + (r.start_m - first.start_m))
+        v.append(r.speed_ms)
+        trac += [np.zeros(1), r.traction_j]
+        regen += [np.zeros(1), r.regen_j]
+    return ClockedRun(time_s=np.concatenate(t), position_m=np.concatenate(x), speed_ms=np.concatenate(v),
+                      traction_j=np.concatenate(trac), regen_j=np.concatenate(regen), departure_s=first.departure_s,
+                      start_m=first.start_m)
+
+
+def clock_span(runs, time_step_s: float) -> tuple[float, int]:
+    """Start and number of bins of a clock covering every run."""
+    if not (math.isfinite(time_step_s) and time_step_s > 0):
+        raise ValueError(f"time_step_s = {time_step_s!r}: must be a positive number of seconds")
+    t0 = min(r.departure_s for r in runs)
+    t_end = max(r.arrival_s for r in runs)
+    return t0, int(math.ceil((t_end - t0) / time_step_s)) + 1
+
+
+def power_bins(runs, t0_s: float, time_step_s: float, n_bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """Traction and regenerated energy (J) of each run per bin: two (n_runs, n_bins) arrays."""
+    trac = np.zeros((len(runs), n_bins))
+    regen = np.zeros((len(runs), n_bins))
+    for j, r in enumerate(runs):
+        t = r.time_s
+        bin_energy(t, r.traction_j, r.departure_s, t0_s, time_step_s, trac[j])
+        bin_energy(t, r.regen_j, r.departure_s, t0_s, time_step_s, regen[j])
+    return trac, regen
+
+
+def shared_energy_kwh(runs, transmission_efficiency: float = 1.0, time_step_s: float = 0.1) -> float:
+    """Regenerated energy the runs' traction takes from each other's braking (kWh), seed 001 eq. 5."""
+    t0, n_bins = clock_span(runs, time_step_s)
+    trac, regen = power_bins(runs, t0, time_step_s, n_bins)
+    return float(shared_energy_bins(trac, regen, float(transmission_efficiency)).sum() / J_PER_KWH)
+
+
+def power_profiles(runs, labels, transmission_efficiency: float = 1.0, time_step_s: float = 0.1) -> pd.DataFrame:
+    """Power of every run on the common clock (kW per bin) and the shared power.
+
+    Columns ``time_s`` (bin start), ``traction_<label>_kw``, ``regen_<label>_kw`` per run, and
+    ``shared_kw``.
+    """
+    labels = list(labels)
+    if len(labels) != len(runs):
+        raise ValueError(f"{len(labels)} labels for {len(runs)} runs")
+    t0, n_bins = clock_span(runs, time_step_s)
+    trac, regen = power_bins(runs, t0, time_step_s, n_bins)
+    to_kw = 1.0 / time_step_s / 1000.0
+    cols = {"time_s": t0 + time_step_s * np.arange(n_bins)}
+    for j, label in enumerate(labels):
+        cols[f"traction_{label}_kw"] = trac[j] * to_kw
+        cols[f"regen_{label}_kw"] = regen[j] * to_kw
+    cols["shared_kw"] = shared_energy_bins(trac, regen, float(transmission_efficiency)) * to_kw
+    return pd.DataFrame(cols)
+
+
+def separation_m(follower: ClockedRun, leader: ClockedRun, gap_m: float, decel_ms2: float,
+                 time_step_s: float = 0.1, clear_s: float = math.inf) -> float:
+    """Largest excess (m) of the follower's braking distance over its room behind the leader (eq. 9).
+
+    ``gap_m`` is the train length plus the safety margin; > 0 means the follower runs too close.
+    The leader stands at its last stop after arriving until ``clear_s`` (common clock), then leaves.
+    """
+    t0, n_bins = clock_span((follower, leader), time_step_s)
+    f, lead = follower, leader
+    return float(separation_excess(f.time_s, f.position_m, f.speed_ms, follower.departure_s, follower.start_m,
+                                   lead.time_s, lead.position_m, leader.departure_s, leader.start_m, float(gap_m), float(decel_ms2), t0,
+                                   time_step_s, n_bins, float(clear_s)))

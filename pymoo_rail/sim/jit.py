@@ -4,7 +4,7 @@ The simulator's kernels are compiled by Numba on their first call in a fresh ins
 of seconds on a small machine) and cached on disk next to the package (or in
 ``NUMBA_CACHE_DIR``); later runs load them in a fraction of a second. :func:`compile_notice`
 tells the user when that first compilation happens, so a first run does not look hung, and
-:func:`warmup` compiles ahead of time (``pymoo-rail warmup``), e.g. when building a container
+:func:`pymoo_rail.warmup.warmup` compiles ahead of time (``pymoo-rail warmup``), e.g. when building a container
 image or before a study on a cluster whose workers share the cache directory.
 """
 
@@ -91,55 +91,3 @@ def compile_notice(say: Callable[[str], None] = _say_stderr, summary: bool = Tru
     if summary and watch.n_compiled:
         say(f"compiled {watch.n_compiled} simulator functions in {watch.compile_s:.0f} s (cached: later runs "
             "start at once)")
-
-
-WARMUP_PARTS = ("simulator", "reference", "tracking")
-
-
-def warmup(parts: tuple[str, ...] = ("simulator",), case: str = "yizhuang") -> dict[str, float]:
-    """Compile (or load from the cache) the kernels a command uses, ahead of time.
-
-    Parameters
-    ----------
-    parts : tuple of str
-        Any of ``"simulator"`` (the kernels of ``pymoo-rail optimize`` and of
-        ``SpeedProfileProblem``: both encodings, batches and traces), ``"reference"`` (the exact
-        solver of ``pymoo-rail reference``), ``"tracking"`` (the ATO controllers).
-    case : str
-        A built-in case to run them on.
-
-    Returns
-    -------
-    dict
-        Wall time (s) per part.
-    """
-    import numpy as np
-
-    from pymoo_rail.cases import load_case
-
-    unknown = [p for p in parts if p not in WARMUP_PARTS]
-    if unknown:
-        raise ValueError(f"warm-up part {unknown[0]!r} is unknown (known: {', '.join(WARMUP_PARTS)})")
-    the_case = load_case(case)
-    seconds: dict[str, float] = {}
-    for part in parts:
-        start = time.perf_counter()
-        if part == "simulator":
-            from pymoo_rail.problems import SpeedProfileProblem
-
-            for encoding in ("speed_codes", "switching_points"):
-                problem = SpeedProfileProblem(the_case, encoding=encoding)
-                X = np.random.default_rng(0).uniform(problem.xl, problem.xu, (4, problem.n_var))
-                problem.evaluate(X)
-                problem.trajectory(X[0])
-        elif part == "reference":
-            from pymoo_rail.optimal import min_running_time, optimal_profile
-
-            optimal_profile(the_case, 1.1 * min_running_time(the_case))
-        else:
-            from pymoo_rail.control import PID, track
-            from pymoo_rail.sim import Simulator
-
-            track(the_case, Simulator(the_case).flat_out(), PID())
-        seconds[part] = time.perf_counter() - start
-    return seconds

@@ -234,6 +234,28 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
 
 
 @njit(cache=True)
+def trace_cell_energies(m, x, v, f):
+    """Per-cell energies of a recorded run (J): traction drawn and regeneration delivered.
+
+    ``x``, ``v`` are the trace's node positions and speeds, ``f`` its per-cell forces. The same
+    accounting as :func:`complete_cell` (traction ``F dx / eta_traction``; regeneration
+    ``eta_regen`` times the electric share of braking above the cut-off speed), so the sums equal
+    the run's ``traction_kwh`` and ``regen_kwh``; used to put runs on a common clock.
+    """
+    n_cells = x.shape[0] - 1
+    trac = np.zeros(n_cells)
+    regen = np.zeros(n_cells)
+    for i in range(n_cells):
+        d = x[i + 1] - x[i]
+        if f[i] > 0.0:
+            trac[i] = f[i] * d / m.traction_efficiency
+        elif f[i] < 0.0:
+            share = _share_above(v[i], v[i + 1], m.regen_min_speed_ms)
+            regen[i] = m.regen_efficiency * electric_braking_capped(m, 0.5 * (v[i] + v[i + 1]), -f[i]) * d * share
+    return trac, regen
+
+
+@njit(cache=True)
 def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime):
     """Write one cell into the trace arrays."""
     tr_x[cell + 1] = x1

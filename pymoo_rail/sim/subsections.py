@@ -34,8 +34,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from pymoo_rail.sim.kernel import REGIME_BRAKE, REGIME_COAST, REGIME_CRUISE, REGIME_TRACTION, _share_above
-from pymoo_rail.sim.physics import davis_force, electric_braking_capped, max_braking, max_traction
+from pymoo_rail.sim.kernel import REGIME_BRAKE, REGIME_COAST, REGIME_CRUISE, REGIME_TRACTION, trace_cell_energies
+from pymoo_rail.sim.physics import davis_force, max_braking, max_traction
 
 # Columns of the per-subsection record (sub_out[j, :]).
 SUB_ACTIVE = 0       # 1 when the subsection lies before the braking point
@@ -387,7 +387,7 @@ def time_window(m, sub_start, sub_end, sub_kind, sub_cap, brake_dist_m, gamma, v
 @njit(cache=True)
 def repair_one(m, sub_start, sub_end, sub_kind, sub_cap, brake_dist_m, gamma, v_rel, planned_time_s, service_decel_ms2,
                v_floor_ms, gamma_out, v_out, iterations):
-    """The seed's repair (section 3.2, step 1) for relative speed genes: move the exit speeds until
+    """The paper's repair (section 3.2, step 1) for relative speed genes: move the exit speeds until
     the planned time lies in the window of eq. 10.
 
     Too slow: every exit speed and traction coefficient moves the same fraction lam toward 1 (the
@@ -623,20 +623,13 @@ def drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_
         f_out[i] = f
         if f > 0.0:
             w_trac += f * dx
-            e_trac[i] = f * dx / m.traction_efficiency
-            e_regen[i] = 0.0
             over = (f - max_traction(m, vm, i)) / mass
         else:
-            e_trac[i] = 0.0
             brake_n = -f
             w_brake += brake_n * dx
-            e_regen[i] = (m.regen_efficiency * electric_braking_capped(m, vm, brake_n) * dx
-                          * _share_above(v0, v1, m.regen_min_speed_ms)) if brake_n > 0.0 else 0.0
             over = (brake_n - max_braking(m, vm, i)) / mass
         if over > force_excess:
             force_excess = over
-        e_tr_sum += e_trac[i]
-        e_rg_sum += e_regen[i]
         w_davis += w0 * dx
         w_line += wl * dx
         if lab[i] == _LAB_BRAKE:
@@ -652,6 +645,14 @@ def drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_
         ex = v1 - m.limit_ms[i + 1]
         if ex > limit_excess:
             limit_excess = ex
+
+    # the energies of every cell by the kernel's own accounting
+    cell_trac, cell_regen = trace_cell_energies(m, m.position_m, v_out, f_out)
+    for i in range(n - 1):
+        e_trac[i] = cell_trac[i]
+        e_regen[i] = cell_regen[i]
+        e_tr_sum += cell_trac[i]
+        e_rg_sum += cell_regen[i]
 
     # eq. 8: change of acceleration where the gradient changes between subsections, each side's
     # acceleration taken as the mean over comfort_window_m (one cell alone would depend on the grid)

@@ -238,3 +238,14 @@ def test_switching_points_with_hold_brake_hold_the_speed_down_a_descent():
     assert np.ptp(runs["hold_brake"].speed_ms[down]) < 1e-9 and np.all(runs["hold_brake"].force_n[down] < 0.0)
     assert runs["hold"].speed_ms[down].max() > runs["hold_brake"].speed_ms[down].max() + 5.0
     assert runs["hold_brake"].energy.regen_kwh > runs["hold"].energy.regen_kwh
+
+
+def test_decisions_are_reported_in_each_variables_unit(yizhuang):
+    p = SpeedProfileProblem(yizhuang, objectives=("energy", "stop_error"), encoding="braking_onset")
+    X = np.tile(p.xl, (2, 1))
+    X[1, -1] = p.xu[-1] + 4.0  # the service deceleration
+    with pytest.raises(DecisionError, match=rf"row 1, variable {p.n_var - 1} = .* m/s\^2 is outside"):
+        p.evaluate(X)
+    X[1, -1], X[1, 0] = p.xu[-1], -1.0  # a switching position
+    with pytest.raises(DecisionError, match=r"row 1, variable 0 = -1.0 m is outside"):
+        p.evaluate(X)

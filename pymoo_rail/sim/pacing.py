@@ -1,0 +1,172 @@
+"""Punctuality by construction: a driving shape plus one pace, the pace found for the planned time.
+
+A *paced* program family maps a shape ``c`` (speed codes as fractions of each section's limit, in
+[0, 1]) and a scalar pace ``p`` in [-1, 1] to targets ``limit_k * clip(c_k + p, 0, 1)``: at
+``p = 1`` every section runs at its limit (the fastest run), at ``p = -1`` every target is zero (the
+train never leaves). Raising the pace raises every target, so the train is nowhere slower and the
+running time falls monotonically with ``p``. :func:`solve_pace` finds, for a whole population at
+once, the pace at which each shape takes its planned time, by bracketing regula falsi (Illinois)
+with bisection where a run does not reach the platform. The shape is what an optimiser varies; the
+time is met by the solve, as the exact solver meets it by pricing time (:mod:`pymoo_rail.optimal`).
+
+Nothing here knows pymoo.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pymoo_rail.model import Case
+from pymoo_rail.sim.drivers import gradient_limit_partition, speed_code_programs
+from pymoo_rail.sim.kernel import OUT_REACHED, OUT_RUNNING_TIME_S
+from pymoo_rail.sim.simulator import Simulator
+
+PACE_MIN, PACE_MAX = -1.0, 1.0
+DEFAULT_TIME_TOL_S = 0.02
+MAX_ITERATIONS = 40
+
+
+def split_long_sections(boundaries_m: np.ndarray, max_section_m: float | None) -> np.ndarray:
+    """Cut every section longer than ``max_section_m`` into equal pieces."""
+    if max_section_m is None:
+        return np.asarray(boundaries_m, dtype=float)
+    if not (np.isfinite(max_section_m) and max_section_m > 0):
+        raise ValueError(f"max_section_m = {max_section_m!r}: must be a positive number of metres")
+    out = [float(boundaries_m[0])]
+    for a, b in zip(boundaries_m[:-1], boundaries_m[1:]):
+        pieces = int(np.ceil((b - a) / max_section_m - 1e-9))
+        out.extend(np.linspace(a, b, pieces + 1)[1:])
+    return np.asarray(out)
+
+
+@dataclass(frozen=True, eq=False)
+class PacedSpeedCodes:
+    """Speed-code shapes of one run, timed by a pace (see the module docstring).
+
+    Attributes
+    ----------
+    boundaries_m : (n_sections + 1,)
+        Section boundaries: every gradient and limit change, long sections split.
+    limits_ms : (n_sections,)
+        The highest target of each section (its lowest limit, at most the train's maximum speed).
+    planned_time_s : float
+        The running time every shape is paced to.
+    """
+
+    boundaries_m: np.ndarray
+    limits_ms: np.ndarray
+    planned_time_s: float
+
+    @classmethod
+    def build(cls, case: Case, max_section_m: float | None = 200.0,
+              planned_time_s: float | None = None) -> PacedSpeedCodes:
+        """The shape encoding of a single-run case, paced to ``planned_time_s`` (default: its plan)."""
+        line = case.line
+        bounds = split_long_sections(gradient_limit_partition(line), max_section_m)
+        limits = np.empty(bounds.shape[0] - 1)
+        for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
+            limits[k] = min(v for s, e, v in line.speed_limits if s < b and e > a)
+        limits = np.minimum(limits, case.train.max_speed_kmh) / 3.6
+        planned = case.planned_time_s if planned_time_s is None else float(planned_time_s)
+        if not (np.isfinite(planned) and planned > 0):
+            raise ValueError(f"planned_time_s = {planned_time_s!r}: must be a positive number of seconds")
+        return cls(boundaries_m=bounds, limits_ms=limits, planned_time_s=planned)
+
+    @property
+    def n_var(self) -> int:
+        return self.limits_ms.shape[0]
+
+    def programs(self, shapes: np.ndarray, pace: np.ndarray) -> np.ndarray:
+        """Kernel programs of shapes (N, n_var) at paces (N,)."""
+        shapes = np.atleast_2d(np.asarray(shapes, dtype=float))
+        if shapes.shape[1] != self.n_var:
+            raise ValueError(f"shapes have {shapes.shape[1]} values: this encoding has {self.n_var} sections")
+        rel = np.clip(shapes + np.asarray(pace, dtype=float)[:, None], 0.0, 1.0)
+        return speed_code_programs(self.boundaries_m, rel * self.limits_ms)
+
+
+@dataclass(frozen=True, eq=False)
+class PacedRuns:
+    """Result of :func:`solve_pace`: per run the pace, its kernel program and its summary."""
+
+    pace: np.ndarray
+    programs: np.ndarray
+    summaries: np.ndarray
+
+    @property
+    def running_time_s(self) -> np.ndarray:
+        return self.summaries[:, OUT_RUNNING_TIME_S]
+
+
+def _times(simulator: Simulator, encoding: PacedSpeedCodes, shapes: np.ndarray, pace: np.ndarray):
+    out = simulator.run_batch(encoding.programs(shapes, pace))
+    t = np.where(out[:, OUT_REACHED] > 0, out[:, OUT_RUNNING_TIME_S], np.inf)
+    return t, out
+
+
+def solve_pace(simulator: Simulator, encoding: PacedSpeedCodes, shapes: np.ndarray,
+               time_tol_s: float = DEFAULT_TIME_TOL_S) -> PacedRuns:
+    """The pace at which each shape runs in ``encoding.planned_time_s`` (a population at once).
+
+    Parameters
+    ----------
+    simulator : Simulator
+        Of the case the encoding was built on.
+    encoding : PacedSpeedCodes
+    shapes : (N, n_var)
+        Speed-code shapes in [0, 1].
+    time_tol_s : float
+        Stop once every run is this close to the plan (or its pace bracket has shrunk to 1e-9).
+
+    Returns
+    -------
+    PacedRuns
+        The runs found; a run whose time jumps over the plan (a discontinuity of the grid) is the
+        closer side of its final bracket. The plan must be at least the flat-out time
+        (:meth:`Simulator.check_planned_time`), or the fastest side is returned.
+    """
+    shapes = np.atleast_2d(np.asarray(shapes, dtype=float))
+    n = shapes.shape[0]
+    target = encoding.planned_time_s
+    lo = np.full(n, PACE_MIN)  # slow side: time >= target
+    hi = np.full(n, PACE_MAX)  # fast side: time <= target
+    t_hi, out_hi = _times(simulator, encoding, shapes, hi)
+    f_hi = t_hi - target
+    f_lo = np.full(n, np.inf)
+    pace = hi.copy()
+    out = out_hi.copy()
+    best_err = np.abs(f_hi)
+    side = np.zeros(n)
+    active = f_hi < -time_tol_s  # flat out is too fast: the pace must come down
+    for _ in range(MAX_ITERATIONS):
+        if not active.any():
+            break
+        idx = np.flatnonzero(active)
+        a, b, fa, fb = lo[idx], hi[idx], f_lo[idx], f_hi[idx]
+        finite = np.isfinite(fa)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            secant = b - fb * (b - a) / (fb - fa)
+        mid = 0.5 * (a + b)
+        trial = np.where(finite & (secant > a) & (secant < b), secant, mid)
+        t, o = _times(simulator, encoding, shapes[idx], trial)
+        f = t - target
+        err = np.abs(f)
+        better = err < best_err[idx]
+        pace[idx[better]] = trial[better]
+        out[idx[better]] = o[better]
+        best_err[idx[better]] = err[better]
+        slow = f > 0
+        # Illinois: halve the stale end's value when the same side moves twice
+        fb_new = np.where(slow & (side[idx] == -1), 0.5 * fb, fb)
+        fa_new = np.where(~slow & (side[idx] == 1), 0.5 * fa, fa)
+        lo[idx] = np.where(slow, trial, a)
+        f_lo[idx] = np.where(slow, f, fa_new)
+        hi[idx] = np.where(slow, b, trial)
+        f_hi[idx] = np.where(slow, fb_new, f)
+        side[idx] = np.where(slow, -1, 1)
+        done = (err <= time_tol_s) | (hi[idx] - lo[idx] < 1e-9)
+        active[idx[done]] = False
+    programs = encoding.programs(shapes, pace)
+    return PacedRuns(pace=pace, programs=programs, summaries=out)
