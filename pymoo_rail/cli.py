@@ -138,8 +138,11 @@ def build_parser() -> argparse.ArgumentParser:
               pymoo-rail optimize yizhuang --out out/
               pymoo-rail optimize yizhuang --algorithm grnsga2 --pop-size 60 --n-gen 80 --out out/gr
               pymoo-rail optimize metro-a --objectives energy accel_variation stop_error time_error --encoding braking_onset --out out/m4
-              pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc"""))
-    p.add_argument("case", metavar="CASE", help="built-in case name (see 'pymoo-rail cases') or a .toml case file")
+              pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
+              pymoo-rail optimize --track T.json --train R.json --from 0 --to -1 --time 1500 --out out/t"""))
+    p.add_argument("case", metavar="CASE", nargs="?", default=None,
+                   help="built-in case name (see 'pymoo-rail cases') or a .toml case file; or give --track ...")
+    _add_ttobench_options(p)
     p.add_argument("--algorithm", "-a", default="nsga2", metavar="NAME", help="optimisation algorithm")
     p.add_argument("--pop-size", "-p", type=_positive_int, default=40, metavar="N", help="population size")
     p.add_argument("--n-gen", "-g", type=_positive_int, default=50, metavar="N", help="number of generations")
@@ -163,13 +166,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
 
     p = sub.add_parser(
+        "journey", help="solve a TTOBench journey (timing points) with the exact solver", formatter_class=_Formatter,
+        description="Read a TTOBench journey file, its track and a train, find the least-energy run that meets "
+                    "every timing point, and write into --out: timing.csv (time and speed at every timing "
+                    "point, window and check), trajectory_<k>.csv per section and journey.png.",
+        epilog="example:\n  pymoo-rail journey tracks/../journeys/J.json --train trains/CH_Stadler_KISS_SBB.json")
+    p.add_argument("journey", metavar="JOURNEY", help="TTOBench journey JSON file, or a .toml journey "
+                                                       "(track, train and timing points, docs/ttobench.md)")
+    p.add_argument("--track", default=None, metavar="T.json",
+                   help="TTOBench track file (default: ../tracks/<associated track>.json next to the journey)")
+    p.add_argument("--train", default=None, metavar="R.json", help="TTOBench train file (for a JSON journey)")
+    p.add_argument("--curve-model", default="tang2020", choices=["tang2020", "roeckl"], help="curve resistance")
+    p.add_argument("--out", default="out", metavar="DIR", help="output directory")
+
+    p = sub.add_parser(
         "reference", help="the exact minimum-energy front of a case", formatter_class=_Formatter,
         description="Compute the exact minimum-energy run for a range of running times (dynamic programming, "
                     "pymoo_rail.optimal) and write optimal_front.csv / .png and the optimal run at the planned "
                     "time (optimal_trajectory.csv, optimal_profile.png).",
         epilog="examples:\n  pymoo-rail reference yizhuang --out out/ref\n"
                "  pymoo-rail reference yizhuang --times 140 150 160 170 --out out/ref")
-    p.add_argument("case", metavar="CASE", help="built-in case name or a .toml case file")
+    p.add_argument("case", metavar="CASE", nargs="?", default=None,
+                   help="built-in case name or a .toml case file; or give --track ...")
+    _add_ttobench_options(p)
     p.add_argument("--times", type=_positive_float, nargs="+", default=None, metavar="S",
                    help="running times (s); default: --n-points from the minimum time to 1.3 x planned")
     p.add_argument("--n-points", type=_positive_int, default=8, metavar="N", help="number of running times")
@@ -350,6 +369,79 @@ class _Progress:
         self.bar.update(1)
 
 
+def _add_ttobench_options(p: argparse.ArgumentParser) -> None:
+    """``--track T.json --train R.json --from A --to B --time S``: a TTOBench run instead of CASE."""
+    p.add_argument("--track", default=None, metavar="T.json", help="TTOBench track file (instead of CASE)")
+    p.add_argument("--train", default=None, metavar="R.json", help="TTOBench train file (with --track)")
+    p.add_argument("--from", dest="from_stop", default="0", metavar="A",
+                   help="departure stop: index (0, 1, ..., -1 = last) or position in m (e.g. 8500.0)")
+    p.add_argument("--to", dest="to_stop", default="-1", metavar="B", help="arrival stop (as --from)")
+    p.add_argument("--time", dest="planned_time", type=float, default=None, metavar="S",
+                   help="planned running time in s; without it, 1.15 x the minimum running time")
+    p.add_argument("--curve-model", default="tang2020", choices=["tang2020", "roeckl"],
+                   help="curve resistance of the track's curvatures")
+
+
+def _stop_ref(value: str):
+    try:
+        return int(value)
+    except ValueError:
+        try:
+            return float(value)
+        except ValueError:
+            raise UsageError("--from/--to", f"{value!r} is neither a stop index nor a position in m") from None
+
+
+def _case_from_args(args):
+    """The case of CASE, or of --track/--train/--from/--to/--time."""
+    if args.track is None:
+        if args.train is not None:
+            raise UsageError("--train", "needs --track")
+        if args.case is None:
+            raise UsageError("CASE", "give a case name or file, or --track T.json --train R.json")
+        return _load_case("CASE", args.case)
+    if args.case is not None:
+        raise UsageError("CASE", "give either CASE or --track, not both")
+    if args.train is None:
+        raise UsageError("--train", "--track needs --train R.json")
+    from pymoo_rail.cases.ttobench import from_ttobench
+    from pymoo_rail.optimal import min_running_time
+
+    case = from_ttobench(args.track, args.train, _stop_ref(args.from_stop), _stop_ref(args.to_stop), 1.0,
+                         curve_model=args.curve_model)
+    time_s = args.planned_time if args.planned_time is not None else 1.15 * min_running_time(case)
+    return case.with_planned_time(time_s)
+
+
+def cmd_journey(args) -> int:
+    from pymoo_rail.journeys.timing import (read_timing_points, solve_timed_journey, timed_journey_from_toml,
+                                            timed_journey_from_ttobench)
+    from pymoo_rail.plotting.journey import plot_timed_run
+    from pymoo_rail.plotting import save_figure
+
+    import pandas as pd
+
+    out = _out_dir(args.out)
+    if args.journey.endswith(".toml"):
+        timed = timed_journey_from_toml(args.journey)
+    else:
+        if args.train is None:
+            raise UsageError("--train", "a TTOBench journey file names no train: give --train R.json")
+        track = args.track
+        if track is None:
+            _, track_id, _, _ = read_timing_points(args.journey)
+            track = Path(args.journey).resolve().parent.parent / "tracks" / f"{track_id}.json"
+        timed = timed_journey_from_ttobench(args.journey, track, args.train, curve_model=args.curve_model)
+    run = solve_timed_journey(timed)
+    pd.DataFrame(list(run.checks)).to_csv(out / "timing.csv", index=False)
+    for k, traj in enumerate(run.trajectories):
+        traj.to_frame().to_csv(out / f"trajectory_{k}.csv", index=False)
+    save_figure(plot_timed_run(timed, run), out / "journey.png")
+    _say(f"{timed.journey.name}: {run.energy_kwh:.2f} kWh net, every timing point met; wrote {out}/timing.csv, "
+         f"trajectory_*.csv, journey.png")
+    return 0
+
+
 def cmd_optimize(args) -> int:
     import numpy as np
     import pandas as pd
@@ -363,7 +455,7 @@ def cmd_optimize(args) -> int:
     from pymoo_rail.plotting import plot_front, plot_speed_profile, plot_speed_time, save_figure
     from pymoo_rail.problems import SpeedProfileProblem
 
-    case = _load_case("CASE", args.case)
+    case = _case_from_args(args)
     objectives = _objectives(args.objectives)
     if canonical_name(args.algorithm) not in ALGORITHMS:
         raise UsageError("--algorithm", f"unknown algorithm {args.algorithm!r} (choose from "
@@ -531,7 +623,7 @@ def _default_times(t_min: float, planned_time_s: float, n_points: int):
 
 
 def cmd_reference(args) -> int:
-    case = _load_case("CASE", args.case)
+    case = _case_from_args(args)
     try:
         from pymoo_rail.optimal import optimal_front, optimal_profile
     except ImportError as err:
@@ -703,7 +795,7 @@ def cmd_warmup(args) -> int:
     return 0
 
 
-COMPILING_COMMANDS = ("optimize", "optimise", "reference", "warmup", "plot", "suite")
+COMPILING_COMMANDS = ("optimize", "optimise", "reference", "warmup", "plot", "suite", "journey")
 def _add_suite_parser(sub) -> None:
     p = sub.add_parser(
         "suite", help="the benchmark suite: list its problems, verify its shipped fronts", formatter_class=_Formatter,
@@ -756,7 +848,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 2
     commands = {"cases": cmd_cases, "optimize": cmd_optimize, "optimise": cmd_optimize, "reference": cmd_reference,
-                "study": cmd_study, "warmup": cmd_warmup, "suite": cmd_suite}
+                "study": cmd_study, "warmup": cmd_warmup, "suite": cmd_suite, "journey": cmd_journey}
     subparser = parser._subparsers._group_actions[0].choices[args.command]  # for its usage line
     try:
         if args.command not in COMPILING_COMMANDS:

@@ -180,3 +180,31 @@ def test_four_objectives_give_a_scatter_matrix_front(capsys, tmp_path):
 
     with Image.open(tmp_path / "front.png") as image:
         assert min(image.size) > 600  # a 4 x 4 grid, not an empty canvas
+
+
+def _release():
+    from pathlib import Path
+
+    return Path(__file__).resolve().parent / "data" / "ttobench"
+
+
+def test_optimize_a_ttobench_track_and_train(capsys, tmp_path):
+    root = _release()
+    code, out, err = run(capsys, "optimize", "--track", root / "tracks" / "CN_Songjiazhuang_Yizhuang.json",
+                         "--train", root / "trains" / "CN_Beijing_Subway.json", "--from", 9, "--to", 10,
+                         "--time", 150, "--pop-size", 8, "--n-gen", 2, "--out", tmp_path, "--quiet")
+    assert code == 0, err
+    trajectory = pd.read_csv(tmp_path / "trajectory.csv")
+    assert trajectory["position_m"].iloc[-1] == pytest.approx(2265.0, abs=1.0)
+    assert (tmp_path / "front.png").is_file()
+    code, _, err = run(capsys, "optimize", "yizhuang", "--track", root / "tracks" / "CN_Songjiazhuang_Yizhuang.json")
+    assert code == 2 and "either CASE or --track" in err
+    code, _, err = run(capsys, "optimize", "--track", root / "tracks" / "CN_Songjiazhuang_Yizhuang.json")
+    assert code == 2 and "--train" in err
+
+
+def test_journey_command_reports_an_unreachable_window(capsys, tmp_path):
+    root = _release()
+    code, _, err = run(capsys, "journey", root / "journeys" / "CH_StGallen_Wil_Journey_01.json", "--train",
+                       root / "trains" / "CH_Stadler_KISS_SBB.json", "--out", tmp_path)
+    assert code == 1 and "timing point at 29556.1 m" in err and "345.4 s" in err

@@ -9,6 +9,7 @@ one pymoo iteration is one full cycle.
 from __future__ import annotations
 
 import numpy as np
+from pymoo.core.individual import default_config
 from pymoo.core.population import Population
 from pymoo.core.sampling import Sampling
 from pymoo.operators.sampling.rnd import FloatRandomSampling
@@ -24,6 +25,7 @@ from pymoo_rail.algorithms._bees import (
 )
 
 MOVES = ("centred", "canonical", "literal")
+_DEFAULT_CV_CONFIG = default_config()
 
 
 class MOABCOutput(ScoutColumn, MultiObjectiveOutput):
@@ -59,8 +61,13 @@ def population_arrays(pop: Population) -> tuple[np.ndarray, np.ndarray, np.ndarr
 
     The same values as ``pop.get("X")``, ``pop.get("F")``, ``pop.get("CV")[:, 0]`` in one pass.
     """
-    return (np.array([ind.X for ind in pop]), np.array([ind.F for ind in pop]),
-            np.array([ind.CV[0] for ind in pop]))
+    X = np.array([ind.X for ind in pop])
+    F = np.array([ind.F for ind in pop])
+    if all((ind.H is None or len(ind.H) == 0) and ind.config == _DEFAULT_CV_CONFIG for ind in pop):
+        # pymoo's default violation (sum of positive G, no H) for all rows at once
+        G = np.array([ind.G if ind.G is not None else np.zeros(0) for ind in pop])
+        return X, F, np.maximum(0.0, G - 0.0).sum(axis=1) if G.shape[1] > 0 else np.zeros(len(pop))
+    return X, F, np.array([ind.CV[0] for ind in pop])
 
 
 def nondominated_indices(X: np.ndarray, F: np.ndarray, CV: np.ndarray) -> np.ndarray:

@@ -33,10 +33,13 @@ Mapping decisions (the full table is in ``docs/ttobench.md``):
   mass is a train of :data:`POINT_MASS_LENGTH_M` (1 mm) with ``gradient_model = "point_mass"``.
 - Efficiencies absent (TTOBench allows omitting both) give traction efficiency 1 and no regen,
   so net energy is the traction work at the wheel.
-- Not represented (a :class:`CaseError` if present and not trivial): track ``curvatures`` with a
-  finite radius and ``tunnels`` (TTOBench's tunnel drag depends on cross-section and speed; the
-  model's tunnel term does not). Informational train fields (``num seats``, ``num coaches``,
-  ``tunnel resistance``, ``ETCS braking data``) are accepted and not used.
+- Curvatures become ``line.curves`` (clothoids cut into pieces of at most 5 m), with the curve
+  resistance the caller picks (``curve_model``: ``"tang2020"`` 600 / R, or ``"roeckl"``);
+  tunnels become ``line.tunnels`` (``tunnel_model``: Liu (2019) eq. 2-12, or ``"none"``).
+- Read and checked but not modelled, each named in a :class:`TTOBenchWarning`: ``ETCS braking
+  data`` (tracks and trains) and the trains' speed-dependent ``tunnel resistance``. ``num seats``
+  and ``num coaches`` are kept on :class:`TTOBenchTrain`. An efficiency map (not part of the
+  released format) is a :class:`CaseError`.
 
 The TTOBench files shipped in ``pymoo_rail/cases/data/`` (Yizhuang line and Beijing subway train)
 are copies under the BSD 2-Clause license; the notice is in ``data/TTOBENCH_LICENSE``.
@@ -47,6 +50,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -56,6 +60,7 @@ import numpy as np
 
 from pymoo_rail.model import Case, CaseError, DavisResistance, ForceCurve, Line, Train
 from pymoo_rail.model.curves import KMH_PER_MS
+from pymoo_rail.model.line import CURVE_MODELS
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
 YIZHUANG_TRACK = DATA_DIR / "CN_Songjiazhuang_Yizhuang.json"
@@ -103,7 +108,19 @@ _TRAIN_USED = {"rho", "length", "max pn braking force", "max acceleration", "max
                "efficiency traction", "efficiency reg brake"}
 _TRAIN_INFORMATIONAL = {"num seats", "num coaches", "tunnel resistance", "ETCS braking data"}
 _TRACK_REQUIRED = ("metadata", "stops", "speed limits")
-_TRACK_OPTIONAL = {"altitude", "gradients", "curvatures", "tunnels"}
+_TRACK_OPTIONAL = {"altitude", "gradients", "curvatures", "tunnels", "ETCS braking data"}
+TUNNEL_MODELS = ("liu2019", "none")
+# Clothoids (curvature linear in distance) become constant-radius pieces this long at most, each with
+# the mean curvature of its stretch (exact for the 600 / R model, which is linear in curvature).
+CLOTHOID_PIECE_M = 5.0
+
+
+class TTOBenchWarning(UserWarning):
+    """A TTOBench field that is read and checked but not modelled (the message names it)."""
+
+
+def _warn(field: str, reason: str, source: str) -> None:
+    warnings.warn(f"{source}: TTOBench field '{field}' {reason}", TTOBenchWarning, stacklevel=3)
 
 
 # ----------------------------------------------------------------------------------------- reading
@@ -229,7 +246,10 @@ class TTOBenchTrack:
     """A TTOBench track in the case's units: positions in m, limits in km/h, gradients in permille.
 
     ``speed_limits`` and ``gradients`` are change points ``(position_m, value)``: each value holds
-    from its position to the next change point (the last one to the end of the track).
+    from its position to the next change point (the last one to the end of the track). ``curves``
+    are rows ``(start_m, end_m, radius_m)`` of constant radius (clothoids already cut into pieces of
+    at most :data:`CLOTHOID_PIECE_M`, straight track left out); ``tunnels`` rows
+    ``(start_m, end_m, cross_section_m2)``.
     """
 
     id: str
@@ -238,15 +258,28 @@ class TTOBenchTrack:
     gradients: tuple[tuple[float, float], ...]
     altitude_m: float = 0.0
     metadata: Mapping[str, Any] = field(default_factory=dict, compare=False)
+    curves: tuple[tuple[float, float, float], ...] = ()
+    tunnels: tuple[tuple[float, float, float], ...] = ()
 
     @property
     def length_m(self) -> float:
         return self.stops_m[-1]
 
-    def line(self, gradient_model: str = "point_mass") -> Line:
-        """The whole track as one :class:`Line` (stop 0 to the last stop)."""
+    def line(self, gradient_model: str = "point_mass", *, curve_model: str = "tang2020",
+             tunnel_model: str = "liu2019") -> Line:
+        """The whole track as one :class:`Line` (stop 0 to the last stop).
+
+        ``curve_model``: ``"tang2020"`` (600 / R) or ``"roeckl"``; ``tunnel_model``: ``"liu2019"``
+        (0.00013 L_s N/kN, speed-independent) or ``"none"`` (tunnels add no resistance).
+        """
+        if curve_model not in CURVE_MODELS:
+            raise CaseError("curve_model", curve_model, f"must be one of {CURVE_MODELS}")
+        if tunnel_model not in TUNNEL_MODELS:
+            raise CaseError("tunnel_model", tunnel_model, f"must be one of {TUNNEL_MODELS}")
+        tunnels = tuple((s, e) for s, e, _ in self.tunnels) if tunnel_model == "liu2019" else ()
         return Line(length_m=self.length_m, gradients=_rows(self.gradients, self.length_m),
-                    speed_limits=_rows(self.speed_limits, self.length_m), gradient_model=gradient_model)
+                    speed_limits=_rows(self.speed_limits, self.length_m), gradient_model=gradient_model,
+                    curves=self.curves, tunnels=tunnels, curve_model=curve_model)
 
     def stop_index(self, stop: StopRef, stop_names: Sequence[str] | None = None) -> int:
         """Index of a stop given by index (int), name (str, needs ``stop_names``) or position (float, m).
@@ -325,25 +358,149 @@ def read_track(source: Source) -> TTOBenchTrack:
         gradients = _change_points(data, "gradients", "slope", _SLOPE_PERMILLE, length, label)
     else:  # TTOBench: the field may be omitted for level tracks
         gradients = ((0.0, 0.0),)
-    if "curvatures" in data:
-        _refuse_curvatures(data["curvatures"], label)
-    if "tunnels" in data and (not isinstance(data["tunnels"], Mapping) or data["tunnels"].get("values")):
-        raise CaseError("tunnels", data["tunnels"], "is not represented: TTOBench tunnel drag depends on the "
-                                                    "cross-section and the speed, the model's tunnel term does not",
-                        label)
+    curves = _curvatures(data["curvatures"], length, label) if "curvatures" in data else ()
+    tunnels = _tunnels(data["tunnels"], length, label) if "tunnels" in data else ()
+    if "ETCS braking data" in data:
+        _etcs(data["ETCS braking data"], ("M_NVAVADH", "Kt_int"), label)
     altitude = _scalar(data, "altitude", _LENGTH, label, default=0.0)
     return TTOBenchTrack(id=data["metadata"]["id"], stops_m=tuple(stops_m), speed_limits=limits,
-                         gradients=gradients, altitude_m=altitude, metadata=dict(data["metadata"]))
+                         gradients=gradients, altitude_m=altitude, metadata=dict(data["metadata"]),
+                         curves=curves, tunnels=tunnels)
 
 
-def _refuse_curvatures(entry: Any, source: str) -> None:
-    values = entry.get("values", []) if isinstance(entry, Mapping) else entry
-    for k, row in enumerate(values or []):
-        radii = row[1:] if isinstance(row, (list, tuple)) else [row]
-        if any(not (isinstance(r, str) and r.lower() in ("infinity", "inf")) and
-               not (isinstance(r, (int, float)) and math.isinf(r)) for r in radii):
-            raise CaseError(f"curvatures.values[{k}]", row,
-                            "curves are not represented: TTOBench gives no curve-resistance model", source)
+def _table_entry(entry: Any, key: str, columns: Sequence[tuple[str, Mapping[str, tuple[float, float]]]],
+                 source: str) -> tuple[list[tuple[float, float]], list]:
+    """The unit factors and the rows of a ``{"units": {...}, "values": [[...], ...]}`` entry."""
+    if not isinstance(entry, Mapping) or set(entry) != {"units", "values"}:
+        raise CaseError(key, entry, 'must be an object {"units": {...}, "values": [...]}', source)
+    units = entry["units"]
+    names = [c for c, _ in columns]
+    if not isinstance(units, Mapping) or set(units) != set(names):
+        raise CaseError(f"{key}.units", units, f"must give exactly the units of {', '.join(names)}", source)
+    factors = [_unit_factor(f"{key}.units.{c}", units[c], table, source) for c, table in columns]
+    values = entry["values"]
+    if not isinstance(values, list):
+        raise CaseError(f"{key}.values", values, "must be a list of rows", source)
+    for k, row in enumerate(values):
+        if not isinstance(row, (list, tuple)) or len(row) != len(columns):
+            raise CaseError(f"{key}.values[{k}]", row, f"must be a row [{', '.join(names)}]", source)
+    return factors, values
+
+
+def _radius(field: str, value: Any, factor: tuple[float, float], source: str) -> float:
+    """A signed radius in m; ``"infinity"`` (straight track) gives ``inf``."""
+    if isinstance(value, str) and value.strip().lower() in ("infinity", "inf", "+infinity", "-infinity"):
+        return math.inf
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+        raise CaseError(field, value, 'must be a number or "infinity"', source)
+    if value == 0:
+        raise CaseError(field, value, "a radius of 0 is not a curve", source)
+    return _convert(float(value), factor) if math.isfinite(value) else math.inf
+
+
+def _mean_abs_curvature(k_a: float, k_b: float) -> float:
+    """Mean of |k| over a stretch where the curvature k runs linearly from k_a to k_b."""
+    if k_a * k_b >= 0.0:
+        return 0.5 * abs(k_a + k_b)
+    return 0.5 * (k_a * k_a + k_b * k_b) / abs(k_b - k_a)
+
+
+def _curvatures(entry: Any, length_m: float, source: str) -> tuple[tuple[float, float, float], ...]:
+    """TTOBench ``curvatures`` as constant-radius rows ``(start_m, end_m, |radius| m)``.
+
+    The sign (turn direction) does not change the resistance. A clothoid (different radii at the
+    start and the end: curvature linear in distance) is cut into pieces of at most
+    :data:`CLOTHOID_PIECE_M`, each with its mean absolute curvature.
+    """
+    factors, values = _table_entry(entry, "curvatures", (("position", _LENGTH), ("radius at start", _LENGTH),
+                                                         ("radius at end", _LENGTH)), source)
+    rows: list[tuple[float, float, float]] = []
+    starts = []
+    for k, row in enumerate(values):
+        pos = _convert(_number(f"curvatures.values[{k}]", row[0], source), factors[0])
+        if k == 0 and pos != 0.0:
+            raise CaseError(f"curvatures.values[{k}]", row, "the first change point must be at position 0", source)
+        if starts and pos <= starts[-1]:
+            raise CaseError(f"curvatures.values[{k}]", row, "positions must be strictly increasing", source)
+        if pos >= length_m:
+            raise CaseError(f"curvatures.values[{k}]", row, f"must start before the end of the track ({length_m} m)",
+                            source)
+        starts.append(pos)
+    for k, row in enumerate(values):
+        start, end = starts[k], (starts[k + 1] if k + 1 < len(starts) else length_m)
+        k_a = 1.0 / _radius(f"curvatures.values[{k}][1]", row[1], factors[1], source)
+        k_b = 1.0 / _radius(f"curvatures.values[{k}][2]", row[2], factors[2], source)
+        n_pieces = 1 if k_a == k_b else max(1, math.ceil((end - start) / CLOTHOID_PIECE_M))
+        edges = np.linspace(start, end, n_pieces + 1)
+        for a, b in zip(edges[:-1], edges[1:]):
+            kappa = _mean_abs_curvature(k_a + (k_b - k_a) * (a - start) / (end - start),
+                                        k_a + (k_b - k_a) * (b - start) / (end - start))
+            if kappa > 0.0:
+                rows.append((float(a), float(b), 1.0 / kappa))
+    return tuple(rows)
+
+
+_AREA_M2 = {"m^2": (1.0, 1.0)}
+
+
+def _tunnels(entry: Any, length_m: float, source: str) -> tuple[tuple[float, float, float], ...]:
+    """TTOBench ``tunnels`` ``[position, length, cross section]`` as rows ``(start_m, end_m, area_m2)``."""
+    factors, values = _table_entry(entry, "tunnels", (("position", _LENGTH), ("length", _LENGTH),
+                                                      ("cross section", _AREA_M2)), source)
+    rows: list[tuple[float, float, float]] = []
+    for k, row in enumerate(values):
+        field = f"tunnels.values[{k}]"
+        start = _convert(_number(field, row[0], source), factors[0])
+        tunnel_length = _convert(_number(field, row[1], source), factors[1])
+        area = _number(field, row[2], source)
+        if start < 0 or tunnel_length < 0 or area < 0:
+            raise CaseError(field, row, "position, length and cross section must be >= 0", source)
+        if start + tunnel_length > length_m:
+            raise CaseError(field, row, f"ends beyond the end of the track ({length_m} m)", source)
+        if rows and start < rows[-1][1]:
+            raise CaseError(field, row, f"overlaps the previous tunnel ending at {rows[-1][1]} m", source)
+        if tunnel_length > 0:  # a tunnel of length 0 adds nothing
+            rows.append((start, start + tunnel_length, area))
+    return tuple(rows)
+
+
+def _etcs(entry: Any, required: Sequence[str], source: str) -> None:
+    """Check the fields of ``ETCS braking data`` and warn that ETCS supervision is not modelled."""
+    if not isinstance(entry, Mapping):
+        raise CaseError("ETCS braking data", entry, "must be an object", source)
+    missing = sorted(set(required) - set(entry))
+    unknown = sorted(set(entry) - set(required))
+    if missing or unknown:
+        bad = (missing or unknown)[0]
+        raise CaseError(f"ETCS braking data.{bad}", entry.get(bad),
+                        f"TTOBench's ETCS braking data holds exactly {', '.join(required)}", source)
+    _warn("ETCS braking data", "is not modelled: runs are bounded by the speed limits and the train's "
+                               "braking forces and deceleration cap, not by ETCS braking curves", source)
+
+
+_TIME_S = {"s": (1.0, 1.0), "min": (60.0, 1.0)}
+_JOURNEY_COLUMNS = (("position", _LENGTH), ("lower time constraint", _TIME_S), ("upper time constraint", _TIME_S),
+                    ("lower speed constraint", _SPEED_KMH), ("upper speed constraint", _SPEED_KMH))
+
+
+def read_journey(source: Source) -> tuple[str, str | None, list[tuple[float | None, ...]], dict, str]:
+    """Read a TTOBench journey file: ``(id, associated track id, rows, metadata, label)``.
+
+    Each row is ``(position_m, earliest_s, latest_s, min_kmh, max_kmh)`` in these units, ``None``
+    where the file has ``null``. The timing-point rules are checked by
+    :func:`pymoo_rail.journeys.read_timing_points`.
+    """
+    data, label = _load(source, "journey")
+    _check_keys(data, ("metadata", "timing points"), set(), "journey", label)
+    factors, values = _table_entry(data["timing points"], "timing points", _JOURNEY_COLUMNS, label)
+    rows = []
+    for k, row in enumerate(values):
+        field = f"timing points.values[{k}]"
+        if row[0] is None:
+            raise CaseError(field, row, "a timing point needs a position", label)
+        rows.append(tuple(None if v is None else _convert(_number(field, v, label), f) for v, f in zip(row, factors)))
+    meta = dict(data["metadata"])
+    return meta["id"], meta.get("associated track"), rows, meta, label
 
 
 @dataclass(frozen=True)
@@ -354,6 +511,9 @@ class TTOBenchTrain:
     train: Train
     length_m: float | None
     metadata: Mapping[str, Any] = field(default_factory=dict, compare=False)
+    n_seats: int | None = None
+    n_coaches: int | None = None
+    tunnel_resistance: tuple[tuple[float, float], ...] = ()  # (cross section m^2, kN/(km/h)^2)
 
 
 def braking_curve(reg_force_kn: float, reg_power_kw: float, pn_force_kn: float, max_speed_kmh: float) -> ForceCurve:
@@ -384,6 +544,15 @@ def read_train(source: Source, *, train_length_m: float | None = None) -> TTOBen
     """
     data, label = _load(source, "train")
     _check_keys(data, _TRAIN_REQUIRED, _TRAIN_USED | _TRAIN_INFORMATIONAL, "train", label)
+    for key in ("efficiency traction", "efficiency reg brake"):
+        if isinstance(data.get(key), Mapping) and ("units" in data[key] or "values" in data[key]):
+            raise CaseError(key, data[key], "an efficiency map is not part of the released TTOBench format "
+                                            "(v1.5 gives each efficiency as one {unit, value}); give a scalar", label)
+    counts = {key: _count(data, key, label) for key in ("num seats", "num coaches")}
+    tunnel_resistance = _tunnel_resistance(data["tunnel resistance"], label) if "tunnel resistance" in data else ()
+    if "ETCS braking data" in data:
+        _etcs(data["ETCS braking data"], ("A_brake_emergency", "A_brake_service", "K_dry_rst", "K_wet_rst",
+                                          "T_traction", "T_be", "T_bs", "v_uncertainty"), label)
     mass_t = _scalar(data, "mass", _MASS_T, label)
     rho = _fraction(data, "rho", label, default=0.0)
     vmax = _scalar(data, "max speed", _SPEED_KMH, label)
@@ -430,7 +599,46 @@ def read_train(source: Source, *, train_length_m: float | None = None) -> TTOBen
         )
     except CaseError as err:  # name the TTOBench field behind the model's field
         raise CaseError(_TTOBENCH_FIELD.get(err.field, err.field), err.value, err.reason, label) from None
-    return TTOBenchTrain(id=data["metadata"]["id"], train=train, length_m=length, metadata=dict(data["metadata"]))
+    return TTOBenchTrain(id=data["metadata"]["id"], train=train, length_m=length, metadata=dict(data["metadata"]),
+                         n_seats=counts["num seats"], n_coaches=counts["num coaches"],
+                         tunnel_resistance=tunnel_resistance)
+
+
+def _count(data: Mapping, key: str, source: str) -> int | None:
+    """``num seats`` / ``num coaches``: kept with the train (they do not change the physics)."""
+    if key not in data:
+        return None
+    value = _scalar(data, key, {"-": (1.0, 1.0)}, source)
+    if value != int(value) or value < 0:
+        raise CaseError(f"{key}.value", data[key]["value"], "must be a whole number >= 0", source)
+    return int(value)
+
+
+_TUNNEL_COEF_KN_PER_KMH2 = {"kN/(km/h)^2": (1.0, 1.0), "N/(m/s)^2": (1.0, 1000.0 * KMH_PER_MS**2),
+                            "kg/m": (1.0, 1000.0 * KMH_PER_MS**2)}
+
+
+def _tunnel_resistance(entry: Any, source: str) -> tuple[tuple[float, float], ...]:
+    """``tunnel resistance`` rows ``(cross section m^2, extra v^2 coefficient in kN/(km/h)^2)``.
+
+    Read and checked, then a :class:`TTOBenchWarning`: the kernels' resistance depends on speed only
+    through the train's Davis terms, so an extra ``c v^2`` inside tunnels is not modelled.
+    """
+    factors, values = _table_entry(entry, "tunnel resistance", (("cross section", _AREA_M2),
+                                                                ("coefficient", _TUNNEL_COEF_KN_PER_KMH2)), source)
+    rows = []
+    for k, row in enumerate(values):
+        area = _number(f"tunnel resistance.values[{k}]", row[0], source)
+        coef = _convert(_number(f"tunnel resistance.values[{k}]", row[1], source), factors[1])
+        if area <= 0 or coef < 0:
+            raise CaseError(f"tunnel resistance.values[{k}]", row, "needs a cross section > 0 and a coefficient >= 0",
+                            source)
+        rows.append((area, coef))
+    _warn("tunnel resistance", "is not modelled: the extra aerodynamic drag c v^2 in tunnels is speed-dependent "
+                               "and the kernels' line resistance is not; tunnels on the track get the "
+                               "speed-independent 0.00013 L_s N/kN of Liu (2019) eq. 2-12 (tunnel_model='liu2019') "
+                               "or nothing (tunnel_model='none')", source)
+    return tuple(rows)
 
 
 _TTOBENCH_FIELD = {
@@ -450,7 +658,8 @@ def _boundary_speed_ms(field: str, kmh: float) -> float:
 def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to_stop: StopRef,
                   planned_time_s: float, *, dwell_s: float = 0.0, stop_names: Sequence[str] | None = None,
                   train_length_m: float | None = None, name: str | None = None,
-                  initial_speed_kmh: float = 0.0, final_speed_kmh: float = 0.0) -> Case:
+                  initial_speed_kmh: float = 0.0, final_speed_kmh: float = 0.0,
+                  curve_model: str = "tang2020", tunnel_model: str = "liu2019") -> Case:
     """The run of a TTOBench train between two stops of a TTOBench track, as a :class:`Case`.
 
     Parameters
@@ -476,6 +685,11 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
     initial_speed_kmh, final_speed_kmh : float
         Speeds at ``from_stop`` and ``to_stop`` (default 0: a stop at both); TTOBench benchmark
         formulations such as the ms-eetc one start and end at a small speed (e.g. 1 m/s).
+    curve_model : {"tang2020", "roeckl"}
+        Curve resistance from the track's ``curvatures``: ``600 / R`` N/kN (Tang et al. (2020)) or
+        Roeckl's standard-gauge formula (``docs/ttobench.md`` compares them).
+    tunnel_model : {"liu2019", "none"}
+        Resistance of the track's ``tunnels``: Liu (2019) eq. 2-12, ``0.00013 L_s`` N/kN, or none.
     """
     track = read_track(track_path)
     tt_train = read_train(train_path, train_length_m=train_length_m)
@@ -484,21 +698,39 @@ def from_ttobench(track_path: Source, train_path: Source, from_stop: StopRef, to
     if j <= i:
         raise CaseError("to_stop", to_stop, f"must lie after from_stop {from_stop!r} (stop {i} at "
                                             f"{track.stops_m[i]} m) in the track's direction")
-    point_mass = tt_train.length_m is None
-    line = track.line("point_mass" if point_mass else "train_length").slice(track.stops_m[i], track.stops_m[j])
     stop_label = (lambda k: f"{stop_names[k]} (stop {k}, {track.stops_m[k]:g} m)") if stop_names else \
         (lambda k: f"stop {k} at {track.stops_m[k]:g} m")
+    return case_between(track, tt_train, track.stops_m[i], track.stops_m[j], planned_time_s, dwell_s=dwell_s,
+                        name=name or f"{track.id}[{i}-{j}]", labels=(stop_label(i), stop_label(j)),
+                        curve_model=curve_model, tunnel_model=tunnel_model, initial_speed_kmh=initial_speed_kmh,
+                        final_speed_kmh=final_speed_kmh)
+
+
+def case_between(track: TTOBenchTrack, tt_train: TTOBenchTrain, start_m: float, end_m: float,
+                 planned_time_s: float, *, dwell_s: float = 0.0, name: str | None = None,
+                 labels: tuple[str, str] | None = None, curve_model: str = "tang2020",
+                 tunnel_model: str = "liu2019", initial_speed_kmh: float = 0.0,
+                 final_speed_kmh: float = 0.0) -> Case:
+    """The run from ``start_m`` to ``end_m`` on a read track (any positions, e.g. a journey's stops).
+
+    Arguments as in :func:`from_ttobench`; ``labels`` name the two ends in the case's source.
+    """
+    if not 0.0 <= start_m < end_m <= track.length_m:
+        raise CaseError("start_m, end_m", (start_m, end_m), f"must satisfy 0 <= start < end <= {track.length_m}")
+    point_mass = tt_train.length_m is None
+    line = track.line("point_mass" if point_mass else "train_length", curve_model=curve_model,
+                      tunnel_model=tunnel_model).slice(start_m, end_m)
+    a, b = labels or (f"{start_m:g} m", f"{end_m:g} m")
     model = "point mass" if point_mass else f"train of {tt_train.length_m:g} m (limits over its length)"
     source = (f"TTOBench track {track.id} ({track.metadata.get('library version', '?')}), "
-              f"{stop_label(i)} -> {stop_label(j)}; TTOBench train {tt_train.id} "
-              f"({tt_train.metadata.get('library version', '?')}); {model}; converted by "
-              f"pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
-    return Case(name=name or f"{track.id}[{i}-{j}]", train=tt_train.train, line=line,
+              f"{a} -> {b}; TTOBench train {tt_train.id} "
+              f"({tt_train.metadata.get('library version', '?')}); {model}; curves {curve_model}, tunnels "
+              f"{tunnel_model}; converted by pymoo_rail.cases.ttobench. {TTOBENCH_NOTICE}.")
+    return Case(name=name or f"{track.id}[{start_m:g}-{end_m:g}]", train=tt_train.train, line=line,
                 planned_time_s=planned_time_s, dwell_s=dwell_s, source=source,
                 initial_speed_ms=_boundary_speed_ms("initial_speed_kmh", initial_speed_kmh),
                 final_speed_ms=_boundary_speed_ms("final_speed_kmh", final_speed_kmh),
-                description=f"{track.id} {stop_label(i)} -> {stop_label(j)}, {line.length_m:g} m, "
-                            f"train {tt_train.id}")
+                description=f"{track.id} {a} -> {b}, {line.length_m:g} m, train {tt_train.id}")
 
 
 # ----------------------------------------------------------------------------------------- writing
@@ -677,7 +909,7 @@ def write_pair(out_dir: str | Path, track: Mapping, train: Mapping) -> tuple[Pat
     return paths[0], paths[1]
 
 
-__all__ = ["from_ttobench", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
+__all__ = ["from_ttobench", "case_between", "read_journey", "TTOBenchWarning", "TUNNEL_MODELS", "CLOTHOID_PIECE_M", "to_ttobench", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
            "track_to_json", "train_to_json", "write_pair", "ttobench_id", "braking_curve", "YIZHUANG_TRACK",
            "BEIJING_SUBWAY_TRAIN", "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M", "TTOBENCH_LICENSE",
            "TTOBENCH_NOTICE", "DATA_DIR"]

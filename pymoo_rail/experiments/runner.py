@@ -329,8 +329,17 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
     Returns
     -------
     StudyReport
-        Counts of skipped, finished and failed runs. Failed runs are stored in ``failed/`` with
-        their traceback and are retried at the next start.
+        Counts of skipped, finished and failed runs, runs another process stored meanwhile
+        (``n_elsewhere``) and why stored records were redone (``redone``). Failed runs are stored
+        in ``failed/`` with their traceback and are retried at the next start.
+
+    Notes
+    -----
+    A stored run is skipped only if its record passes its checks and its input fingerprint
+    (case content, files and module the specs name, package versions) equals the current one;
+    otherwise the record is set aside (``corrupt/`` or ``stale/``), the reason is printed, and
+    the run is redone. Each run is claimed with a file lock first, so several processes can work
+    on one directory and each run is computed once. See ``docs/experiments.md``.
     """
     from tqdm import tqdm
 

@@ -26,9 +26,21 @@ from pymoo_rail.journeys.fronts import (
     strategy_programs,
 )
 from pymoo_rail.journeys.journey import Journey
+from pymoo_rail.journeys.timing import (
+    TimedJourney,
+    TimedRun,
+    TimingError,
+    TimingPoint,
+    read_timing_points,
+    solve_timed_journey,
+    timed_journey_from_toml,
+    timed_journey_from_ttobench,
+)
+from pymoo_rail.journeys.timed_problem import TimedSectionProblem
 from pymoo_rail.journeys.problem import BudgetRepair, RunningTimeAllocationProblem, project_to_budget
 
 __all__ = ["Journey", "Allocation", "allocate_running_time", "allocate_on_fronts", "supplement_split",
            "section_fronts", "marginal_slopes", "strategy_front", "strategy_programs", "convex_front",
            "check_front", "front_energy", "front_slopes", "RunningTimeAllocationProblem", "BudgetRepair",
-           "project_to_budget", "DEFAULT_FRONT_SOURCE"]
+           "project_to_budget", "DEFAULT_FRONT_SOURCE", "TimingPoint", "TimedJourney", "TimedRun", "TimingError",
+           "read_timing_points", "timed_journey_from_ttobench", "timed_journey_from_toml", "solve_timed_journey", "TimedSectionProblem"]

@@ -1,9 +1,12 @@
 """The line on a distance grid: what the simulator and the exact solver read per step.
 
 Line resistances are per unit weight (N/kN): gradient ``i`` permille gives ``i`` N/kN (Liu (2019)
-eq. 2-10), a curve of radius R gives ``600 / R`` (eq. 2-11), a tunnel of length Ls gives
-``0.00013 Ls`` (eq. 2-12). With ``gradient_model = "train_length"`` they act on the train as the
-average over its length (eq. 4-14); the stations beyond both ends count as flat. Each grid cell
+eq. 2-10), a curve of radius R gives ``600 / R`` (Liu (2019) eq. 2-11, Tang et al. (2020) eq. 2;
+``line.curve_model = "tang2020"``) or Roeckl's standard-gauge ``650 / (R - 55)`` for R >= 300 m and
+``500 / (R - 30)`` below (``"roeckl"``), a tunnel of length Ls gives ``0.00013 Ls`` (Liu (2019)
+eq. 2-12). Averaged over the train, ``600 / R`` is Tang et al.'s ``10.5 alpha / L_c`` branch for a
+curve shorter than the train (alpha in degrees: ``10.5 alpha / L_c = 601.6 L_r / (R L_c)``). With
+``gradient_model = "train_length"`` they act on the train as the average over its length (eq. 4-14); the stations beyond both ends count as flat. Each grid cell
 stores the exact mean of that (piecewise linear) average over the cell, so the work done against
 gradients over a run equals ``m g`` times the rise of the train's centre of mass exactly.
 """
@@ -91,9 +94,31 @@ def cell_means(rows: list[tuple[float, float, float]], position_m: np.ndarray, t
     return (ww_b - ww_a - ww_bl + ww_al) / (length * (b - a))
 
 
+def curve_resistance_n_per_kn(radius_m: float, model: str = "tang2020") -> float:
+    """Curve resistance per unit weight (N/kN) of a curve of radius ``radius_m`` under ``model``.
+
+    ``"tang2020"``: ``600 / R`` (Tang et al. (2020) eq. 2, Liu (2019) eq. 2-11). ``"roeckl"``:
+    Roeckl's formula for standard gauge, ``650 / (R - 55)`` for R >= 300 m, ``500 / (R - 30)`` below.
+    """
+    if model == "tang2020":
+        return CURVE_RESISTANCE_A / radius_m
+    if model == "roeckl":
+        return 650.0 / (radius_m - 55.0) if radius_m >= 300.0 else 500.0 / (radius_m - 30.0)
+    raise CaseError("line.curve_model", model, "unknown curve model (known: tang2020, roeckl)")
+
+
+FINE_DX_M, COARSE_DX_M = 1.0, 5.0
+FINE_UP_TO_M, COARSE_FROM_M = 10_000.0, 40_000.0
+
+
 def default_dx_m(case: Case) -> float:
-    """Grid step used when none is given: 1 m for metro sections, 5 m for long main-line runs."""
-    return 1.0 if case.line.length_m <= 10_000 else 5.0
+    """Grid step used when none is given: 1 m up to 10 km, 5 m from 40 km, linear in between.
+
+    The step grows with the line so that the number of cells (the cost of a run) stays between
+    8000 and 10 000 from 10 to 40 km instead of dropping fivefold at one length.
+    """
+    share = (case.line.length_m - FINE_UP_TO_M) / (COARSE_FROM_M - FINE_UP_TO_M)
+    return FINE_DX_M + (COARSE_DX_M - FINE_DX_M) * min(max(share, 0.0), 1.0)
 
 
 def build_grid(case: Case, dx_m: float | None = None) -> TrackGrid:
@@ -117,7 +142,7 @@ def build_grid(case: Case, dx_m: float | None = None) -> TrackGrid:
     averaging = train.length_m if line.gradient_model == "train_length" else None
     weight_kn = train.mass_kg * GRAVITY_MS2 / 1000.0
     grade = cell_means(list(line.gradients), position, averaging) * weight_kn
-    other_rows = [(s, e, CURVE_RESISTANCE_A / r) for s, e, r in line.curves]
+    other_rows = [(s, e, curve_resistance_n_per_kn(r, line.curve_model)) for s, e, r in line.curves]
     other_rows += [(s, e, TUNNEL_RESISTANCE_PER_M * (e - s)) for s, e in line.tunnels]
     other = cell_means(other_rows, position, averaging) * weight_kn if other_rows else np.zeros(n_cells)
 

@@ -13,6 +13,10 @@ Interval = tuple[float, float]
 Valued = tuple[float, float, float]
 
 GRADIENT_MODELS = ("train_length", "point_mass")
+# Curve resistance per unit weight (N/kN) from the radius R (m), see ``model/grid.py`` and docs/ttobench.md:
+# "tang2020": 600 / R (Tang et al. (2020) eq. 2; with the train-length average it is their 10.5 alpha / L_c
+# branch for curves shorter than the train); "roeckl": Roeckl's standard-gauge formula.
+CURVE_MODELS = ("tang2020", "roeckl")
 
 
 def _check_intervals(field: str, rows: tuple, length_m: float, *, tile: bool, width: int) -> None:
@@ -46,7 +50,9 @@ class Line:
     ``(start_m, end_m, kmh)``; both must tile [0, length]. ``curves`` rows are
     ``(start_m, end_m, radius_m)``; ``tunnels`` and ``neutral_sections`` rows ``(start_m, end_m)``.
     ``gradient_model`` is ``"train_length"`` (line resistance averaged over the train, Liu (2019)
-    eq. 4-14) or ``"point_mass"``.
+    eq. 4-14) or ``"point_mass"``. ``curve_model`` picks the curve resistance: ``"tang2020"``
+    (``600 / R`` N/kN) or ``"roeckl"`` (``650 / (R - 55)`` for R >= 300 m, ``500 / (R - 30)`` below;
+    needs R > 30 m).
     """
 
     length_m: float
@@ -56,6 +62,7 @@ class Line:
     tunnels: tuple[Interval, ...] = ()
     neutral_sections: tuple[Interval, ...] = ()
     gradient_model: str = "train_length"
+    curve_model: str = "tang2020"
 
     def __post_init__(self) -> None:
         check_number("line.length_m", self.length_m, positive=True)
@@ -78,6 +85,12 @@ class Line:
         for k, row in enumerate(self.curves):
             if row[2] <= 0:
                 raise CaseError(f"line.curves[{k}]", list(row), "the radius must be > 0 m")
+        if self.curve_model not in CURVE_MODELS:
+            raise CaseError("line.curve_model", self.curve_model, f"must be one of {CURVE_MODELS}")
+        if self.curve_model == "roeckl":
+            for k, row in enumerate(self.curves):
+                if row[2] <= 30.0:
+                    raise CaseError(f"line.curves[{k}]", list(row), "Roeckl's formula needs a radius > 30 m")
         if self.gradient_model not in GRADIENT_MODELS:
             raise CaseError("line.gradient_model", self.gradient_model, f"must be one of {GRADIENT_MODELS}")
 

@@ -27,7 +27,8 @@ _RESISTANCE = {"a", "b", "c", "unit", "speed_unit"}
 _CURVE = {"segments", "table", "max_force_kn", "max_power_kw"}
 _BRAKING = _CURVE | {"regen_max_force_kn", "regen_max_power_kw"}
 _SEGMENT = {"v_max_kmh", "poly"}
-_LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_sections", "gradient_model"}
+_LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_sections", "gradient_model",
+         "curve_model"}
 
 
 # every table of the format and the keys it may hold ("[]": each table of an array of tables)
@@ -124,6 +125,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
             tunnels=_rows(line.get("tunnels", []), "line.tunnels", source),
             neutral_sections=_rows(line.get("neutral_sections", []), "line.neutral_sections", source),
             gradient_model=line.get("gradient_model", "train_length"),
+            curve_model=line.get("curve_model", "tang2020"),
         )
         return Case(name=data["name"], source=data.get("source", ""), description=data.get("description", ""),
                     train=train, line=line_obj, planned_time_s=run["planned_time_s"],
@@ -204,12 +206,14 @@ def case_to_dict(case: Case) -> dict:
     if case.legs:
         run["legs"] = [{"start_m": g.start_m, "end_m": g.end_m, "planned_time_s": g.planned_time_s,
                         "dwell_s": g.dwell_s} for g in case.legs]
+    line = {"length_m": ln.length_m, "gradient_model": ln.gradient_model,
+            "gradients": [list(r) for r in ln.gradients], "speed_limits": [list(r) for r in ln.speed_limits],
+            "curves": [list(r) for r in ln.curves], "tunnels": [list(r) for r in ln.tunnels],
+            "neutral_sections": [list(r) for r in ln.neutral_sections]}
+    if ln.curve_model != "tang2020":  # the default stays out of the file (older files read the same)
+        line["curve_model"] = ln.curve_model
     return {"name": case.name, "source": case.source, "description": case.description, "run": run,
-            "train": train,
-            "line": {"length_m": ln.length_m, "gradient_model": ln.gradient_model,
-                     "gradients": [list(r) for r in ln.gradients], "speed_limits": [list(r) for r in ln.speed_limits],
-                     "curves": [list(r) for r in ln.curves], "tunnels": [list(r) for r in ln.tunnels],
-                     "neutral_sections": [list(r) for r in ln.neutral_sections]}}
+            "train": train, "line": line}
 
 
 def write_case(case: Case, path: str | Path) -> Path:

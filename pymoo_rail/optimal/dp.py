@@ -351,7 +351,8 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float):
 def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
-    ``time_price_w`` is the price of time beyond the auxiliary power (already in the energies);
+    ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
+    the energies; one value everywhere for one running time, one per stretch between timing points);
     ``fixed_u1`` and ``tgt_u1`` hold node positions (:func:`value_position`).
     """
     n, n_speeds = value.shape
@@ -365,14 +366,14 @@ def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, t
             for c in range(N_FIXED):
                 e = fixed_e[i, j, c]
                 if e < INF:
-                    cost = e + time_price_w * fixed_dt[i, j, c] + interp_at(v_next, fixed_u1[i, j, c])
+                    cost = e + time_price_w[i] * fixed_dt[i, j, c] + interp_at(v_next, fixed_u1[i, j, c])
                     if cost < best:
                         best = cost
             s = i * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w * tgt_dt[p] + interp_at(v_next, tgt_u1[p])
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_at(v_next, tgt_u1[p])
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J else PENALTY_J
@@ -397,7 +398,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     time = 0.0
     previous = MODE_TRACTION
     for i in range(n - 1):
-        cost, mode, target = best_control(m, i, v, time_price_w, value[i + 1], max_targets, bias)
+        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time
         tr_u, tr_f, tr_w, _ = _full_step(m, v, i, _KIND_TRACTION)
@@ -407,7 +408,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
                 u1, f, w0 = cell_outcome(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-                c_keep, _ = cell_cost(m, v, u1, f, w0, i, time_price_w)
+                c_keep, _ = cell_cost(m, v, u1, f, w0, i, time_price_w[i])
                 if c_keep < INF:
                     c_keep += interp_value(value[i + 1], m.envelope_ms[i + 1] ** 2, u1, bias)
                     if c_keep <= cost + tie_j:
@@ -424,20 +425,24 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     return n - 1, energy, time
 
 
-def solve(model, tables, lambda_w: float, max_targets: int, bias: float, tie_j: float, value: np.ndarray):
+def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
+
+    ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
+    stretch between them its own price.
 
     ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
     cost-to-go. Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s).
     Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
     energy, and the tables already hold it.
     """
-    backward_sweep(float(lambda_w), *tables, value)
     n = model.position_m.shape[0]
+    prices = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,)))
+    backward_sweep(prices, *tables, value)
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)
-    price = float(lambda_w) + model.aux_power_w
+    price = prices + model.aux_power_w
     done, energy, time = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j), modes,
                                          targets, speeds)
     return modes, targets, speeds, done, energy, time

@@ -100,11 +100,15 @@ class OptimalSolver:
     certify : bool
         Give every run an error bound (``summary["energy_bound_kwh"]``, see :meth:`energy_bound_kwh`);
         costs a second solve on a speed grid of half the nodes.
+    price_shape : array (n_cells,), optional
+        Relative price of time per grid cell, scaled by the ``lambda`` search: a journey's timing
+        points give each stretch between them its own price (:meth:`set_price_shape`).
     """
 
     def __init__(self, case: Case, dx_m: float | None = None, n_speeds: int = DEFAULT_N_SPEEDS,
                  max_targets: int = DEFAULT_MAX_TARGETS, time_tol_s: float = DEFAULT_TIME_TOL_S,
-                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J, certify: bool = True):
+                 top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J, certify: bool = True,
+                 price_shape: np.ndarray | None = None):
         if isinstance(n_speeds, bool) or not isinstance(n_speeds, (int, np.integer)) or n_speeds < 3:
             raise ValueError(f"n_speeds = {n_speeds!r}: must be an integer >= 3")
         if isinstance(max_targets, bool) or not isinstance(max_targets, (int, np.integer)) or max_targets < 1:
@@ -127,6 +131,24 @@ class OptimalSolver:
         self.certify = bool(certify)
         self._coarse: OptimalSolver | None = None
         self._history: list[_Solve] = []  # every solve so far: time depends on lambda alone
+        self.price_shape: np.ndarray | None = None
+        self.set_price_shape(price_shape)
+
+    def set_price_shape(self, price_shape: np.ndarray | None) -> None:
+        """Price time per cell as ``lambda x price_shape`` (None: one price everywhere).
+
+        Earlier solves were made at another shape, so they no longer guide the ``lambda`` search.
+        """
+        if price_shape is not None:
+            shape = np.asarray(price_shape, dtype=float)
+            n_cells = self.simulator.grid.n_nodes - 1
+            if shape.shape != (n_cells,) or not np.all(np.isfinite(shape) & (shape > 0)):
+                raise ValueError(f"price_shape: needs {n_cells} finite values > 0, one per cell")
+            price_shape = shape
+        self.price_shape = price_shape
+        self._history = []
+        if self._coarse is not None:
+            self._coarse.set_price_shape(price_shape)
 
     @property
     def dx_m(self) -> float:
@@ -143,7 +165,8 @@ class OptimalSolver:
         if self._tables is None:
             self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
         self.n_solves += 1
-        run = dp.solve(self.simulator.model, self._tables, lambda_w, self.max_targets, self.top_bias, self.tie_j,
+        prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
+        run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, self.tie_j,
                        self._value)
         solution = self._record(lambda_w, run)
         self._history.append(solution)
@@ -364,7 +387,8 @@ class OptimalSolver:
         """
         if self._coarse is None:
             self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
-                                         self.time_tol_s, self.top_bias, self.tie_j, certify=False)
+                                         self.time_tol_s, self.top_bias, self.tie_j, certify=False,
+                                         price_shape=self.price_shape)
             self._coarse.simulator = self.simulator  # same grid and model: share them
             self._coarse._min_time_s = self._min_time_s
         coarse = self._coarse
@@ -408,7 +432,7 @@ class OptimalSolver:
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
                                    f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
-                                  self.top_bias, self.tie_j, self.certify)
+                                  self.top_bias, self.tie_j, self.certify, self.price_shape)
             return finer.profile(running_time_s, solution.lambda_w)
         tr = self.trajectory(solution)
         if self.certify:

@@ -4,7 +4,8 @@ An encoding turns a population of decision vectors into kernel programs. Two fam
 
 - ``SpeedCodes``: one target speed (km/h) per section of a partition of the line (Liu (2019)
   4.3.3): ``"gradient_limit"`` cuts at every gradient, limit and neutral-section change (the
-  non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``;
+  non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``
+  (by default 1 km on long sparse lines, whose sections average more than 2 km);
   ``"equal"`` cuts ``n_sections`` equal pieces (fig. 4-3). Bounds run from a floor to the highest
   limit in the section; sections inside a neutral section are fixed at the floor (coasting).
 - ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (Meng et al. (2017) and Tang et al. (2020)),
@@ -39,6 +40,11 @@ from pymoo_rail.sim import kernel as k
 
 KMH_PER_MS = 3.6
 PARTITIONS = ("gradient_limit", "equal")
+# Long sparse lines: a gradient/limit partition whose sections average more than this is cut into
+# sections of at most SPARSE_MAX_SECTION_M unless max_section_m is given (the 48.5 km TTOBench
+# reference would otherwise be one variable: one cruise speed, no coasting).
+SPARSE_MEAN_SECTION_M = 2000.0
+SPARSE_MAX_SECTION_M = 1000.0
 
 
 def _split_long(boundaries: np.ndarray, max_section_m: float | None) -> np.ndarray:
@@ -82,6 +88,8 @@ class SpeedCodes:
             bounds = gradient_limit_partition(line)
             neutral_points = [p for row in line.neutral_sections for p in row]
             bounds = np.unique(np.concatenate([bounds, neutral_points]))
+            if max_section_m is None and (bounds[-1] - bounds[0]) / (bounds.shape[0] - 1) > SPARSE_MEAN_SECTION_M:
+                max_section_m = SPARSE_MAX_SECTION_M
             bounds = _split_long(bounds, max_section_m)
         elif partition == "equal":
             bounds = equal_partition(line, n_sections if n_sections is not None else 10)

@@ -89,7 +89,6 @@ def _full_step(m, v0, cell, kind):
 
     Returns (u1, control force N (+ traction, - braking), W0 N, mean speed m/s).
     """
-    dx = m.dx_m
     wl = m.line_force_n[cell]
     if kind == _KIND_TRACTION:
         f = max_traction(m, v0, cell)
@@ -97,14 +96,15 @@ def _full_step(m, v0, cell, kind):
         f = -max_braking(m, v0, cell)
     else:
         f = 0.0
-    u_half = v0 * v0 + dx * (f - davis_force(m, v0) - wl) / m.effective_mass_kg
+    gain = m.dx_per_mass_m_kg  # dx / M: a multiplication instead of a division on the critical path
+    u_half = v0 * v0 + (f - davis_force(m, v0) - wl) * gain
     v_half = math.sqrt(u_half) if u_half > 0.0 else 0.5 * v0
     if kind == _KIND_TRACTION:
         f = max_traction(m, v_half, cell)
     elif kind == _KIND_BRAKE:
         f = -max_braking(m, v_half, cell)
     w0 = davis_force(m, v_half)
-    u1 = v0 * v0 + 2.0 * dx * (f - w0 - wl) / m.effective_mass_kg
+    u1 = v0 * v0 + 2.0 * ((f - w0 - wl) * gain)
     return u1, f, w0, v_half
 
 

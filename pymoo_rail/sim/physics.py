@@ -48,6 +48,7 @@ class KernelModel(NamedTuple):
     envelope_ms: np.ndarray
     initial_speed_ms: float = 0.0
     final_speed_ms: float = 0.0
+    dx_per_mass_m_kg: float = 0.0  # dx_m / effective_mass_kg, precomputed for the kernel's step
 
 
 def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | None = None) -> KernelModel:
@@ -74,6 +75,7 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
         grade_force_n=grid.grade_force_n, line_force_n=np.ascontiguousarray(grid.line_force_n),
         neutral=grid.neutral, envelope_ms=np.empty(0),
         initial_speed_ms=float(case.initial_speed_ms), final_speed_ms=float(case.final_speed_ms),
+        dx_per_mass_m_kg=grid.dx_m / train.effective_mass_kg,
     )
     envelope = braking_envelope(model)
     if model.initial_speed_ms > envelope[0]:

@@ -291,6 +291,8 @@ def test_bad_train_input_names_the_field(mutate, field, reason):
     assert err.value.field == field
 
 
+_TUNNEL_UNITS = {"position": "m", "length": "m", "cross section": "m^2"}
+_CURVE_UNITS = {"position": "m", "radius at start": "m", "radius at end": "m"}
 TRACK_CASES = [
     (_set("gradients/values/5", [1000.0, 3.0]), "gradients.values[5]", "sorted"),
     (_set("speed limits/values/3", [480.0, 70]), "speed limits.values[3]", "sorted"),
@@ -305,9 +307,19 @@ TRACK_CASES = [
     (_set("speed limits/values/2", [480.0, -5]), "speed limits.values[2]", "> 0"),
     (_set("speed limits/values/2", [480.0]), "speed limits.values[2]", "pair"),
     (_set("altitude/unit", "ft"), "altitude.unit", "unknown unit"),
-    (_set("tunnels", {"units": {}, "values": [[100.0, 200.0, 40.0]]}), "tunnels", "not represented"),
+    (_set("tunnels", {"units": {}, "values": [[100.0, 200.0, 40.0]]}), "tunnels.units", "exactly the units"),
+    (_set("tunnels", {"units": _TUNNEL_UNITS, "values": [[100.0, 200.0, 40.0], [250.0, 10.0, 40.0]]}),
+     "tunnels.values[1]", "overlaps"),
+    (_set("tunnels", {"units": _TUNNEL_UNITS, "values": [[22700.0, 200.0, 40.0]]}), "tunnels.values[0]",
+     "beyond the end"),
     (_set("curvatures", {"units": {}, "values": [[0.0, "infinity", "infinity"], [500.0, 400.0, 400.0]]}),
-     "curvatures.values[1]", "not represented"),
+     "curvatures.units", "exactly the units"),
+    (_set("curvatures", {"units": _CURVE_UNITS, "values": [[0.0, "infinity", "infinity"], [500.0, 0, 400.0]]}),
+     "curvatures.values[1][1]", "radius of 0"),
+    (_set("curvatures", {"units": _CURVE_UNITS, "values": [[0.0, "infinity", "straight"]]}),
+     "curvatures.values[0][2]", "infinity"),
+    (_set("ETCS braking data", {"Kt_int": {"unit": "-", "value": 1.1}}), "ETCS braking data.M_NVAVADH",
+     "exactly"),
     (_set("metadata", {}), "metadata.id", "is required"),
 ]
 
@@ -324,7 +336,7 @@ def test_bad_track_input_names_the_field(mutate, field, reason):
 def test_level_track_without_gradients_and_straight_curvatures_are_accepted():
     d = track_dict()
     del d["gradients"]
-    d["curvatures"] = {"units": {}, "values": [[0.0, "infinity", "infinity"]]}
+    d["curvatures"] = {"units": _CURVE_UNITS, "values": [[0.0, "infinity", "infinity"]]}
     case = from_ttobench(d, BEIJING_SUBWAY_TRAIN, 9, 10, 150.0)
     assert case.line.gradients == ((0.0, 2265.0, 0.0),)
 

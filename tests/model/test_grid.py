@@ -68,3 +68,19 @@ def test_neutral_cells():
 def test_bad_step(yizhuang):
     with pytest.raises(ValueError, match="dx_m"):
         build_grid(yizhuang, 0.0)
+
+
+def test_default_step_grows_with_the_line_without_a_jump():
+    from pymoo_rail.model.grid import default_dx_m
+    from tests.conftest import make_case
+
+    def case(length_m):
+        return make_case(line={"length_m": length_m, "gradients": [[0.0, length_m, 0.0]],
+                               "speed_limits": [[0.0, length_m, 100.0]]})
+
+    assert default_dx_m(case(2265.0)) == 1.0 and default_dx_m(case(10_000.0)) == 1.0
+    assert default_dx_m(case(40_000.0)) == 5.0 and default_dx_m(case(48_531.0)) == 5.0
+    lengths = np.linspace(9_000.0, 41_000.0, 161)
+    cells = np.array([L / default_dx_m(case(L)) for L in lengths])
+    assert np.all(np.abs(np.diff(cells)) <= 200 + 1e-6)  # continuous: no fivefold drop at one length
+    assert cells[lengths >= 10_000].min() >= 8_000 - 1e-6 and cells[lengths <= 40_000].max() <= 10_000 + 1e-6

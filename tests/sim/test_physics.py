@@ -181,3 +181,22 @@ def test_hold_brake_keeps_the_speed_down_a_descent_where_hold_runs_away(descent_
         # too steep: maximum braking, and the speed still rises until the limit's envelope
         assert np.any(brake_hold.force_n[down] == pytest.approx(-100e3))
         assert brake_hold.speed_ms[down].max() > v_hold + 1.0
+
+
+def test_runs_side_by_side_equal_single_runs_when_one_stops_short(yizhuang_sim):
+    """Batches run programs in pairs; a pair whose runs end at different cells (one brakes to a
+    stop half way) and an odd batch give exactly the single runs' summaries, serial or threaded."""
+    from pymoo_rail.sim import kernel as k
+
+    length = yizhuang_sim.length_m
+    reach = [[length, k.MODE_TOWARD, 60 / 3.6]]
+    stop_short = [[600.0, k.MODE_TRACTION, 0.0], [length, k.MODE_BRAKE, 0.0]]
+    coast = [[900.0, k.MODE_TRACTION, 0.0], [length, k.MODE_COAST, 0.0]]
+    programs = np.array([np.array(p + p[-1:] * (2 - len(p)), dtype=float)
+                         for p in (reach, stop_short, stop_short, reach, coast)])
+    single = np.array([[yizhuang_sim.run(p).summary[name] for name in OUT_NAMES] for p in programs])
+    assert single[1, k.OUT_REACHED] == 0.0 and single[0, k.OUT_REACHED] == 1.0
+    for batch in (k.simulate_batch(yizhuang_sim.model, programs),
+                  k.simulate_batch_serial(yizhuang_sim.model, programs),
+                  yizhuang_sim.run_batch(programs)):
+        np.testing.assert_array_equal(batch, single)

@@ -1,0 +1,421 @@
+"""Journeys with timing points: time windows and speed bounds along the track, stops with dwell.
+
+A TTOBench *journey* file lists timing points ``[position, earliest, latest, min speed, max speed]``
+(times from the journey's start, ``null`` where unset). Two consecutive points at one position with
+both speed bounds 0 are the arrival at and the departure from an intermediate stop; a point with
+both speed bounds 0 is a stopping point, any other a passing point. The stopping points cut the
+journey into stop-to-stop sections (each a :class:`~pymoo_rail.model.Case`), so one model serves:
+a :class:`~pymoo_rail.journeys.Journey` with its timing points.
+
+:func:`solve_timed_journey` finds the least-energy run meeting every window. Each section's run is
+the exact solver's optimum for a running time: departures are as early as their windows allow
+(a longer dwell never saves energy), the running time as long as the arrival window and the next
+departure window allow (energy falls with running time), and passing-point windows are met by
+bisection on the section's running time: passing points inside a section share the section's
+single price of time. When one price cannot meet them all (a window that needs a faster first
+part and a slower second part), the function raises :class:`TimingError` naming the point.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from pymoo_rail.cases import ttobench
+from pymoo_rail.model import CaseError
+from pymoo_rail.sim import Trajectory
+
+TIME_TOL_S = 0.5  # the exact solver returns runs within 0.5 s of the request
+
+
+class TimingError(CaseError):
+    """No run of the journey meets a timing point (the message names it)."""
+
+
+@dataclass(frozen=True)
+class TimingPoint:
+    """One timing point: a position on the track, a time window and speed bounds (``None`` = unset).
+
+    Times are seconds from the journey's start; speeds in km/h; ``position_m`` on the track.
+    """
+
+    position_m: float
+    earliest_s: float | None = None
+    latest_s: float | None = None
+    min_speed_kmh: float | None = None
+    max_speed_kmh: float | None = None
+
+    @property
+    def is_stop(self) -> bool:
+        return self.min_speed_kmh == 0.0 and self.max_speed_kmh == 0.0
+
+    def time_ok(self, time_s: float, tol_s: float = 1e-6) -> bool:
+        return (self.earliest_s is None or time_s >= self.earliest_s - tol_s) and \
+            (self.latest_s is None or time_s <= self.latest_s + tol_s)
+
+    def speed_ok(self, speed_kmh: float, tol_kmh: float = 1e-6) -> bool:
+        return (self.min_speed_kmh is None or speed_kmh >= self.min_speed_kmh - tol_kmh) and \
+            (self.max_speed_kmh is None or speed_kmh <= self.max_speed_kmh + tol_kmh)
+
+
+def read_timing_points(source: ttobench.Source) -> tuple[str, str | None, tuple[TimingPoint, ...], dict]:
+    """Read a TTOBench journey file: ``(id, associated track id, timing points, metadata)``.
+
+    Checks the rules of the TTOBench journey format (ordered positions, equal positions only for an
+    arrival/departure pair of stopping points, first and last points stops, lower <= upper bounds).
+    """
+    journey_id, track_id, rows, meta, label = ttobench.read_journey(source)
+    values = [list(r) for r in rows]
+    points = []
+    for k, row in enumerate(rows):
+        field = f"timing points.values[{k}]"
+        pos = row[0]
+        point = TimingPoint(*row)
+        for lo, hi, what in ((point.earliest_s, point.latest_s, "time"),
+                             (point.min_speed_kmh, point.max_speed_kmh, "speed")):
+            if lo is not None and hi is not None and lo > hi:
+                raise CaseError(field, row, f"the lower {what} constraint exceeds the upper one", label)
+        if (point.min_speed_kmh or 0.0) < 0 or (point.max_speed_kmh is not None and point.max_speed_kmh < 0):
+            raise CaseError(field, row, "speed constraints must be >= 0", label)
+        if points and pos < points[-1].position_m:
+            raise CaseError(field, row, "timing points must be ordered by position", label)
+        if points and pos == points[-1].position_m and not (point.is_stop and points[-1].is_stop):
+            raise CaseError(field, row, "equal positions are only allowed for the arrival and departure "
+                                        "stopping points of one station", label)
+        points.append(point)
+    if len(points) < 2:
+        raise CaseError("timing points.values", values, "needs at least two timing points", label)
+    for k in (0, len(points) - 1):
+        if not points[k].is_stop:
+            raise CaseError(f"timing points.values[{k}]", values[k], "the first and last timing points must be "
+                                                                    "stops (both speed constraints 0)", label)
+    return journey_id, track_id, tuple(points), meta
+
+
+@dataclass(frozen=True)
+class TimedJourney:
+    """A :class:`Journey` with the timing points of each section.
+
+    ``windows[k]`` holds section ``k``'s departure point, its passing points and its arrival point
+    (positions on the track); ``journey.stops_m`` are the section ends on the same track.
+    """
+
+    journey: Any  # Journey (imported lazily to keep the module order one-way)
+    windows: tuple[tuple[TimingPoint, ...], ...]
+
+    @property
+    def timing_points(self) -> tuple[TimingPoint, ...]:
+        out: list[TimingPoint] = []
+        for section in self.windows:
+            out.extend(section)
+        return tuple(out)
+
+
+def timed_journey_from_ttobench(journey_path: ttobench.Source, track_path: ttobench.Source,
+                                train_path: ttobench.Source, *, train_length_m: float | None = None,
+                                curve_model: str = "tang2020", tunnel_model: str = "liu2019") -> TimedJourney:
+    """A TTOBench journey file on its track with a train, as sections and their timing points."""
+    from pymoo_rail.journeys.journey import Journey
+
+    journey_id, track_id, points, _ = read_timing_points(journey_path)
+    track = ttobench.read_track(track_path)
+    if track_id is not None and track_id != track.id:
+        raise CaseError("metadata.associated track", track_id, f"the journey belongs to another track "
+                                                               f"(this one is {track.id!r})", str(journey_path))
+    groups: list[list[TimingPoint]] = [[points[0]]]
+    for point in points[1:]:
+        groups[-1].append(point)
+        if point.is_stop and point is not points[-1]:
+            groups.append([point])
+    # An intermediate station is two stopping points at one position: arrival ends one section,
+    # departure starts the next (the grouping above put the arrival at the head of a one-point group).
+    merged: list[list[TimingPoint]] = []
+    for group in groups:
+        if merged and len(group) >= 2 and group[0].position_m == group[1].position_m:
+            group = group[1:]
+        if len(group) >= 2:
+            merged.append(group)
+    stops = [g[0].position_m for g in merged] + [merged[-1][-1].position_m]
+    tt_train = ttobench.read_train(train_path, train_length_m=train_length_m)
+    sections, dwell = [], []
+    for k, group in enumerate(merged):
+        planned = window_end_s(group[-1]) - window_start_s(group[0])
+        if not math.isfinite(planned):
+            planned = 1.0  # no window: the solver picks the time
+        case = ttobench.case_between(track, tt_train, stops[k], stops[k + 1], max(planned, 1.0),
+                                     name=f"{journey_id}[{k}]", curve_model=curve_model, tunnel_model=tunnel_model)
+        case = replace(case, line=_with_speed_caps(case.line, group, stops[k]))
+        sections.append(case)
+        if k > 0:
+            arrival = merged[k - 1][-1]
+            dwell.append(max(0.0, window_start_s(group[0]) - window_end_s(arrival)))
+    journey = Journey(name=journey_id, sections=tuple(sections), dwell_s=tuple(dwell),
+                      stops_m=tuple(stops), source=sections[0].source)
+    return TimedJourney(journey=journey, windows=tuple(tuple(g) for g in merged))
+
+
+_TOML_TOP = {"name", "track", "train", "curve_model", "tunnel_model", "train_length_m", "timing_points"}
+_TOML_POINT = ("position_m", "earliest_s", "latest_s", "min_speed_kmh", "max_speed_kmh")
+
+
+def timed_journey_from_toml(path: str | Path) -> TimedJourney:
+    """A journey with timing points from a TOML file (TTOBench track and train files beside it).
+
+    ``name``, ``track`` and ``train`` (paths relative to the file), optional ``curve_model``,
+    ``tunnel_model``, ``train_length_m``, and one ``[[timing_points]]`` table per point with
+    ``position_m`` and any of ``earliest_s``, ``latest_s``, ``min_speed_kmh``, ``max_speed_kmh``
+    (a stop has both speeds 0). The rules are those of TTOBench journey files.
+    """
+    from pymoo_rail.model.toml_io import tomllib
+
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as err:
+        raise CaseError("<file>", str(path), f"cannot read the journey file: {err}", str(path)) from None
+    for key in sorted(set(data) - _TOML_TOP):
+        raise CaseError(key, data[key], f"unknown key (allowed: {', '.join(sorted(_TOML_TOP))})", str(path))
+    for key in ("name", "track", "train", "timing_points"):
+        if key not in data:
+            raise CaseError(key, None, "is required", str(path))
+    rows = []
+    for k, point in enumerate(data["timing_points"]):
+        if not isinstance(point, dict) or "position_m" not in point:
+            raise CaseError(f"timing_points[{k}].position_m", None, "is required", str(path))
+        for key in sorted(set(point) - set(_TOML_POINT)):
+            raise CaseError(f"timing_points[{k}].{key}", point[key],
+                            f"unknown key (allowed: {', '.join(_TOML_POINT)})", str(path))
+        rows.append([point.get(key) for key in _TOML_POINT])
+    journey = {"metadata": {"id": data["name"]},
+               "timing points": {"units": {"position": "m", "lower time constraint": "s",
+                                           "upper time constraint": "s", "lower speed constraint": "km/h",
+                                           "upper speed constraint": "km/h"}, "values": rows}}
+    return timed_journey_from_ttobench(journey, path.parent / data["track"], path.parent / data["train"],
+                                       train_length_m=data.get("train_length_m"),
+                                       curve_model=data.get("curve_model", "tang2020"),
+                                       tunnel_model=data.get("tunnel_model", "liu2019"))
+
+
+def window_start_s(point: TimingPoint) -> float:
+    """The earliest time of a timing point, 0 when it has none."""
+    return point.earliest_s if point.earliest_s is not None else 0.0
+
+
+def window_end_s(point: TimingPoint) -> float:
+    """The latest time of a timing point, infinity when it has none."""
+    return point.latest_s if point.latest_s is not None else math.inf
+
+
+_CAP_LENGTH_M = 1.0  # a passing point's maximum speed holds on this stretch of track after it
+
+
+def _with_speed_caps(line, group: Sequence[TimingPoint], start_m: float):
+    """The section's line with each passing point's maximum speed as a short speed limit."""
+    caps = [(p.position_m - start_m, p.max_speed_kmh) for p in group[1:-1] if p.max_speed_kmh is not None]
+    if not caps:
+        return line
+    rows = []
+    for s, e, v in line.speed_limits:
+        cuts = sorted({s, e} | {x for x, _ in caps if s < x < e} | {x + _CAP_LENGTH_M for x, _ in caps
+                                                                   if s < x + _CAP_LENGTH_M < e})
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            limit = min([v] + [c for x, c in caps if x <= a < x + _CAP_LENGTH_M])
+            if limit <= 0:
+                raise CaseError("timing point", limit, "a passing point needs a maximum speed > 0")
+            rows.append((a, b, limit))
+    return replace(line, speed_limits=tuple(rows))
+
+
+@dataclass(frozen=True)
+class TimedRun:
+    """The solved journey: one trajectory per section, departure times, and the check of every point."""
+
+    trajectories: tuple[Trajectory, ...]
+    departures_s: tuple[float, ...]
+    checks: tuple[dict, ...]
+
+    @property
+    def energy_kwh(self) -> float:
+        return float(sum(t.energy.net_kwh for t in self.trajectories))
+
+    @property
+    def all_met(self) -> bool:
+        return all(c["time_ok"] and c["speed_ok"] for c in self.checks)
+
+
+def _time_and_speed_at(trajectory: Trajectory, x_m: float) -> tuple[float, float]:
+    t = float(np.interp(x_m, trajectory.position_m, trajectory.time_s))
+    v = float(np.interp(x_m, trajectory.position_m, trajectory.speed_ms)) * 3.6
+    return t, v
+
+
+def check_run(timed: TimedJourney, trajectories: Sequence[Trajectory], departures_s: Sequence[float]) -> tuple[dict, ...]:
+    """Time and speed of the run at every timing point, and whether its window and bounds hold."""
+    out = []
+    for k, group in enumerate(timed.windows):
+        start = timed.journey.stops_m[k]
+        traj = trajectories[k]
+        for j, point in enumerate(group):
+            if j == 0:
+                t, v = departures_s[k], 0.0
+            elif j == len(group) - 1:
+                t, v = departures_s[k] + traj.running_time_s, float(traj.speed_ms[-1]) * 3.6
+            else:
+                tau, v = _time_and_speed_at(traj, point.position_m - start)
+                t = departures_s[k] + tau
+            out.append({"section": k, "position_m": point.position_m, "time_s": t, "speed_kmh": v,
+                        "earliest_s": point.earliest_s, "latest_s": point.latest_s,
+                        "min_speed_kmh": point.min_speed_kmh, "max_speed_kmh": point.max_speed_kmh,
+                        "time_ok": point.time_ok(t, TIME_TOL_S), "speed_ok": point.speed_ok(v, 1e-3)})
+    return tuple(out)
+
+
+def limit_time_bound_s(line, start_m: float, end_m: float) -> float:
+    """Time to run from ``start_m`` to ``end_m`` of a line at its speed limits: a bound no train beats."""
+    total = 0.0
+    for s, e, v in line.speed_limits:
+        a, b = max(s, start_m), min(e, end_m)
+        if b > a:
+            total += (b - a) / (v / 3.6)
+    return total
+
+
+def check_windows_reachable(timed: TimedJourney) -> None:
+    """Raise :class:`TimingError` when two timing points' windows leave less time than the speed
+    limits allow between them (a bound independent of the train)."""
+    for k, group in enumerate(timed.windows):
+        start = timed.journey.stops_m[k]
+        line = timed.journey.sections[k].line
+        for i, p in enumerate(group):
+            for q in group[i + 1:]:
+                if p.earliest_s is None or q.latest_s is None:
+                    continue
+                need = limit_time_bound_s(line, p.position_m - start, q.position_m - start)
+                if q.latest_s - p.earliest_s < need:
+                    raise TimingError(f"timing point at {q.position_m} m", q.latest_s,
+                                      f"cannot be met: after the earliest time {p.earliest_s:g} s at "
+                                      f"{p.position_m} m, {q.position_m - p.position_m:.1f} m take at least "
+                                      f"{need:.1f} s at the speed limits, but the windows leave "
+                                      f"{q.latest_s - p.earliest_s:.1f} s")
+
+
+def _passing_times(traj: Trajectory, passing: Sequence[TimingPoint], start_m: float, depart_s: float) -> list[float]:
+    return [depart_s + _time_and_speed_at(traj, p.position_m - start_m)[0] for p in passing]
+
+
+def _violation(times: Sequence[float], passing: Sequence[TimingPoint]) -> tuple[int, float] | None:
+    """The first passing point missed: (index, signed miss in s, + late / - early)."""
+    for j, (t, p) in enumerate(zip(times, passing)):
+        if p.latest_s is not None and t > p.latest_s + TIME_TOL_S:
+            return j, t - p.latest_s
+        if p.earliest_s is not None and t < p.earliest_s - TIME_TOL_S:
+            return j, t - p.earliest_s
+    return None
+
+
+def _meet_passing_windows(solver, case, passing: Sequence[TimingPoint], start_m: float, depart_s: float,
+                          running_time_s: float, n_bisect: int) -> Trajectory:
+    """The least-energy run of one section taking ``running_time_s`` and meeting its passing windows.
+
+    One price of time per stretch between passing points (the Lagrange structure of the windows: a
+    binding latest time raises the price of every stretch before the point, a binding earliest time
+    lowers it). Starting from one price everywhere, each missed window in turn gets the ratio of
+    the prices before and after its point that puts the run on the window's bound (bisection on
+    the log of the ratio; the ``lambda`` search keeps the running time); two sweeps over the points.
+    """
+    cells_mid = 0.5 * (solver.simulator.grid.position_m[:-1] + solver.simulator.grid.position_m[1:])
+    point_x = np.array([p.position_m - start_m for p in passing])
+    log_ratio = np.zeros(len(passing))
+
+    def run(ratios):
+        # stretch before point j is priced exp(sum of log ratios of the points at or after it)
+        after = np.searchsorted(point_x, cells_mid)  # index of the first point after each cell
+        cum = np.concatenate([np.cumsum(ratios[::-1])[::-1], [0.0]])
+        solver.set_price_shape(np.exp(cum[after]))
+        traj = solver.profile(running_time_s)
+        return traj, _passing_times(traj, passing, start_m, depart_s)
+
+    best, times = run(log_ratio)
+    for _ in range(2 * len(passing)):
+        missed = _violation(times, passing)
+        if missed is None:
+            return best
+        j, miss = missed
+        # late (miss > 0): a higher price before point j; early: a lower one
+        lo, hi = (log_ratio[j], log_ratio[j] + 8.0) if miss > 0 else (log_ratio[j] - 8.0, log_ratio[j])
+        bound = passing[j].latest_s if miss > 0 else passing[j].earliest_s
+        found = None
+        for _ in range(n_bisect):  # keep the feasible ratio closest to the window's bound
+            mid = 0.5 * (lo + hi)
+            trial = log_ratio.copy()
+            trial[j] = mid
+            traj, t = run(trial)
+            still_late, still_early = t[j] > bound + TIME_TOL_S, t[j] < bound - TIME_TOL_S
+            if miss > 0:
+                if still_late:
+                    lo = mid
+                else:
+                    found, hi = (trial, traj, t), mid
+            else:
+                if still_early:
+                    hi = mid
+                else:
+                    found, lo = (trial, traj, t), mid
+            if found is not None and abs(found[2][j] - bound) <= TIME_TOL_S:
+                break
+        if found is None:
+            raise TimingError(f"timing point at {passing[j].position_m} m", bound,
+                              "no price of time before it meets the window at this section's running time")
+        log_ratio, best, times = found
+    if _violation(times, passing) is not None:
+        j, _ = _violation(times, passing)
+        raise TimingError(f"timing point at {passing[j].position_m} m", times[j], "missed after the price search")
+    return best
+
+
+def solve_timed_journey(timed: TimedJourney, *, n_bisect: int = 12, **settings) -> TimedRun:
+    """The least-energy run of the journey that meets every timing point (exact solver per section).
+
+    ``settings`` go to :class:`pymoo_rail.optimal.OptimalSolver` (``dx_m``, ``n_speeds`` ...;
+    ``certify`` is off unless asked for: the window search solves many running times).
+    Raises :class:`TimingError` naming the first point no run with one price per section can meet.
+    """
+    from pymoo_rail.optimal.solver import OptimalSolver
+
+    check_windows_reachable(timed)
+    settings.setdefault("certify", False)
+    trajectories, departures = [], []
+    arrival_prev = 0.0
+    for k, group in enumerate(timed.windows):
+        case = timed.journey.sections[k]
+        dep_point, arr_point, passing = group[0], group[-1], group[1:-1]
+        depart = max(window_start_s(dep_point), arrival_prev)
+        if depart > window_end_s(dep_point) + 1e-9:
+            raise TimingError(f"section {k} departure", depart, f"the train arrives at {arrival_prev:.1f} s, "
+                                                                f"after the departure window ends ({dep_point.latest_s} s)")
+        solver = OptimalSolver(case, **settings)
+        t_min = solver.min_running_time_s()
+        t_hi = window_end_s(arr_point) - depart
+        if k + 1 < len(timed.windows):  # arriving after the next departure window closes is useless
+            t_hi = min(t_hi, window_end_s(timed.windows[k + 1][0]) - depart)
+        t_lo = max(window_start_s(arr_point) - depart, t_min)
+        if not math.isfinite(t_hi):
+            t_hi = 1.5 * t_min
+        if t_hi < t_lo:
+            raise TimingError(f"section {k} arrival", arr_point, f"needs a running time <= {t_hi:.1f} s; the "
+                                                                 f"minimum is {t_min:.1f} s")
+        best = _meet_passing_windows(solver, case, passing, timed.journey.stops_m[k], depart, t_hi, n_bisect)
+        trajectories.append(best)
+        departures.append(depart)
+        arrival_prev = depart + best.running_time_s
+    checks = check_run(timed, trajectories, departures)
+    for c in checks:
+        if not c["time_ok"] or not c["speed_ok"]:
+            raise TimingError(f"timing point at {c['position_m']} m", c,
+                              "no run with one price of time per section meets it")
+    return TimedRun(trajectories=tuple(trajectories), departures_s=tuple(departures), checks=checks)
