@@ -64,10 +64,12 @@ class NoExactFrontError(NotImplementedError):
 
 
 def case_hash(case: Case) -> str:
-    """SHA-256 of the case's content (train, line, planned time, dwell, legs): not of its name or prose."""
+    """SHA-256 of the case's content (train, line, planned time, dwell, legs): not of its names or prose."""
     data = case_to_dict(case)
     for key in ("name", "source", "description"):
         data.pop(key, None)
+    if isinstance(data.get("train"), dict):
+        data["train"].pop("name", None)  # the train's name is prose too
     text = json.dumps(data, sort_keys=True, default=repr)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 

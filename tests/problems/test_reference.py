@@ -38,7 +38,7 @@ def test_front_is_the_solvers_and_cached_by_content(cache, metro):
     table = front.table
     # decreasing and convex in time (more time, less energy, diminishing returns)
     assert np.all(np.diff(table["energy_kwh"]) < 0)
-    assert np.all(np.diff(table["lambda_kwh_per_s"]) < 0)
+    assert np.all(np.diff(table["lambda_kwh_per_s"]) <= 0)  # runs moved at one price share a slope
     assert (table["energy_bound_kwh"] > 0).all()
     assert front.certificate in ("two-grid", "solver")
     files = list((cache / "fronts").glob("*.csv"))
