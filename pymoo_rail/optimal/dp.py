@@ -27,12 +27,9 @@ import numpy as np
 from numba import njit, prange
 
 from pymoo_rail.sim.kernel import (
-    _KIND_BRAKE,
-    _KIND_COAST,
-    _KIND_TRACTION,
-    _T_ELEC,
-    _T_TIME,
-    _T_TRAC,
+    KIND_BRAKE,
+    KIND_COAST,
+    KIND_TRACTION,
     MODE_BRAKE,
     MODE_COAST,
     MODE_HOLD,
@@ -40,12 +37,15 @@ from pymoo_rail.sim.kernel import (
     MODE_TOWARD,
     MODE_TRACTION,
     REGIME_COAST,
-    _full_step,
-    _landing_force,
+    TOTAL_ELECTRIC_BRAKE_J,
+    TOTAL_TIME,
+    TOTAL_TRACTION_J,
     clamp_to_envelope,
     complete_cell,
+    full_step,
     new_totals,
 )
+from pymoo_rail.sim.physics import landing_force
 
 INF = math.inf
 # Cost-to-go stored for a node from which the platform cannot be reached (e.g. too slow to clear a
@@ -91,7 +91,7 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
     also by partial braking where coasting would accelerate; ``toward`` pulls or coasts to its
     target and lands on it), then the simulator's ``clamp_to_envelope``.
     ``tr_*``, ``co_*``, ``br_*`` are the cell's full traction, coast and brake steps from ``v0``
-    (``_full_step``), computed once and shared by every control. Returns ``(u1, force_n, w0_n)``.
+    (``full_step``), computed once and shared by every control. Returns ``(u1, force_n, w0_n)``.
     """
     brake_to_hold = mode == MODE_HOLD_BRAKE
     if mode == MODE_HOLD or brake_to_hold:
@@ -108,7 +108,7 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
             u1, f, w0 = co_u, co_f, co_w
             landed = u1 < target * target or brake_to_hold
         if landed:
-            fl, w0l, ok = _landing_force(m, v0, target, cell)
+            fl, w0l, ok = landing_force(m, v0, target, cell)
             if ok:
                 u1, f, w0 = target * target, fl, w0l
             elif brake_to_hold and u1 >= target * target:  # too steep to hold: full braking
@@ -134,8 +134,8 @@ def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     v1, stopped, _, _, totals = complete_cell(m, new_totals(), cell, v0, u1, f, w0, REGIME_COAST)
     if stopped or v0 + v1 <= 0.0:  # (at rest in the last cell: it never arrives)
         return INF, INF
-    dt = totals[_T_TIME]
-    e = totals[_T_TRAC] / m.traction_efficiency - m.regen_efficiency * totals[_T_ELEC]
+    dt = totals[TOTAL_TIME]
+    e = totals[TOTAL_TRACTION_J] / m.traction_efficiency - m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J]
     return e + time_price_w * dt, dt
 
 
@@ -233,9 +233,9 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
     """
     top_u = m.envelope_ms[cell + 1] ** 2
     k_max = v_next.shape[0] - 1
-    tr_u, tr_f, tr_w, _ = _full_step(m, v0, cell, _KIND_TRACTION)
-    co_u, co_f, co_w, _ = _full_step(m, v0, cell, _KIND_COAST)
-    br_u, br_f, br_w, _ = _full_step(m, v0, cell, _KIND_BRAKE)
+    tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
+    co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
+    br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
     best = INF
     best_mode = MODE_COAST
     best_target = 0.0
@@ -280,8 +280,8 @@ def _count_targets(m, n_speeds, max_targets, bias, counts):
             if top1 <= 0.0:
                 continue
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
-            tr_u = _full_step(m, v0, i, _KIND_TRACTION)[0]
-            co_u = _full_step(m, v0, i, _KIND_COAST)[0]
+            tr_u = full_step(m, v0, i, KIND_TRACTION)[0]
+            co_u = full_step(m, v0, i, KIND_COAST)[0]
             k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
             counts[i * n_speeds + j] = _n_targets(k_lo, k_hi, max_targets)[0]
 
@@ -296,9 +296,9 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
         top1 = m.envelope_ms[i + 1] ** 2
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
-            tr_u, tr_f, tr_w, _ = _full_step(m, v0, i, _KIND_TRACTION)
-            co_u, co_f, co_w, _ = _full_step(m, v0, i, _KIND_COAST)
-            br_u, br_f, br_w, _ = _full_step(m, v0, i, _KIND_BRAKE)
+            tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
+            co_u, co_f, co_w, _ = full_step(m, v0, i, KIND_COAST)
+            br_u, br_f, br_w, _ = full_step(m, v0, i, KIND_BRAKE)
             for c in range(N_FIXED):
                 u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
@@ -401,9 +401,9 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time
-        tr_u, tr_f, tr_w, _ = _full_step(m, v, i, _KIND_TRACTION)
-        co_u, co_f, co_w, _ = _full_step(m, v, i, _KIND_COAST)
-        br_u, br_f, br_w, _ = _full_step(m, v, i, _KIND_BRAKE)
+        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
+        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
+        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
         if i > 0 and mode != previous and tie_j > 0.0:
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:

@@ -79,29 +79,30 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
              "brake_work_j", "davis_work_j", "line_work_j", "grade_work_j", "final_speed_ms", "reached",
              "electric_brake_work_j", "max_abs_accel_ms2", "neutral_traction_j")
 
-_KIND_TRACTION, _KIND_COAST, _KIND_BRAKE = 0, 1, 2
+# the three full-force steps of ``full_step`` (public for the DP)
+KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
 _J_PER_KWH = 3.6e6
 
 
 @njit(cache=True, inline="always")
-def _full_step(m, v0, cell, kind):
+def full_step(m, v0, cell, kind):
     """Two-stage step over one cell at maximum traction, coasting or maximum braking.
 
     Returns (u1, control force N (+ traction, - braking), W0 N, mean speed m/s).
     """
     wl = m.line_force_n[cell]
-    if kind == _KIND_TRACTION:
+    if kind == KIND_TRACTION:
         f = max_traction(m, v0, cell)
-    elif kind == _KIND_BRAKE:
+    elif kind == KIND_BRAKE:
         f = -max_braking(m, v0, cell)
     else:
         f = 0.0
     gain = m.dx_per_mass_m_kg  # dx / M: a multiplication instead of a division on the critical path
     u_half = v0 * v0 + (f - davis_force(m, v0) - wl) * gain
     v_half = math.sqrt(u_half) if u_half > 0.0 else 0.5 * v0
-    if kind == _KIND_TRACTION:
+    if kind == KIND_TRACTION:
         f = max_traction(m, v_half, cell)
-    elif kind == _KIND_BRAKE:
+    elif kind == KIND_BRAKE:
         f = -max_braking(m, v_half, cell)
     w0 = davis_force(m, v_half)
     u1 = v0 * v0 + 2.0 * ((f - w0 - wl) * gain)
@@ -121,10 +122,10 @@ def _decel_step(m, v0, cell, decel_ms2):
     w0 = davis_force(m, v_mid)
     f = -m.effective_mass_kg * decel_ms2 + w0 + m.line_force_n[cell]
     if f > 0.0:  # resistance and gradient alone decelerate more: coast
-        u1, f, w0, _ = _full_step(m, v0, cell, _KIND_COAST)
+        u1, f, w0, _ = full_step(m, v0, cell, KIND_COAST)
         return u1, f, w0, REGIME_COAST
     if -f > max_braking(m, v_mid, cell):  # more than the brakes give: brake fully
-        u1, f, w0, _ = _full_step(m, v0, cell, _KIND_BRAKE)
+        u1, f, w0, _ = full_step(m, v0, cell, KIND_BRAKE)
     return u1, f, w0, REGIME_BRAKE
 
 
@@ -139,15 +140,16 @@ def _share_above(v0, v1, v_cut):
     return (hi * hi - v_cut * v_cut) / (hi * hi - lo * lo)
 
 
-# the landing force lives with the braking envelope it must agree with (``physics``)
-_landing_force = landing_force
+# the landing force lives with the braking envelope it must agree with (``physics.landing_force``)
 
 
-# Slots of the running totals of a run (see ``new_totals``).
-_T_TIME, _T_TRAC, _T_BRAKE, _T_ELEC, _T_DAVIS, _T_LINE, _T_GRADE, _T_NEUTRAL = 0, 1, 2, 3, 4, 5, 6, 7
-_T_JERK, _T_PREV_ACC, _T_MAX_ACC, _T_PREV_REGIME, _T_CHANGES, _T_EXCESS = 8, 9, 10, 11, 12, 13
+# Slots of the running totals of a run (see ``new_totals``): public for the kernels that drive the
+# train themselves (the DP, the tracking controllers).
+TOTAL_TIME, TOTAL_TRACTION_J, TOTAL_BRAKE_J, TOTAL_ELECTRIC_BRAKE_J = 0, 1, 2, 3
+TOTAL_DAVIS_J, TOTAL_LINE_J, TOTAL_GRADE_J, TOTAL_NEUTRAL_TRACTION_J = 4, 5, 6, 7
+TOTAL_ACCEL_VARIATION, TOTAL_PREV_ACCEL, TOTAL_MAX_ABS_ACCEL = 8, 9, 10
+TOTAL_PREV_REGIME, TOTAL_REGIME_CHANGES, TOTAL_LIMIT_EXCESS = 11, 12, 13
 N_TOTALS = 14
-TOTAL_TIME = _T_TIME  # the clock, for kernels that drive the train themselves (control)
 
 
 @njit(cache=True)
@@ -169,13 +171,18 @@ def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     cap = m.envelope_ms[cell + 1]
     clamped = u1 > cap * cap
     if clamped:
-        fl, w0l, ok = _landing_force(m, v, cap, cell)
+        fl, w0l, ok = landing_force(m, v, cap, cell)
         if ok:
             u1, f, w0 = cap * cap, fl, w0l
         else:  # cannot brake hard enough by a rounding margin: brake fully, record the excess
-            u1, f, w0, _ = _full_step(m, v, cell, _KIND_BRAKE)
-        if f < 0.0 and cap < m.limit_ms[cell + 1] - 1e-9:
-            regime = REGIME_BRAKE
+            u1, f, w0, _ = full_step(m, v, cell, KIND_BRAKE)
+        if cap < m.limit_ms[cell + 1] - 1e-9:
+            # on a braking curve, not on a limit: the landing finishes the regime that reached it
+            # (partial traction at the top of a traction-then-braking run is still traction)
+            if f < 0.0:
+                regime = REGIME_BRAKE
+            elif f > 0.0 and regime != REGIME_TRACTION:
+                regime = REGIME_CRUISE
         elif f != 0.0:
             regime = REGIME_CRUISE
     if f == 0.0:
@@ -270,32 +277,32 @@ def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, 
 def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r):
     """Close a run (back to rest) and write its ``OUT_*`` summary."""
     length = m.position_m[m.position_m.shape[0] - 1]
-    jerk = totals[_T_JERK] + abs(totals[_T_PREV_ACC])
+    jerk = totals[TOTAL_ACCEL_VARIATION] + abs(totals[TOTAL_PREV_ACCEL])
     if record:
         tr_a[count - 1] = 0.0
         tr_f[count - 1] = 0.0
         tr_r[count - 1] = REGIME_BRAKE if reached else REGIME_COAST
-    t = totals[_T_TIME]
-    out[OUT_TRACTION_KWH] = totals[_T_TRAC] / m.traction_efficiency / _J_PER_KWH
-    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[_T_ELEC] / _J_PER_KWH
+    t = totals[TOTAL_TIME]
+    out[OUT_TRACTION_KWH] = totals[TOTAL_TRACTION_J] / m.traction_efficiency / _J_PER_KWH
+    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J] / _J_PER_KWH
     out[OUT_AUX_KWH] = m.aux_power_w * t / _J_PER_KWH
     out[OUT_NET_KWH] = out[OUT_TRACTION_KWH] + out[OUT_AUX_KWH] - out[OUT_REGEN_KWH]
     out[OUT_RUNNING_TIME_S] = t
     out[OUT_STOP_POSITION_M] = stop_pos
     out[OUT_STOP_ERROR_M] = abs(length - stop_pos)
     out[OUT_JERK_MS2] = jerk
-    out[OUT_REGIME_CHANGES] = totals[_T_CHANGES]
-    out[OUT_LIMIT_EXCESS_MS] = totals[_T_EXCESS] if totals[_T_EXCESS] > 0.0 else 0.0
-    out[OUT_TRACTION_WORK_J] = totals[_T_TRAC]
-    out[OUT_BRAKE_WORK_J] = totals[_T_BRAKE]
-    out[OUT_DAVIS_WORK_J] = totals[_T_DAVIS]
-    out[OUT_LINE_WORK_J] = totals[_T_LINE]
-    out[OUT_GRADE_WORK_J] = totals[_T_GRADE]
+    out[OUT_REGIME_CHANGES] = totals[TOTAL_REGIME_CHANGES]
+    out[OUT_LIMIT_EXCESS_MS] = totals[TOTAL_LIMIT_EXCESS] if totals[TOTAL_LIMIT_EXCESS] > 0.0 else 0.0
+    out[OUT_TRACTION_WORK_J] = totals[TOTAL_TRACTION_J]
+    out[OUT_BRAKE_WORK_J] = totals[TOTAL_BRAKE_J]
+    out[OUT_DAVIS_WORK_J] = totals[TOTAL_DAVIS_J]
+    out[OUT_LINE_WORK_J] = totals[TOTAL_LINE_J]
+    out[OUT_GRADE_WORK_J] = totals[TOTAL_GRADE_J]
     out[OUT_FINAL_SPEED_MS] = v
     out[OUT_REACHED] = 1.0 if reached else 0.0
-    out[OUT_ELECTRIC_BRAKE_WORK_J] = totals[_T_ELEC]
-    out[OUT_MAX_ABS_ACCEL_MS2] = totals[_T_MAX_ACC]
-    out[OUT_NEUTRAL_TRACTION_J] = totals[_T_NEUTRAL]
+    out[OUT_ELECTRIC_BRAKE_WORK_J] = totals[TOTAL_ELECTRIC_BRAKE_J]
+    out[OUT_MAX_ABS_ACCEL_MS2] = totals[TOTAL_MAX_ABS_ACCEL]
+    out[OUT_NEUTRAL_TRACTION_J] = totals[TOTAL_NEUTRAL_TRACTION_J]
 
 
 @njit(cache=True, inline="always")
@@ -327,31 +334,31 @@ def drive_cell(m, program, totals, i, v, row, hold_speed):
     if mode == MODE_TOWARD:
         landed = False
         if v < target:
-            u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
+            u1, f, w0, vm = full_step(m, v, i, KIND_TRACTION)
             regime = REGIME_TRACTION
             landed = u1 > target * target
         else:
-            u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
+            u1, f, w0, vm = full_step(m, v, i, KIND_COAST)
             regime = REGIME_COAST
             landed = u1 < target * target or brake_to_hold  # the second: brake down onto it
         if landed:
-            fl, w0l, ok = _landing_force(m, v, target, i)
+            fl, w0l, ok = landing_force(m, v, target, i)
             if ok:
                 u1, f, w0 = target * target, fl, w0l
                 regime = REGIME_CRUISE
             elif brake_to_hold and u1 >= target * target:
-                u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)  # the descent is too steep to hold
+                u1, f, w0, vm = full_step(m, v, i, KIND_BRAKE)  # the descent is too steep to hold
                 regime = REGIME_BRAKE
     elif mode == MODE_TRACTION:
-        u1, f, w0, vm = _full_step(m, v, i, _KIND_TRACTION)
+        u1, f, w0, vm = full_step(m, v, i, KIND_TRACTION)
         regime = REGIME_TRACTION
     elif mode == MODE_BRAKE:
-        u1, f, w0, vm = _full_step(m, v, i, _KIND_BRAKE)
+        u1, f, w0, vm = full_step(m, v, i, KIND_BRAKE)
         regime = REGIME_BRAKE
     elif mode == MODE_DECEL:
         u1, f, w0, regime = _decel_step(m, v, i, target)
     else:
-        u1, f, w0, vm = _full_step(m, v, i, _KIND_COAST)
+        u1, f, w0, vm = full_step(m, v, i, KIND_COAST)
         regime = REGIME_COAST
 
     u1, f, w0, regime, _ = clamp_to_envelope(m, v, i, u1, f, w0, regime)
@@ -383,7 +390,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
         v, row, hold_speed, stopped, x1, a_cell, f, regime, totals = drive_cell(
             m, program, totals, i, v, row, hold_speed)
         if record:
-            record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[_T_TIME], a_cell, f, regime)
+            record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[TOTAL_TIME], a_cell, f, regime)
         count = i + 2
         if stopped:
             reached = False
