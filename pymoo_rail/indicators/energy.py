@@ -48,6 +48,31 @@ def _reference_curve(reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t, e
 
 
+
+def gap_summary(table: pd.DataFrame) -> dict:
+    """Mean, largest and smallest relative gap of the points in range, and how many are out of range.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        One row per front point with the columns ``gap_rel`` and ``in_range`` (bool).
+
+    Returns
+    -------
+    dict
+        ``points`` (the table), ``mean_gap_rel``, ``max_gap_rel``, ``min_gap_rel`` (NaN when no
+        point is in range) and ``n_out_of_range``.
+    """
+    in_range = table["in_range"].to_numpy(dtype=bool)
+    stats = table.loc[in_range, "gap_rel"]
+    return {
+        "points": table,
+        "mean_gap_rel": float(stats.mean()) if len(stats) else float("nan"),
+        "max_gap_rel": float(stats.max()) if len(stats) else float("nan"),
+        "min_gap_rel": float(stats.min()) if len(stats) else float("nan"),
+        "n_out_of_range": int((~in_range).sum()),
+    }
+
 def energy_gap(front, reference, ref_point=None) -> dict:
     """Energy of each front point above the optimal front at its running time, and the HV ratio.
 
@@ -93,13 +118,8 @@ def energy_gap(front, reference, ref_point=None) -> dict:
     dense = np.column_stack([dense_t, np.interp(dense_t, t_ref, e_ref)])
     hv_reference = float(indicator(dense))
     hv = float(indicator(points))
-    stats = table.loc[in_range, "gap_rel"]
     return {
-        "points": table,
-        "mean_gap_rel": float(stats.mean()) if len(stats) else float("nan"),
-        "max_gap_rel": float(stats.max()) if len(stats) else float("nan"),
-        "min_gap_rel": float(stats.min()) if len(stats) else float("nan"),
-        "n_out_of_range": int((~in_range).sum()),
+        **gap_summary(table),
         "hv": hv,
         "hv_reference": hv_reference,
         "hv_ratio": hv / hv_reference if hv_reference > 0 else float("nan"),

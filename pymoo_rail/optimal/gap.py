@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from pymoo_rail.indicators.energy import ENERGY_COLUMN, TIME_COLUMN, as_front
+from pymoo_rail.indicators.energy import ENERGY_COLUMN, TIME_COLUMN, as_front, gap_summary
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.optimal.solver import OptimalSolver
 
@@ -97,12 +97,4 @@ def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> d
     table = pd.DataFrame({TIME_COLUMN: t, ENERGY_COLUMN: e, "optimal_kwh": optimal, "gap_kwh": gap,
                           "gap_rel": gap / optimal, "energy_bound_kwh": bound,
                           "below_reference": in_range & (gap < -bound), "in_range": in_range})
-    stats = table.loc[in_range, "gap_rel"]
-    return {
-        "points": table,
-        "mean_gap_rel": float(stats.mean()) if len(stats) else float("nan"),
-        "max_gap_rel": float(stats.max()) if len(stats) else float("nan"),
-        "min_gap_rel": float(stats.min()) if len(stats) else float("nan"),
-        "n_out_of_range": int((~in_range).sum()),
-        "n_below_reference": int(table["below_reference"].sum()),
-    }
+    return {**gap_summary(table), "n_below_reference": int(table["below_reference"].sum())}

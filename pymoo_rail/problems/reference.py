@@ -89,6 +89,21 @@ def front_key(case: Case, dx_m: float, n_times: int) -> str:
     return f"{case_hash(case)[:16]}-dx{dx_m:g}-n{n_times}-v{FRONT_VERSION}"
 
 
+def read_commented_csv(path: str | Path) -> tuple[dict[str, str], pd.DataFrame]:
+    """A CSV file whose leading ``# key: value`` lines describe it: (those fields, the table).
+
+    The format of the shipped and cached fronts (certified and best-known).
+    """
+    meta = {}
+    with open(path, encoding="utf-8") as handle:
+        for line in handle:
+            if not line.startswith("#"):
+                break
+            key, _, value = line[1:].partition(":")
+            meta[key.strip()] = value.strip()
+    return meta, pd.read_csv(path, comment="#")
+
+
 @dataclass(frozen=True)
 class CertifiedFront:
     """The certified energy / running-time front of one case.
@@ -180,14 +195,7 @@ class CertifiedFront:
     def read_csv(cls, path: str | Path) -> CertifiedFront:
         """Read a front written by :meth:`to_csv_text` (raises ValueError naming the file if malformed)."""
         path = Path(path)
-        meta = {}
-        with open(path, encoding="utf-8") as handle:
-            for line in handle:
-                if not line.startswith("#"):
-                    break
-                key, _, value = line[1:].partition(":")
-                meta[key.strip()] = value.strip()
-        table = pd.read_csv(path, comment="#")
+        meta, table = read_commented_csv(path)
         missing = [c for c in COLUMNS if c not in table.columns]
         needed = ("case_hash", "case_name", "planned_time_s", "dx_m", "certificate", "version")
         if missing or any(k not in meta for k in needed) or len(table) < 2:

@@ -80,14 +80,7 @@ def best_known_front(name: str = METRO_4OBJ) -> pd.DataFrame:
     if not path.is_file():
         raise FileNotFoundError(f"{name}: no best-known front shipped ({path.name}); "
                                 f"compute one with pymoo_rail.suite.compute_best_known_front({name!r})")
-    meta = {}
-    with open(path, encoding="utf-8") as handle:
-        for line in handle:
-            if not line.startswith("#"):
-                break
-            key, _, value = line[1:].partition(":")
-            meta[key.strip()] = value.strip()
-    table = pd.read_csv(path, comment="#")
+    meta, table = reference.read_commented_csv(path)
     table.attrs.update(meta)
     return table
 
