@@ -78,8 +78,8 @@ def test_bad_input():
         braking_programs(np.array([[500.0]]), ("traction",), np.array([-1.0]), 2000.0)
 
 
-@pytest.mark.slow
 def test_nsga2_front_has_a_live_stop_error_axis():
+    # the done-when of the four-objective form: stop error spans >= 0.1 m, every axis is live
     from pymoo.algorithms.moo.nsga2 import NSGA2
     from pymoo.optimize import minimize
 
