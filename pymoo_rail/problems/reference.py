@@ -41,7 +41,7 @@ from pymoo_rail import __version__
 from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.model import Case, case_to_dict
 
-FRONT_VERSION = "2"
+FRONT_VERSION = "3"
 """Version of the front computation; bump it when the solver or the node choice changes."""
 FRONT_SPAN = 1.3
 """Fronts cover running times from the minimum to ``FRONT_SPAN`` x the planned time."""
