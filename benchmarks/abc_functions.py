@@ -36,7 +36,6 @@ The functions are the study registry's ``sphere`` (seed eq. 3-6 on [-100, 100]),
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 import numpy as np
@@ -292,8 +291,9 @@ def main() -> None:
     workers = max(1, min(args.workers, 2))
     if not args.report_only:
         from pymoo_rail.experiments import run_study
+        from pymoo_rail.experiments.scripts import lower_priority
 
-        os.nice(max(0, 10 - os.nice(0)))  # be gentle on the shared 2-core machine
+        lower_priority()  # be gentle on the shared 2-core machine
         for (dim, iterations), study in build_studies(args.runs).items():
             # seed by seed: a study stopped early still compares every algorithm on the same seeds
             print(run_study(study, study_directory(args.work, dim, iterations), workers=workers,

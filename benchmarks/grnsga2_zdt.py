@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import os
 from pathlib import Path
 
 import numpy as np
@@ -474,10 +473,9 @@ def main(argv=None) -> None:
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
 
-    # share the machine politely: niceness at least 10 (not 10 more if run under `nice`)
-    current = os.nice(0)
-    if current < 10:
-        os.nice(10 - current)
+    from pymoo_rail.experiments.scripts import lower_priority
+
+    lower_priority()  # share the machine politely: niceness at least 10 (not 10 more under `nice`)
     problems = [p.strip() for p in args.problems.split(",") if p.strip()]
     algorithms = [a.strip() for a in args.algorithms.split(",") if a.strip()]
     for p in problems:

@@ -25,15 +25,15 @@ Writes ``benchmarks/reports/metro_controllers.md``, ``metro_controllers.csv`` an
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+
+from pymoo_rail.experiments.scripts import add_study_options, lower_priority
 
 REPORTS = ROOT / "benchmarks" / "reports"
 METRICS = {"control_error_rms_kmh": "tracking error rms km/h", "jerk_ms2": "jerk (sum of abs da) m/s^2",
@@ -71,13 +71,9 @@ def main(argv=None) -> None:
     parser.add_argument("--budget", type=int, default=400, help="DE evaluations per tuning run")
     parser.add_argument("--tuning-seeds", type=int, default=3)
     parser.add_argument("--test", type=int, default=20, help="held-out disturbed trains")
-    parser.add_argument("--work", type=Path, default=ROOT / "out" / "metro_controllers")
-    parser.add_argument("--out", type=Path, default=REPORTS)
-    parser.add_argument("--report-only", action="store_true")
+    add_study_options(parser, ROOT / "out" / "metro_controllers", REPORTS)
     args = parser.parse_args(argv)
-    current = os.nice(0)
-    if current < 10:
-        os.nice(10 - current)
+    lower_priority()
 
     import matplotlib
 

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 import warnings
 from dataclasses import replace
@@ -37,6 +36,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+
+from pymoo_rail.experiments.scripts import add_study_options, lower_priority
 
 REPORTS = ROOT / "benchmarks" / "reports"
 STUDIES = (ROOT / "examples" / "metro_table3.toml", ROOT / "examples" / "metro_weights.toml")
@@ -291,13 +292,9 @@ def write_report(out: Path, table3, weights) -> None:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", type=int, default=None, help="seeds per study (default: the study files')")
-    parser.add_argument("--work", type=Path, default=ROOT / "out" / "metro_table3")
-    parser.add_argument("--out", type=Path, default=REPORTS)
-    parser.add_argument("--report-only", action="store_true")
+    add_study_options(parser, ROOT / "out" / "metro_table3", REPORTS)
     args = parser.parse_args(argv)
-    current = os.nice(0)
-    if current < 10:
-        os.nice(10 - current)
+    lower_priority()
     from pymoo_rail.experiments import load_results, read_study, run_study
 
     results = []

@@ -37,7 +37,6 @@ the records. ``--report-only`` rewrites the report from them.
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 import numpy as np
@@ -213,10 +212,11 @@ def main() -> None:
     parser.add_argument("--report-only", action="store_true")
     args = parser.parse_args()
     from pymoo_rail.experiments import load_results, run_study
+    from pymoo_rail.experiments.scripts import lower_priority
 
     study = build_study(args.runs)
     if not args.report_only:
-        os.nice(max(0, 10 - os.nice(0)))  # be gentle on the shared 2-core machine
+        lower_priority()  # be gentle on the shared 2-core machine
         print(run_study(study, args.work, workers=max(1, min(args.workers, 2)), seed_major=True), flush=True)
     args.out.mkdir(parents=True, exist_ok=True)
     report(args.out, load_results(args.work, study=study))

@@ -16,7 +16,6 @@ Writes ``benchmarks/reports/yizhuang_loads.md``.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -26,6 +25,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+
+from pymoo_rail.experiments.scripts import add_study_options, lower_priority
 
 STUDY = ROOT / "examples" / "yizhuang_loads.toml"
 REPORTS = ROOT / "benchmarks" / "reports"
@@ -79,13 +80,9 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", type=int, default=None, help="seeds (default: the study file's)")
     parser.add_argument("--workers", type=int, default=1)
-    parser.add_argument("--work", type=Path, default=ROOT / "out" / "yizhuang_loads")
-    parser.add_argument("--out", type=Path, default=REPORTS)
-    parser.add_argument("--report-only", action="store_true")
+    add_study_options(parser, ROOT / "out" / "yizhuang_loads", REPORTS)
     args = parser.parse_args(argv)
-    current = os.nice(0)
-    if current < 10:
-        os.nice(10 - current)
+    lower_priority()
     from pymoo_rail.experiments import load_results, read_study, run_study
 
     study = read_study(STUDY)
