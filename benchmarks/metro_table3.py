@@ -116,6 +116,7 @@ def write_report(out: Path, table3, weights) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import save_figure
 
     from pymoo_rail.cases import load_case
     from pymoo_rail.experiments import read_study
@@ -272,7 +273,7 @@ def write_report(out: Path, table3, weights) -> None:
         ax.grid(True, alpha=0.3)
     axes[0].legend(fontsize="small")
     fig.tight_layout()
-    fig.savefig(out / "metro_table3.png", dpi=120)
+    save_figure(fig, out / "metro_table3.png", dpi=120)
     L += ["![distance-speed and time-speed](metro_table3.png)", ""]
     (out / "metro_table3.md").write_text("\n".join(L) + "\n")
 

@@ -31,6 +31,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from pymoo_rail.plotting import save_figure  # noqa: E402
 import numpy as np  # noqa: E402
 from pymoo.algorithms.soo.nonconvex.de import DE  # noqa: E402
 from pymoo.optimize import minimize  # noqa: E402
@@ -150,8 +151,7 @@ def main() -> None:
         ax_x.set_title(f"{case.name}, {curve}: control period {period:g} s")
         ax_x.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out_dir / f"{stem}.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, out_dir / f"{stem}.png", dpi=100)
 
     # ---- report
     lines = [f"# PID and adaptive fuzzy PID tracking on {case.name} (seed 002, sections 3.4-3.5)", "",

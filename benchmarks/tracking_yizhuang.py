@@ -29,6 +29,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from pymoo_rail.plotting import save_figure  # noqa: E402
 import numpy as np  # noqa: E402
 from pymoo.algorithms.soo.nonconvex.de import DE  # noqa: E402
 from pymoo.optimize import minimize  # noqa: E402
@@ -136,8 +137,7 @@ def main() -> None:
     axes[0, 0].legend(loc="lower center", fontsize=8)
     fig.suptitle("yizhuang: hysteresis tracking of the DE-tracked recommended curve (cf. seed 000 fig. 5-8)")
     fig.tight_layout()
-    fig.savefig(out_dir / "tracking_yizhuang_profiles.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out_dir / "tracking_yizhuang_profiles.png", dpi=110)
 
     fig, (ax_e, ax_t) = plt.subplots(1, 2, figsize=(11, 4))
     for name in references:
@@ -155,8 +155,7 @@ def main() -> None:
     ax_e.grid(alpha=0.3)
     ax_t.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out_dir / "tracking_yizhuang_table.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out_dir / "tracking_yizhuang_table.png", dpi=110)
 
     # ---- report
     lines = ["# Hysteresis tracking on yizhuang (seed 000, table 5-7)", "",

@@ -99,3 +99,36 @@ def test_the_checks_catch_a_violation(tmp_path, rule):
     found = list(_imports(bad))
     assert ("pymoo_rail.cli", ["main"]) == found[0][1:]
     assert ("pymoo_rail.sim.kernel", ["_x"]) == found[1][1:]
+
+
+def _unit_factor_uses(path: Path) -> list[str]:
+    """Places that define or spell out a unit factor instead of importing it from ``pymoo_rail.constants``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            for t in targets:
+                if isinstance(t, ast.Name) and any(k in t.id for k in ("KMH_PER_MS", "J_PER_KWH", "MS_TO_KMH")):
+                    found.append(f"{path.name}:{node.lineno} defines {t.id}")
+        elif isinstance(node, ast.Constant) and type(node.value) is float and node.value == 3.6e6:
+            found.append(f"{path.name}:{node.lineno} spells out 3.6e6 (J_PER_KWH)")
+        elif isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Mult, ast.Div)):
+            for side in (node.left, node.right):
+                if isinstance(side, ast.Constant) and side.value == 3.6:
+                    other = ast.unparse(node.right if side is node.left else node.left)
+                    if isinstance(node.op, ast.Div) and side is node.right or "_ms" in other or "speed" in other:
+                        found.append(f"{path.name}:{node.lineno} spells out 3.6 (KMH_PER_MS) in {ast.unparse(node)}")
+    return found
+
+
+def test_unit_factors_are_defined_once():
+    wrong = [w for p in _sources() if p != PACKAGE / "constants.py" for w in _unit_factor_uses(p)]
+    assert not wrong, "use pymoo_rail.constants:\n" + "\n".join(wrong)
+
+
+def test_the_unit_factor_check_catches_a_copy(tmp_path):
+    bad = tmp_path / "bad.py"
+    bad.write_text("J_PER_KWH = 3.6e6\nv_kmh = speed_ms * 3.6\nv_ms = 80 / 3.6\nfigsize = (4.6, 3.6 * 2)\n")
+    found = _unit_factor_uses(bad)
+    assert len(found) == 4 and "figsize" not in " ".join(found)  # define + 3.6e6 + two spelled-out 3.6

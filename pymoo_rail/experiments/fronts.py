@@ -100,9 +100,44 @@ def choose_member(F: np.ndarray, CV: np.ndarray, running_time_s: np.ndarray, ene
         candidates = np.array([int(np.argmin(CV))])
     if F.shape[1] == 1:
         return int(candidates[np.argmin(F[candidates, 0])])
+    punctual = punctual_member(running_time_s[candidates], energy_kwh[candidates], planned_time_s, window_s)
+    if punctual is not None:
+        return int(candidates[punctual])
     error = np.abs(running_time_s[candidates] - planned_time_s)
-    punctual = candidates[error <= window_s]
-    if len(punctual):
-        return int(punctual[np.argmin(energy_kwh[punctual])])
     order = np.lexsort((energy_kwh[candidates], error))
     return int(candidates[order[0]])
+
+
+def punctual_member(running_time_s: np.ndarray, energy_kwh: np.ndarray, planned_time_s: float, window_s: float,
+                    CV: np.ndarray | None = None) -> int | None:
+    """Index of the least-energy feasible member within ``window_s`` of the planned time, if any.
+
+    The rule :func:`choose_member` applies first; studies that report "no punctual member" instead
+    of a fallback (a run whose front misses the window) call it directly.
+
+    Parameters
+    ----------
+    running_time_s, energy_kwh : array (n,)
+        Running times (s) and net energies (kWh) of the members.
+    planned_time_s : float
+        The planned running time (s).
+    window_s : float
+        How far from the planned time a member may run (s), inclusive.
+    CV : array (n,), optional
+        Constraint violations; members with ``CV > 0`` are never chosen (default: all feasible).
+
+    Returns
+    -------
+    int or None
+        Index of the chosen member (ties: the first), or ``None`` when no feasible member is
+        within the window.
+    """
+    running_time_s = np.asarray(running_time_s, dtype=float).reshape(-1)
+    energy_kwh = np.asarray(energy_kwh, dtype=float).reshape(-1)
+    within = np.abs(running_time_s - planned_time_s) <= window_s
+    if CV is not None:
+        within &= np.asarray(CV, dtype=float).reshape(-1) <= 0
+    if not within.any():
+        return None
+    candidates = np.flatnonzero(within)
+    return int(candidates[np.argmin(energy_kwh[candidates])])

@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, Line
 from pymoo_rail.sim import (
     Simulator,
@@ -39,7 +40,6 @@ from pymoo_rail.sim import (
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.pacing import split_long_sections
 
-KMH_PER_MS = 3.6
 PARTITIONS = ("gradient_limit", "equal")
 # Long sparse lines: a gradient/limit partition whose sections average more than this is cut into
 # sections of at most SPARSE_MAX_SECTION_M unless max_section_m is given (the 48.5 km TTOBench

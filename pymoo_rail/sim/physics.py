@@ -150,18 +150,6 @@ def electric_braking_capped(m, v, brake_n):
     return f
 
 
-@njit(cache=True, inline="always")
-def electric_braking(m, v, brake_n):
-    """The part of a braking force the motors take (and regenerate) at speed v; the rest is friction.
-
-    Zero below the regen cut-off speed. (The simulator credits the share of a cell run above the
-    cut-off instead, so that results do not jump with the grid.)
-    """
-    if v < m.regen_min_speed_ms:
-        return 0.0
-    return electric_braking_capped(m, v, brake_n)
-
-
 # Relative tolerance of a landing: the force it needs may exceed what the train has by this much
 # (rounding of the force-speed curves); the braking envelope itself is built with none.
 LANDING_RTOL = 1e-8
