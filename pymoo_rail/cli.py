@@ -90,6 +90,7 @@ def _seed(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``pymoo-rail`` command with all its subcommands."""
     parser = argparse.ArgumentParser(
         prog="pymoo-rail",
         description="Energy-efficient train driving with pymoo: optimise recommended speed profiles of "
@@ -322,6 +323,7 @@ def _count(n: int, noun: str) -> str:
 
 
 def cmd_cases(args) -> int:
+    """``pymoo-rail cases``: list the built-in cases, or describe one; returns the exit code."""
     from pymoo_rail.cases import list_cases, load_case
 
     if args.case is None:
@@ -430,6 +432,7 @@ def _case_from_args(args):
 
 
 def cmd_journey(args) -> int:
+    """``pymoo-rail journey``: solve a multi-stop journey with timing points; returns the exit code."""
     from pymoo_rail.journeys.timing import (read_timing_points, solve_timed_journey, timed_journey_from_toml,
                                             timed_journey_from_ttobench)
     from pymoo_rail.plotting.journey import plot_timed_run
@@ -459,6 +462,9 @@ def cmd_journey(args) -> int:
 
 
 def cmd_optimize(args) -> int:
+    """``pymoo-rail optimize``: run one algorithm on one case and write the front, the chosen run and figures;
+    returns the exit code.
+    """
     import numpy as np
     import pandas as pd
     from pymoo.optimize import minimize
@@ -639,6 +645,7 @@ def _default_times(t_min: float, planned_time_s: float, n_points: int):
 
 
 def cmd_reference(args) -> int:
+    """``pymoo-rail reference``: the exact optimal front and profile of a case; returns the exit code."""
     case = _case_from_args(args)
     try:
         from pymoo_rail.optimal import optimal_front, optimal_profile
@@ -689,6 +696,7 @@ def cmd_reference(args) -> int:
 
 
 def cmd_timetable(args) -> int:
+    """``pymoo-rail timetable``: optimise the departure times of a line's trains; returns the exit code."""
     import numpy as np
     import pandas as pd
     from pymoo.algorithms.moo.nsga2 import NSGA2
@@ -744,6 +752,7 @@ def _study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool
 
 
 def cmd_study(args) -> int:
+    """``pymoo-rail study``: run (or resume) a study file and write its tables; returns the exit code."""
     from pymoo_rail.experiments import read_study, run_study
     from pymoo_rail.experiments.spec import StudyError
 
@@ -772,6 +781,7 @@ def cmd_study(args) -> int:
 
 
 def cmd_plot(args, parser: argparse.ArgumentParser) -> int:
+    """``pymoo-rail plot``: draw a front or a trajectory from the files ``optimize`` wrote; returns the exit code."""
     import pandas as pd
 
     from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
@@ -841,6 +851,7 @@ def _objective_of_column(column: str) -> str:
 
 
 def cmd_warmup(args) -> int:
+    """``pymoo-rail warmup``: compile the Numba kernels ahead of the first run; returns the exit code."""
     from pymoo_rail.warmup import WARMUP_PARTS, warmup
 
     parts = WARMUP_PARTS if args.all else ("simulator",)
@@ -862,6 +873,7 @@ def _add_suite_parser(sub) -> None:
 
 
 def cmd_suite(args) -> int:
+    """``pymoo-rail suite``: list, describe or verify the benchmark suite's problems; returns the exit code."""
     from pymoo_rail.problems.reference import find_front
     from pymoo_rail.suite import CASES, list_problems, suite_case, verify
     from pymoo_rail.suite.problems import split

@@ -73,6 +73,9 @@ def normalised_hv(F: np.ndarray, ideal: np.ndarray, nadir: np.ndarray) -> float:
 
 
 def gd_van_veldhuizen(F: np.ndarray, pf: np.ndarray) -> float:
+    """Van Veldhuizen's generational distance ``sqrt(sum d_i^2) / n`` of ``F`` to the front ``pf`` (raw units; Tang
+    et al. (2020) eq. 13).
+    """
     from scipy.spatial.distance import cdist
 
     d = cdist(F, pf).min(axis=1)

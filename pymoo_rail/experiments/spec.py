@@ -188,10 +188,12 @@ class Budget:
         return (self.kind, self.value)
 
     def to_dict(self) -> dict:
+        """The budget as a study file writes it: ``{kind: value}``."""
         return {self.kind: self.value}
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str | None = None) -> Budget:
+        """The budget of a study file's ``{kind: value}`` table; :class:`StudyError` naming the field otherwise."""
         if not isinstance(data, Mapping) or len(data) != 1:
             raise StudyError("budget", data, f"must be a table with exactly one of {', '.join(BUDGET_KINDS)}", source)
         (kind, value), = data.items()
@@ -222,6 +224,7 @@ class RunSpec:
         return hashlib.sha256(canonical_json(self.identity()).encode()).hexdigest()[:16]
 
     def describe(self) -> str:
+        """``problem / algorithm / seed``, for progress lines and messages."""
         return f"{self.problem.display} / {self.algorithm.display} / seed {self.seed}"
 
 
@@ -316,6 +319,7 @@ class Study:
                 for p in self.problems for a in self.algorithms for s in self.seeds]
 
     def to_dict(self) -> dict:
+        """The study as plain data (what ``write_study`` stores as TOML)."""
         out: dict[str, Any] = {"name": self.name, "seeds": list(self.seeds), "budget": self.budget.to_dict(),
                                "history": self.history}
         if self.baseline is not None:
@@ -326,6 +330,7 @@ class Study:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: str | None = None) -> Study:
+        """A study from plain data (a study file's tables); :class:`StudyError` naming the field of a bad entry."""
         allowed = {"name", "seeds", "budget", "history", "baseline", "problems", "algorithms"}
         if not isinstance(data, Mapping):
             raise StudyError("study", data, "must be a table", source)

@@ -153,6 +153,7 @@ class OptimalSolver:
 
     @property
     def dx_m(self) -> float:
+        """Step of the distance grid (m)."""
         return self.simulator.grid.dx_m
 
     def min_running_time_s(self) -> float:

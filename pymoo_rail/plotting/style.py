@@ -29,18 +29,21 @@ NEUTRAL_COLOR = "gold"
 
 
 def objective_label(name: str | None, index: int) -> str:
+    """Axis label with unit of objective ``name`` (``f1``, ``f2`` ... when unnamed)."""
     if name is None:
         return f"f{index + 1}"
     return OBJECTIVE_LABELS.get(name, name)
 
 
 def objective_labels(names: Sequence[str] | None, n_obj: int) -> list[str]:
+    """Axis labels of ``n_obj`` objectives; ``ValueError`` when ``names`` has another length."""
     if names is not None and len(names) != n_obj:
         raise ValueError(f"objectives = {list(names)!r}: the front has {n_obj} objectives")
     return [objective_label(None if names is None else names[i], i) for i in range(n_obj)]
 
 
 def indicator_label(name: str) -> str:
+    """Axis label of an indicator (its name when unknown)."""
     return INDICATOR_LABELS.get(name, name)
 
 

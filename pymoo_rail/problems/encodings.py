@@ -106,9 +106,11 @@ class SpeedCodes:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (one speed code per section)."""
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of the speed codes ``X`` (km/h, one row per decision vector)."""
         X = np.asarray(X, dtype=float)
         negative = np.argwhere(X < 0)
         if negative.size:  # reported in km/h, the unit it was given in
@@ -140,6 +142,7 @@ class SwitchingPoints:
 
     @classmethod
     def build(cls, case: Case, regimes: tuple[str, ...] | None = None) -> SwitchingPoints:
+        """The switching-point encoding of ``case`` (default: a traction-hold-coast cycle per limit zone, then brake)."""
         if regimes is None:
             zones = 1
             limits = [row[2] for row in case.line.speed_limits]
@@ -156,12 +159,15 @@ class SwitchingPoints:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (one switching point per regime change)."""
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of the switching points ``X`` (m, one row per decision vector)."""
         return switching_programs(X, self.regimes, self.length_m)
 
     def fixed(self) -> np.ndarray:
+        """Mask of the genes an algorithm must not change (none)."""
         return np.zeros(self.n_var, dtype=bool)
 
 
@@ -239,13 +245,16 @@ class BrakingOnset:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (switching points, braking onset, deceleration)."""
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of ``X`` (switching points and braking onset in m, deceleration last)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         return braking_programs(X[:, :-1], self.regimes, X[:, -1], self.simulator.length_m)
 
     def fixed(self) -> np.ndarray:
+        """Mask of the genes an algorithm must not change (none)."""
         return np.zeros(self.n_var, dtype=bool)
 
     def run_batch(self, programs: np.ndarray) -> np.ndarray:

@@ -317,6 +317,7 @@ class KinematicPhasesProblem(Problem):
         out["energy_index_kwh"] = runs.energy_index_kwh
 
     def describe(self) -> str:
+        """One line naming the case, the form, the coding and the objectives."""
         form = "weighted sum" if self.weights is not None else "Pareto"
         coding = f"{self.n_bits}-bit binary" if self.binary else "real"
         return (f"KinematicPhasesProblem({self.case.name}, {form}: {', '.join(self.objectives)}; "

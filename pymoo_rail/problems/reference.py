@@ -136,6 +136,7 @@ class CertifiedFront:
 
     @property
     def time_range_s(self) -> tuple[float, float]:
+        """Shortest and longest running time of the front's nodes (s)."""
         t = self.table["running_time_s"].to_numpy()
         return float(t[0]), float(t[-1])
 
@@ -187,6 +188,7 @@ class CertifiedFront:
 
     # ------------------------------------------------------------------ file format
     def to_csv_text(self) -> str:
+        """The front as a commented CSV (the format of the shipped and cached fronts)."""
         header = [f"# case_hash: {self.case_hash}", f"# case_name: {self.case_name}",
                   f"# planned_time_s: {self.planned_time_s!r}", f"# dx_m: {self.dx_m!r}",
                   f"# certificate: {self.certificate}", f"# version: {self.version}",

@@ -367,6 +367,7 @@ class SpeedProfileProblem(Problem):
         return self.encoding if isinstance(self.encoding, BrakingOnset) else self.simulator
 
     def describe(self) -> str:
+        """One line naming the case, the form, the encoding and the objectives."""
         form = "weighted sum" if self.weights is not None else (
             "constrained single-objective" if len(self.objectives) == 1 else "Pareto")
         return (f"SpeedProfileProblem({self.case.name}, {form}: {', '.join(self.objectives)}; "

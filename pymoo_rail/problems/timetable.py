@@ -120,6 +120,7 @@ class TimetableProblem(Problem):
 
     @property
     def period_s(self) -> float:
+        """Period of the timetable: trains x headway (s)."""
         return self.n_trains * self.headway_s
 
     def departures_s(self, X: np.ndarray) -> np.ndarray:
@@ -184,6 +185,7 @@ class TimetableProblem(Problem):
             out[key] = sim[key]
 
     def describe(self) -> str:
+        """One line naming the case, the trains, the headway and the legs."""
         return (f"TimetableProblem({self.case.name}: {self.n_trains} trains every {self.headway_s:g} s "
                 f"+- {self.window_s:g} s, {len(self.legs)} legs, {self.n_var} variables, objectives "
                 f"{', '.join(self.objectives)})")

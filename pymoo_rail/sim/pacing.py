@@ -77,6 +77,7 @@ class PacedSpeedCodes:
 
     @property
     def n_var(self) -> int:
+        """Number of shape variables (one per section)."""
         return self.limits_ms.shape[0]
 
     def programs(self, shapes: np.ndarray, pace: np.ndarray) -> np.ndarray:
@@ -98,6 +99,7 @@ class PacedRuns:
 
     @property
     def running_time_s(self) -> np.ndarray:
+        """Running time of each run (s)."""
         return self.summaries[:, OUT_RUNNING_TIME_S]
 
 

@@ -67,6 +67,7 @@ def verify(names=None, progress: bool = True) -> pd.DataFrame:
 
 
 def best_known_path(name: str = METRO_4OBJ) -> Path:
+    """The file of the shipped best-known front of suite problem ``name``."""
     return FRONTS_DIR / f"{name}-best-known-v{BEST_KNOWN_VERSION}.csv"
 
 
