@@ -188,19 +188,12 @@ def variant_cases(case) -> dict:
 
 
 def _best_of(problem, seeds=(1, 2, 3, 4, 5)):
-    from pymoo.optimize import minimize
-
+    """(x, trajectory) of the best ABC run over ``seeds`` (``experiments.best_of_seeds``), or None."""
     from pymoo_rail.algorithms import ABC
+    from pymoo_rail.experiments import best_of_seeds
 
-    best = None
-    for seed in seeds:
-        res = minimize(problem, ABC(pop_size=POP, limit=LIMIT), ("n_gen", N_GEN), seed=seed)
-        if res.X is None or res.CV[0] > 0:
-            continue
-        tr = problem.trajectory(res.X)
-        if best is None or tr.energy.net_kwh < best[1].energy.net_kwh:
-            best = (res.X, tr)
-    return best
+    res = best_of_seeds(problem, lambda: ABC(pop_size=POP, limit=LIMIT), ("n_gen", N_GEN), seeds)
+    return None if res is None else (res.X, problem.trajectory(res.X))
 
 
 def energy_level(case, x_best, tolerance_s: float, reopt_seeds=(1, 2, 3, 4, 5)) -> list[dict]:

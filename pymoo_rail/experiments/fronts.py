@@ -141,3 +141,38 @@ def punctual_member(running_time_s: np.ndarray, energy_kwh: np.ndarray, planned_
         return None
     candidates = np.flatnonzero(within)
     return int(candidates[np.argmin(energy_kwh[candidates])])
+
+
+def best_of_seeds(problem, make_algorithm, termination, seeds):
+    """The best feasible single-objective result of one algorithm over several seeds.
+
+    What a study script does to get one good reference run (e.g. the best of 3 DE runs as the
+    profile a controller then tracks).
+
+    Parameters
+    ----------
+    problem : pymoo Problem
+        A single-objective problem.
+    make_algorithm : callable
+        ``make_algorithm()`` returns a fresh algorithm for each seed.
+    termination : tuple or pymoo Termination
+        As for ``pymoo.optimize.minimize``, e.g. ``("n_gen", 200)``.
+    seeds : iterable of int
+        The seeds, in order.
+
+    Returns
+    -------
+    pymoo.core.result.Result or None
+        The result with the lowest ``F[0]`` among those whose best point is feasible (ties: the
+        first seed), or ``None`` when no seed found a feasible point.
+    """
+    from pymoo.optimize import minimize
+
+    best = None
+    for seed in seeds:
+        res = minimize(problem, make_algorithm(), termination, seed=seed)
+        if res.X is None or np.asarray(res.CV, dtype=float).reshape(-1)[0] > 0:
+            continue
+        if best is None or float(res.F[0]) < float(best.F[0]):
+            best = res
+    return best

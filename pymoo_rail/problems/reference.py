@@ -417,8 +417,7 @@ def exact_points(case: Case, running_times_s: Sequence[float], path: str | Path,
 
     path = Path(path)
     n_speeds = DEFAULT_N_SPEEDS if n_speeds is None else int(n_speeds)
-    # round_trip: a cached float reads back to the same bits it was written from
-    rows = pd.read_csv(path, float_precision="round_trip").to_dict("records") if path.exists() else []
+    rows = pd.read_csv(path).to_dict("records") if path.exists() else []
     rows = [r for r in rows if int(r.get("n_speeds", -1)) == n_speeds]
     done = {float(r["requested_time_s"]) for r in rows} - {float(t) for t in redo_s}
     solver, guess = None, None
