@@ -282,9 +282,8 @@ def main() -> None:
     from pymoo_rail.experiments.scripts import add_study_options
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--runs", type=int, default=30)
-    parser.add_argument("--workers", type=int, default=2, help="process pool size (at most 2)")
-    add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "abc_functions", Path(__file__).parent / "reports")
+    add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "abc_functions", Path(__file__).parent / "reports",
+                      runs=30, workers=True)
     args = parser.parse_args()
     workers = max(1, min(args.workers, 2))
     if not args.report_only:

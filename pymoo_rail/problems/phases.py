@@ -44,7 +44,7 @@ from pymoo.core.problem import Problem
 
 from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case
-from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning, canonical_objective
+from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning, canonical_objective, weighted_sum_settings
 
 PHASE_NAMES = ("traction", "cruise", "coast", "brake")
 PHASE_OBJECTIVES = ("energy", "accel_variation", "stop_error", "time_error")  # "jerk": alias of accel_variation
@@ -231,19 +231,10 @@ class KinematicPhasesProblem(Problem):
         v_top = self.limits[:, 2].max() / KMH_PER_MS
         self.weights = self.scales = None
         if weights is not None:
-            w = np.asarray(weights, dtype=float)
-            if w.shape != (len(objectives),) or not np.all(np.isfinite(w)) or np.any(w < 0):
-                raise ValueError(f"weights = {list(w)!r}: need {len(objectives)} finite values >= 0, "
-                                 f"one per objective {objectives}")
-            if scales is None:
-                default = {"energy": self.mass_kg * 0.5 * v_top ** 2 / J_PER_KWH,
-                           "accel_variation": sum(abs(np.diff([0.0, *a, 0.0]))),
-                           "stop_error": 0.25, "time_error": 0.05 * case.planned_time_s}
-                scales = [default[key] for key in self._keys]
-            sc = np.asarray(scales, dtype=float)
-            if sc.shape != w.shape or not np.all(sc > 0):
-                raise ValueError(f"scales = {list(sc)!r}: need {len(objectives)} positive values")
-            self.weights, self.scales = w, sc
+            default = {"energy": self.mass_kg * 0.5 * v_top ** 2 / J_PER_KWH,
+                       "accel_variation": sum(abs(np.diff([0.0, *a, 0.0]))),
+                       "stop_error": 0.25, "time_error": 0.05 * case.planned_time_s}
+            self.weights, self.scales = weighted_sum_settings(weights, scales, objectives, default)
         if "accel_variation" in self._keys and self.min_phase_s > 0:
             warnings.warn(f"objective {objectives[self._keys.index('accel_variation')]} (comfort, sum |a_i - a_(i-1)|) "
                           "is constant in the kinematic phase model: with fixed accelerations and "
