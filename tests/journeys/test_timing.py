@@ -171,3 +171,41 @@ def test_toml_journey_reads_like_the_ttobench_file(tmp_path):
     with pytest.raises(CaseError, match="unknown key") as err:
         timed_journey_from_toml(path)
     assert err.value.field == "timing_points[6].when"
+
+
+def _min_speed_journey(min_kmh):
+    # Yizhuang stops 9 -> 10; the free optimum passes 17557 m (1800 m into the section) coasting
+    # at about 47 km/h, so a minimum speed of 60 km/h there binds
+    return timed(_yizhuang_journey([[15757, 0, 0, 0, 0], [17557, None, None, min_kmh, None],
+                                    [18022, 160, 170, 0, 0]]), YIZHUANG, BEIJING)
+
+
+def test_the_exact_solve_enforces_a_binding_minimum_speed():
+    free = solve_timed_journey(_min_speed_journey(None), dx_m=5.0)
+    v_free = float(np.interp(1800.0, free.trajectories[0].position_m, free.trajectories[0].speed_ms)) * 3.6
+    assert v_free < 55.0  # the bound below binds
+    run = solve_timed_journey(_min_speed_journey(60.0), dx_m=5.0)
+    traj = run.trajectories[0]
+    v = float(np.interp(1800.0, traj.position_m, traj.speed_ms)) * 3.6
+    assert 60.0 <= v < 62.0  # held, by at most a speed node more than asked
+    assert run.all_met and traj.running_time_s == pytest.approx(170.0, abs=0.5)
+    assert run.energy_kwh > free.energy_kwh  # the bound costs energy
+    assert np.all(traj.speed_ms * 3.6 <= 80.0 + 1e-6) and traj.speed_ms[-1] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_minimum_speed_above_the_speed_limit_is_refused_naming_the_point():
+    with pytest.raises(TimingError, match="minimum speed 85 km/h.*limit of 80 km/h") as err:
+        solve_timed_journey(_min_speed_journey(85.0), dx_m=5.0)
+    assert err.value.field == "timing point at 17557 m"
+
+
+def test_the_problem_form_makes_a_run_below_a_minimum_speed_infeasible():
+    from pymoo_rail.journeys.timed_problem import TimedSectionProblem
+
+    problem = TimedSectionProblem(_min_speed_journey(60.0), 0)
+    column = problem.n_ieq_constr - 3  # min speed, then the arrival window's latest and earliest
+    slow = np.full(problem.n_var, 30.0)  # speed codes: 30 km/h all the way
+    fast = problem.xu.copy()  # flat out: above 60 km/h at 1800 m
+    G = problem.evaluate(np.vstack([slow, fast]), return_values_of=["G"])
+    assert G[0, column] == pytest.approx(30.0, abs=0.5)  # 60 km/h asked, 30 km/h run
+    assert G[1, column] < 0.0
