@@ -122,13 +122,27 @@ def test_a_binding_passing_window_gets_its_own_price_and_is_met():
     assert run.energy_kwh > free_run.energy_kwh  # the window costs energy
 
 
+def test_no_reading_of_the_public_journey_makes_its_last_stretch_reachable():
+    # TTOBench's journey README: times are measured from the start of the journey (s, cumulative),
+    # positions are track coordinates in the track's direction. Read the other way round (positions
+    # from Wil), the last 9556.1 m are the first 9556.1 m of the track run backwards: still too long.
+    assert _limit_time_s(20000.0, 29556.1) == pytest.approx(345.4, abs=0.1)
+    assert _limit_time_s(0.0, 29556.1 - 20000.0) > 250.0
+    # at the head or the tail of a train: the deficit is 95 s, about 2.8 km at 105 km/h
+    assert (_limit_time_s(20000.0, 29556.1) - 250.0) * 105 / 3.6 > 2700.0
+
+
 @pytest.mark.slow
-def test_stgallen_wil_with_a_reachable_window_at_20000_m_is_solved_within_every_window():
+def test_stgallen_wil_as_first_published_is_solved_within_every_window():
+    # TTOBench commit b33a3ff published the journey ending at 25000 m; the review commit 7d62ff9
+    # moved the arrival to the track's end (29556.1 m) and kept its window 1400-1450 s, which made
+    # the last stretch unreachable. With the arrival at 25000 m every window is met (14 s CPU).
     data = json.loads(JOURNEY.read_text())
-    data["timing points"]["values"][4][1:3] = [1040, 1100]  # the public 1200-1250 s cannot be met
+    data["timing points"]["values"][-1][0] = 25000
     run = solve_timed_journey(timed(data))
     assert run.all_met
     assert [c["time_ok"] and c["speed_ok"] for c in run.checks] == [True] * 6
+    assert run.departures_s == (0.0, 800.0)
     for traj in run.trajectories:
         assert traj.reached and traj.speed_ms[-1] == pytest.approx(0.0, abs=1e-9)
 
