@@ -155,8 +155,7 @@ def timed_journey_from_ttobench(journey_path: ttobench.Source, track_path: ttobe
         if k > 0:
             arrival = merged[k - 1][-1]
             dwell.append(max(0.0, window_start_s(group[0]) - window_end_s(arrival)))
-    journey = Journey(name=journey_id, sections=tuple(sections), dwell_s=tuple(dwell),
-                      stops_m=tuple(stops), source=sections[0].source)
+    journey = Journey.from_sections(journey_id, sections, dwell, stops, source=sections[0].source)
     return TimedJourney(journey=journey, windows=tuple(tuple(g) for g in merged))
 
 
