@@ -1,11 +1,14 @@
 """NSGA2 against the exact optimum on TTOBench's long sparse lines: the default speed-code encoding
 (coasting points where sections average more than 5 km) against 1 km pieces.
 
-Usage: python benchmarks/sparse_encoding.py [--gen 200] [--seeds 1 2 3] [--only ID ...]
+Usage: python benchmarks/sparse_encoding.py [--gen 200] [--seeds 1 2 3] [--only ID ...] [--form F]
 Prints, per track of the 48.5 km reference family (and the 20 km "wind" variant) with the Dutch
-VIRM6 at 1.15 x its minimum running time, the gap (%) of NSGA2's best member within 2 s of the
-planned time (pop 40, objectives energy and time error) to the exact optimum, for each seed, with
-the number of variables and the CPU seconds.
+VIRM6 at 1.15 x its minimum running time, the gap (%) to the exact optimum of NSGA2's best member
+within 2 s of the planned time (pop 40), for each seed, with the number of variables and the CPU
+seconds. ``--form front`` (default): objectives energy and time error, the best member within 2 s
+(the protocol of benchmarks/ttobench_release.py; the 40 members spread over the whole front, most
+of them minutes late). ``--form punctual``: energy alone with ``|T - T_plan| <= 2 s`` as a
+constraint (the constrained single-objective form of Liu (2019) 4.4).
 """
 
 from __future__ import annotations
@@ -33,7 +36,10 @@ def main() -> None:
     parser.add_argument("--gen", type=int, default=200)
     parser.add_argument("--seeds", type=int, nargs="*", default=[1, 2, 3])
     parser.add_argument("--only", nargs="*")
+    parser.add_argument("--form", choices=("front", "punctual"), default="front")
     args = parser.parse_args()
+    form = ({"objectives": ("energy", "time_error")} if args.form == "front"
+            else {"objectives": ("energy",), "time_tolerance_s": TIME_TOL_S})
     print("| track | encoding | n_var | gaps % by seed | median % | CPU s |")
     print("|---|---|---|---|---|---|")
     for track, train in release_pairs(ROOT):
@@ -48,9 +54,12 @@ def main() -> None:
             t0 = time.process_time()
             gaps = []
             for seed in args.seeds:
-                problem = SpeedProfileProblem(case, objectives=("energy", "time_error"), **settings)
+                problem = SpeedProfileProblem(case, **form, **settings)
                 F = minimize(problem, NSGA2(pop_size=40), ("n_gen", args.gen), seed=seed).F
-                close = F[F[:, 1] <= TIME_TOL_S]
+                if F is None:
+                    gaps.append(float("nan"))
+                    continue
+                close = F[F[:, 1] <= TIME_TOL_S] if F.shape[1] > 1 else F  # punctual: feasible only
                 gaps.append(100.0 * (close[:, 0].min() / optimum - 1.0) if close.size else float("nan"))
             print(f"| {track.stem} | {label} | {problem.n_var} | {', '.join(f'{g:.2f}' for g in gaps)} | "
                   f"{np.median(gaps):.2f} | {time.process_time() - t0:.1f} |", flush=True)
