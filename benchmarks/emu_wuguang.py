@@ -58,6 +58,8 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS  # noqa: E402
+
 CASE = "wuguang-crh3"
 OBJECTIVES = ("energy", "running_time")
 POP_SIZE = 200
@@ -166,7 +168,7 @@ def exact_front(path: Path, times_s=EXACT_TIMES_S, profile_path: Path | None = N
         guess = traj.summary["lambda_w"]
         row = {"requested_time_s": t, "running_time_s": traj.running_time_s, "energy_kwh": traj.energy.net_kwh,
                "traction_kwh": traj.energy.traction_kwh, "regen_kwh": traj.energy.regen_kwh,
-               "lambda_kwh_per_s": guess / 3.6e6, "neutral_traction_j": traj.summary["neutral_traction_j"],
+               "lambda_kwh_per_s": guess / J_PER_KWH, "neutral_traction_j": traj.summary["neutral_traction_j"],
                "limit_excess_ms": traj.summary["limit_excess_ms"], "stop_error_m": traj.stop_error_m,
                "n_speeds": n_speeds, "solve_s": time.perf_counter() - start}
         rows = [r for r in rows if float(r["requested_time_s"]) != t] + [row]
@@ -212,7 +214,7 @@ def limit_under_train_ms(position_m: np.ndarray, line, train) -> np.ndarray:
     for start, end, value in line.speed_limits:
         under = (position_m >= start) & (position_m - train.length_m < end)
         limit[under] = np.minimum(limit[under], value)
-    return limit / 3.6
+    return limit / KMH_PER_MS
 
 
 def check_member(problem, x: np.ndarray) -> MemberCheck:

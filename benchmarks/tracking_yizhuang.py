@@ -35,6 +35,7 @@ from pymoo.optimize import minimize  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control import Hysteresis, track  # noqa: E402
 from pymoo_rail.problems import SpeedProfileProblem  # noqa: E402
 from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs  # noqa: E402
@@ -53,7 +54,7 @@ def hold_reference(case, sim):
     bounds = gradient_limit_partition(case.line)
 
     def run(v_kmh):
-        return sim.run(speed_code_programs(bounds, np.full(bounds.shape[0] - 1, v_kmh / 3.6))[0])
+        return sim.run(speed_code_programs(bounds, np.full(bounds.shape[0] - 1, v_kmh / KMH_PER_MS))[0])
 
     v = brentq(lambda s: run(s).running_time_s - case.planned_time_s, 40.0, 80.0, xtol=1e-6)
     return run(v), f"one code, {v:.2f} km/h"
@@ -125,7 +126,7 @@ def main() -> None:
         tr = runs["DE tracked", args.period, b]
         ax.plot(ref.position_m, ref.speed_kmh, "r-", lw=1.2, label="recommended (ideal run)")
         ax.plot(tr.position_m, tr.speed_kmh, "b--", lw=1.0, label="tracked")
-        ax.plot(tr.position_m, tr.limit_ms * 3.6, "k:", lw=0.8, label="limit")
+        ax.plot(tr.position_m, tr.limit_ms * KMH_PER_MS, "k:", lw=0.8, label="limit")
         ax.set_title(f"A = {A_KMH:g}, B = {b:g} km/h: {tr.energy.net_kwh:.2f} kWh, {tr.running_time_s:.1f} s")
         ax.grid(alpha=0.3)
     for ax in axes[1]:

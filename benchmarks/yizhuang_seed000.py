@@ -41,6 +41,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import J_PER_KWH
+
 CASE = "yizhuang"
 POP = 40  # colony: 20 employed + 20 onlookers (seed 000 5.2)
 LIMIT = 50
@@ -273,7 +275,7 @@ def energy_level(case, x_best, tolerance_s: float, reopt_seeds=(1, 2, 3, 4, 5)) 
         print(f"  variant {label}: {row}", flush=True)
     p = make_problem(case, tolerance_s=tolerance_s)
     same = p.trajectory(np.asarray(x_best))
-    brake_kwh = same.summary["brake_work_j"] / 3.6e6
+    brake_kwh = same.summary["brake_work_j"] / J_PER_KWH
     rows.append({"variant": "as modelled, braking work counted too (traction + brake work)",
                  "same_codes_kwh": same.energy.net_kwh + brake_kwh, "same_codes_time_s": same.running_time_s})
     for a, b in ((2.0, 3.0), (2.0, 4.0)):

@@ -15,10 +15,8 @@ import textwrap
 from pathlib import Path
 from typing import Sequence
 
-OBJECTIVE_NAMES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
-OBJECTIVE_COLUMNS = {"energy": "energy_kwh", "running_time": "running_time_s", "time_error": "time_error_s",
-                     "accel_variation": "accel_variation_ms2", "stop_error": "stop_error_m"}
-TIME_OBJECTIVES = ("running_time", "time_error")
+from pymoo_rail.constants import OBJECTIVE_COLUMNS, OBJECTIVES, TIME_OBJECTIVES
+
 DEFAULT_TIME_TOLERANCE_S = 1.0
 
 
@@ -362,10 +360,6 @@ def cmd_cases(args) -> int:
 
 
 def _objectives(values: Sequence[str]) -> tuple[str, ...]:
-    try:
-        from pymoo_rail.problems import OBJECTIVES
-    except ImportError:
-        OBJECTIVES = OBJECTIVE_NAMES
     for name in values:
         if name not in OBJECTIVES:
             raise UsageError("--objectives", f"unknown objective {name!r} (choose from {', '.join(OBJECTIVES)})")

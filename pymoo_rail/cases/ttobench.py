@@ -59,7 +59,7 @@ from typing import Any, Union
 import numpy as np
 
 from pymoo_rail.model import Case, CaseError, DavisResistance, ForceCurve, Line, Train
-from pymoo_rail.model.curves import KMH_PER_MS
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.line import CURVE_MODELS
 
 DATA_DIR = Path(__file__).resolve().parent / "data"

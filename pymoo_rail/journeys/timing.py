@@ -27,8 +27,8 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from pymoo_rail.cases import ttobench
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import CaseError, InfeasibleCaseError
-from pymoo_rail.model.curves import KMH_PER_MS
 from pymoo_rail.sim import Trajectory
 
 TIME_TOL_S = 0.5  # the exact solver returns runs within 0.5 s of the request
@@ -250,7 +250,7 @@ class TimedRun:
 
 def _time_and_speed_at(trajectory: Trajectory, x_m: float) -> tuple[float, float]:
     t = float(np.interp(x_m, trajectory.position_m, trajectory.time_s))
-    v = float(np.interp(x_m, trajectory.position_m, trajectory.speed_ms)) * 3.6
+    v = float(np.interp(x_m, trajectory.position_m, trajectory.speed_ms)) * KMH_PER_MS
     return t, v
 
 
@@ -264,7 +264,7 @@ def check_run(timed: TimedJourney, trajectories: Sequence[Trajectory], departure
             if j == 0:
                 t, v = departures_s[k], 0.0
             elif j == len(group) - 1:
-                t, v = departures_s[k] + traj.running_time_s, float(traj.speed_ms[-1]) * 3.6
+                t, v = departures_s[k] + traj.running_time_s, float(traj.speed_ms[-1]) * KMH_PER_MS
             else:
                 tau, v = _time_and_speed_at(traj, point.position_m - start)
                 t = departures_s[k] + tau
@@ -281,7 +281,7 @@ def limit_time_bound_s(line, start_m: float, end_m: float) -> float:
     for s, e, v in line.speed_limits:
         a, b = max(s, start_m), min(e, end_m)
         if b > a:
-            total += (b - a) / (v / 3.6)
+            total += (b - a) / (v / KMH_PER_MS)
     return total
 
 

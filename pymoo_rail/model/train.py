@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
+from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.model.curves import DavisResistance, ForceCurve
 from pymoo_rail.model.errors import CaseError, check_number
 
 GRAVITY_MS2 = 9.81

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.sim import Trajectory
 
 
@@ -77,7 +78,7 @@ def plot_profile(optimal: Trajectory, others: dict[str, Trajectory] | None = Non
     """
     fig, ax = _figure(ax)
     x = optimal.position_m
-    ax.plot(x, optimal.limit_ms * 3.6, "-", color="tab:red", lw=1.2, label="speed limit (under the train)")
+    ax.plot(x, optimal.limit_ms * KMH_PER_MS, "-", color="tab:red", lw=1.2, label="speed limit (under the train)")
     label = (f"optimum: {optimal.running_time_s:.1f} s, {optimal.energy.net_kwh:.2f} kWh")
     ax.plot(x, optimal.speed_kmh, "-", color="black", lw=1.8, label=label)
     for name, tr in (others or {}).items():

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.optimal import dp
 from pymoo_rail.sim import Simulator, Trajectory
@@ -47,7 +48,6 @@ CERTIFICATE_FACTOR = 2.0
 DEFAULT_TIE_J = 100.0
 LAMBDA_MIN_W = 1.0e2
 LAMBDA_MAX_W = 1.0e10
-_J_PER_KWH = 3.6e6
 
 
 @dataclass(frozen=True)
@@ -255,7 +255,7 @@ class OptimalSolver:
             p = moved(j)
             out = self.simulator.run_batch(p[None])[0]
             time = out[OUT_RUNNING_TIME_S] if out[OUT_REACHED] > 0 else math.inf
-            return p, out[OUT_NET_KWH] * _J_PER_KWH, time
+            return p, out[OUT_NET_KWH] * J_PER_KWH, time
 
         runs = {slow_end: run(slow_end), fast_end: run(fast_end)}
         if not runs[slow_end][2] >= target >= runs[fast_end][2]:
@@ -439,19 +439,19 @@ class OptimalSolver:
             other = coarse.solve_price(solution.lambda_w)
         slope_w = 0.5 * (solution.lambda_w + other.lambda_w)
         moved_j = other.energy_j + slope_w * (other.time_s - solution.time_s)
-        return CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) / _J_PER_KWH
+        return CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) / J_PER_KWH
 
     def trajectory(self, solution: _Solve) -> Trajectory:
         """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
         tr = self.simulator.run(solution.program)
         speeds = tr.speed_ms if solution.speeds is None else solution.speeds
         mismatch = float(np.max(np.abs(tr.speed_ms - speeds[: tr.speed_ms.shape[0]])))
-        energy_j = tr.energy.net_kwh * _J_PER_KWH
+        energy_j = tr.energy.net_kwh * J_PER_KWH
         if (not tr.reached or tr.speed_ms.shape[0] != speeds.shape[0] or mismatch > 1e-9
                 or abs(energy_j - solution.energy_j) > 1e-9 * max(abs(energy_j), 1.0)):
             raise RuntimeError(f"the simulator's replay of the optimal controls departs from the solver's run "
                                f"(max speed difference {mismatch:.3g} m/s, energy {tr.energy.net_kwh:.6f} against "
-                               f"{solution.energy_j / _J_PER_KWH:.6f} kWh): solver and simulator disagree")
+                               f"{solution.energy_j / J_PER_KWH:.6f} kWh): solver and simulator disagree")
         summary = dict(tr.summary, lambda_w=solution.lambda_w, dp_value_j=solution.value_j,
                        n_speeds=float(self.n_speeds), dx_m=float(self.dx_m),
                        adjusted=float(solution.speeds is None))
@@ -557,7 +557,7 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
         tr = solver.profile(float(t), lambda_guess_w=guess)
         guess = tr.summary["lambda_w"]
         e = tr.energy
-        slope = guess / _J_PER_KWH
+        slope = guess / J_PER_KWH
         rows.append({"running_time_s": tr.running_time_s, "energy_kwh": e.net_kwh, "requested_time_s": float(t),
                      "traction_kwh": e.traction_kwh, "regen_kwh": e.regen_kwh, "aux_kwh": e.aux_kwh,
                      "lambda_kwh_per_s": slope,

@@ -46,6 +46,7 @@ import pandas as pd
 from pymoo.core.problem import Problem
 from pymoo.core.repair import Repair
 
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case, CaseError
 from pymoo_rail.problems.cooperative import (  # noqa: F401 (re-exported for reproduction scripts)
     SEED_001_OFFSETS_S,
@@ -59,8 +60,6 @@ from pymoo_rail.sim import subsections as sub
 from pymoo_rail.sim.physics import KernelModel, davis_force
 from pymoo_rail.sim.trajectory import EnergyBreakdown
 
-KMH_PER_MS = 3.6
-J_PER_KWH = 3.6e6
 CONSTRAINTS = ("time_a", "time_b", "speed_limit", "comfort", "separation", "feasibility")
 SOLO_CONSTRAINTS = ("time", "speed_limit", "comfort", "feasibility")
 SPEED_GENES = ("relative", "absolute")

@@ -8,12 +8,12 @@ from typing import Sequence
 import numpy as np
 from pymoo.core.problem import Problem
 
+from pymoo_rail.constants import OBJECTIVES
 from pymoo_rail.model import Case
 from pymoo_rail.problems.encodings import ENCODINGS, BrakingOnset, SpeedCodes, SwitchingPoints
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 
-OBJECTIVES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
 # "jerk" is the name Meng et al. (2017) give their comfort figure, sum |a_i - a_(i-1)| (m/s^2): a total
 # variation of acceleration, not a rate of change (m/s^3). "accel_variation" says what it is; "jerk"
 # stays as an alias of the same objective.

@@ -32,11 +32,11 @@ import numpy as np
 import pandas as pd
 from numba import njit
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.sim.kernel import trace_cell_energies
 from pymoo_rail.sim.physics import KernelModel
 from pymoo_rail.sim.trajectory import Trajectory
 
-J_PER_KWH = 3.6e6
 
 
 @njit(cache=True)

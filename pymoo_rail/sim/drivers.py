@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import CaseError, Line
 from pymoo_rail.sim.kernel import (
     MODE_BRAKE,
@@ -145,4 +146,4 @@ def flat_out_program(length_m: float) -> np.ndarray:
 
 def describe_program(program: np.ndarray) -> str:
     """A readable line per program row."""
-    return "\n".join(f"until {r[0]:9.1f} m: {MODE_NAMES[int(r[1])]:8s} {r[2] * 3.6:6.1f} km/h" for r in program)
+    return "\n".join(f"until {r[0]:9.1f} m: {MODE_NAMES[int(r[1])]:8s} {r[2] * KMH_PER_MS:6.1f} km/h" for r in program)

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.sim import kernel as k
 
 
@@ -44,7 +45,7 @@ class Trajectory:
 
     @property
     def speed_kmh(self) -> np.ndarray:
-        return self.speed_ms * 3.6
+        return self.speed_ms * KMH_PER_MS
 
     @property
     def accel_variation_ms2(self) -> float:
@@ -74,7 +75,7 @@ class Trajectory:
         return pd.DataFrame({
             "position_m": self.position_m, "time_s": self.time_s, "speed_kmh": self.speed_kmh,
             "speed_ms": self.speed_ms, "accel_ms2": self.accel_ms2, "force_kn": self.force_n / 1000.0,
-            "regime": [k.REGIME_NAMES[r] for r in self.regime], "limit_kmh": self.limit_ms * 3.6,
+            "regime": [k.REGIME_NAMES[r] for r in self.regime], "limit_kmh": self.limit_ms * KMH_PER_MS,
         })
 
 
