@@ -289,7 +289,7 @@ class SpeedProfileProblem(Problem):
         DecisionError
             Naming the bad rows, and the first bad variable, value and bounds in the encoding's unit.
         """
-        units = [DECISION_UNITS.get(self.encoding.name, "")] * self.n_var
+        units = getattr(self.encoding, "units", [DECISION_UNITS.get(self.encoding.name, "")] * self.n_var)
         if self.encoding.name == "braking_onset":
             units[-1] = "m/s^2"  # positions, then the service deceleration
         return check_decisions(X, self.xl, self.xu, units)
