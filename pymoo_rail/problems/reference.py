@@ -178,6 +178,23 @@ class CertifiedFront:
         total = np.where(np.isclose(t, nodes_t[k + 1]), bound[k + 1], total)
         return energy, total
 
+    def below_certificate(self, running_time_s, energy_kwh) -> tuple[np.ndarray, np.ndarray]:
+        """Which runs lie below the front by more than its certificate, among those it covers.
+
+        Returns ``(inside, below)``: boolean masks over the runs, ``inside`` where the running time
+        is in the front's range (and the energy finite), ``below`` where ``E < E*(T) - bound(T)``,
+        which a correct certificate never allows.
+        """
+        t = np.asarray(running_time_s, dtype=float).reshape(-1)
+        e = np.asarray(energy_kwh, dtype=float).reshape(-1)
+        lo, hi = self.time_range_s
+        inside = (t >= lo) & (t <= hi) & np.isfinite(e)
+        below = np.zeros_like(inside)
+        if inside.any():
+            optimum, bound = self.energy_at(t[inside])
+            below[inside] = e[inside] < optimum - bound - 1e-9
+        return inside, below
+
     def dense(self, n_points: int = 100, window_s: tuple[float, float] | None = None) -> pd.DataFrame:
         """The front at ``n_points`` running times (nodes included) in ``window_s``, with each point's bound."""
         lo, hi = self.clip(window_s)
