@@ -447,12 +447,16 @@ def pair_values(rows, enc: str, key: str):
             [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL])
 
 
+def measured(rows, enc: str, items, key_of):
+    """``(item, (NSGA-II values, GR-NSGA-II values))`` for the items whose key some run measured."""
+    for item in items:
+        if (pair := pair_values(rows, enc, key_of(item))) is not None:
+            yield item, pair
+
+
 def table4(rows, enc: str) -> str:
     t4 = []
-    for name, key in TABLE4:
-        if (pair := pair_values(rows, enc, key)) is None:
-            continue
-        a, b = pair
+    for (name, key), (a, b) in measured(rows, enc, TABLE4, lambda item: item[1]):
         sk = SEED_KEYS.get(key)
         t4.append([name, mean_std(a), mean_std(b), fmt(SEED_TABLE4[NSGA2_LABEL][sk]) if sk else "",
                    fmt(SEED_TABLE4[GR_LABEL][sk]) if sk else ""])
@@ -461,10 +465,7 @@ def table4(rows, enc: str) -> str:
 
 def tests_table(rows, enc: str) -> str:
     st = []
-    for key, lower in TESTED:
-        if (pair := pair_values(rows, enc, key)) is None:
-            continue
-        a, b = pair
+    for (key, lower), (a, b) in measured(rows, enc, TESTED, lambda item: item[0]):
         p, verdict, rel = rank_sum(rows, enc, key, lower)
         st.append([key, "lower" if lower else "higher", mean_std(a), mean_std(b), difference(key, rel), fmt(p, 3),
                    verdict])

@@ -142,3 +142,26 @@ def test_benchmark_scripts_use_only_public_names():
             if private:
                 wrong.append(f"benchmarks/{path.name}:{line} {module}: {', '.join(private)}")
     assert not wrong, "private names used by benchmark scripts:\n" + "\n".join(wrong)
+
+
+def _undocumented(path: Path) -> list[str]:
+    """Public functions, classes and methods of a module without a docstring."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    missing = []
+
+    def visit(body, prefix: str) -> None:
+        for node in body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and not node.name.startswith("_"):
+                if ast.get_docstring(node) is None:
+                    missing.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno} {prefix}{node.name}")
+                if isinstance(node, ast.ClassDef):
+                    visit(node.body, f"{prefix}{node.name}.")
+
+    visit(tree.body, "")
+    return missing
+
+
+def test_every_public_name_has_a_docstring():
+    # private modules (``_bees.py``) and private names are exempt
+    missing = [m for p in _sources() if not p.name.startswith("_") for m in _undocumented(p)]
+    assert not missing, "public names without a docstring:\n" + "\n".join(missing)

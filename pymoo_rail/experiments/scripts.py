@@ -45,3 +45,19 @@ def lower_priority(niceness: int = 10) -> None:
     current = os.nice(0)
     if current < niceness:
         os.nice(niceness - current)
+
+
+def count_range(counts) -> str:
+    """``"30"`` when every cell of a study has the same number of runs, else ``"28 to 30"``.
+
+    Parameters
+    ----------
+    counts : pandas.Series or sequence of int
+        Runs per cell (e.g. ``df.groupby(["problem", "algorithm"]).size()``).
+
+    Returns
+    -------
+    str
+    """
+    low, high = int(min(counts)), int(max(counts))
+    return f"{low}" if low == high else f"{low} to {high}"

@@ -120,10 +120,12 @@ class Journey:
 
     @property
     def name(self) -> str:
+        """The journey's name (its case's)."""
         return self.case.name
 
     @property
     def source(self) -> str:
+        """Where the journey's data come from (its case's source)."""
         return self.case.source
 
     @property

@@ -138,6 +138,7 @@ class CompileProfile(event.Listener):
         return self._stack[-1][0] if self._stack else "?"
 
     def on_start(self, ev: event.Event) -> None:
+        """A compile or a compiler pass starts: open it (and count the signature of a compile)."""
         data = ev.data or {}
         if ev.kind == "numba:compile":
             dispatcher = data.get("dispatcher")
@@ -149,6 +150,7 @@ class CompileProfile(event.Listener):
             self._open(data.get("qualname", "?"), data.get("name", "?").split(" [")[0])
 
     def on_end(self, ev: event.Event) -> None:
+        """The innermost open compile or pass ends: charge its exclusive time."""
         self._close()
 
     def table(self) -> list[tuple[str, float, dict[str, float]]]:
