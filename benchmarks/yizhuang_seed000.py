@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 from dataclasses import replace
@@ -234,10 +233,10 @@ def cached(path: Path, key: dict, compute):
         data = json.loads(path.read_text())
         if data.get("key") == key:
             return data["value"]
+    from pymoo_rail.atomic import atomic_write_text
+
     value = compute()
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps({"key": key, "value": value}, indent=1, default=float))
-    os.replace(tmp, path)
+    atomic_write_text(path, json.dumps({"key": key, "value": value}, indent=1, default=float))
     return value
 
 
