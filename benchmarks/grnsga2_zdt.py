@@ -159,13 +159,13 @@ def summarise(rows: list[dict]):
     return df
 
 
-def plot_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
+def plot_median_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
     """Median-IGD run of NSGA-II and GR-NSGA-II per problem; ``fronts[(problem, algorithm, seed)]`` = F."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from pymoo_rail.plotting import save_figure
+    from pymoo_rail.plotting import plot_fronts, save_figure
 
     names = []
     for p in problems:
@@ -174,18 +174,13 @@ def plot_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
         for ax, (label, alg) in zip(axes, (("(a) NSGA-II", "NSGA-II"),
                                             ("(b) golden-ratio NSGA-II", "GR-NSGA-II"))):
             sub = df[(df.problem == p) & (df.algorithm == alg)].sort_values(["igd", "seed"])
-            ax.plot(pf[:, 0], pf[:, 1], ".", ms=1.5, color="0.6", label="true Pareto front")
-            if len(sub):
-                row = sub.iloc[(len(sub) - 1) // 2]  # median-IGD run
-                F = fronts.get((p, alg, int(row.seed)))
-                if F is not None:
-                    ax.plot(F[:, 0], F[:, 1], "o", ms=3, mfc="none", color="C0" if alg == "NSGA-II" else "C3",
-                            label=f"obtained (seed {int(row.seed)}, median IGD {row.igd:.2e})")
-            ax.set_title(f"{p.upper()} {label}")
-            ax.set_xlabel("$f_1$")
-            ax.set_ylabel("$f_2$")
-            ax.legend(fontsize=8)
-            ax.grid(alpha=0.3)
+            row = sub.iloc[(len(sub) - 1) // 2] if len(sub) else None  # median-IGD run
+            F = fronts.get((p, alg, int(row.seed))) if row is not None else None
+            if F is None:
+                ax.set_title(f"{p.upper()} {label}: no run")
+                continue
+            plot_fronts({f"obtained (seed {int(row.seed)}, median IGD {row.igd:.2e})": F}, reference=pf,
+                        reference_label="true Pareto front", title=f"{p.upper()} {label}", ax=ax)
         fig.tight_layout()
         name = f"grnsga2_{p}_fronts.png"
         save_figure(fig, out / name, dpi=110)
@@ -337,7 +332,7 @@ def write_report(out: Path, results, problems, algorithms) -> None:
     df = summarise(table.to_dict("records"))
     df = df[df.problem.isin(problems) & df.algorithm.isin(algorithms)]
     fronts = {(r.problem, r.algorithm, int(r.seed)): r.F for r in results.itertuples()}
-    pngs = plot_fronts(df, fronts, out, problems)
+    pngs = plot_median_fronts(df, fronts, out, problems)
     n_runs = df.groupby(["problem", "algorithm"]).size()
 
     L = []
