@@ -155,6 +155,7 @@ def report(out: Path, df, curves: dict) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import save_figure
 
     exported = df.assign(best=df.best.map(lambda v: repr(float(v))))  # every digit of the best value
     exported.sort_values(["run", "function", "dim", "iterations", "algorithm"], kind="stable").to_csv(
@@ -238,8 +239,7 @@ def report(out: Path, df, curves: dict) -> None:
             axes[0].legend()
         fig.tight_layout()
         name = f"abc_functions_{function}.png"
-        fig.savefig(out / name, dpi=110)
-        plt.close(fig)
+        save_figure(fig, out / name, dpi=110)
         figures.append(name)
 
     fig, axes = plt.subplots(1, 3, figsize=(14, 3.8))  # like figs. 3-10 to 3-12
@@ -255,8 +255,7 @@ def report(out: Path, df, curves: dict) -> None:
             ax.legend()
     axes[0].set_ylabel("median best-so-far f")
     fig.tight_layout()
-    fig.savefig(out / "abc_functions_sphere_dims.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out / "abc_functions_sphere_dims.png", dpi=110)
     figures.append("abc_functions_sphere_dims.png")
 
     lines += ["## Convergence (median over runs of the best-so-far value)", ""]
@@ -280,13 +279,11 @@ def _observations(df) -> list[str]:
 
 
 def main() -> None:
+    from pymoo_rail.experiments.scripts import add_study_options
+
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--runs", type=int, default=30)
-    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "reports")
-    parser.add_argument("--workers", type=int, default=2, help="process pool size (at most 2)")
-    parser.add_argument("--work", type=Path, default=Path(__file__).resolve().parents[1] / "out" / "abc_functions",
-                        help="study directories: one JSON record per run (not committed)")
-    parser.add_argument("--report-only", action="store_true")
+    add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "abc_functions", Path(__file__).parent / "reports",
+                      runs=30, workers=True)
     args = parser.parse_args()
     workers = max(1, min(args.workers, 2))
     if not args.report_only:

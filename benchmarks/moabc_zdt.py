@@ -98,7 +98,8 @@ def report(out: Path, results) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from scipy.stats import ranksums
+    from pymoo_rail.plotting import save_figure
+    from pymoo_rail.experiments.stats import rank_sum
 
     df = runs_table(results)
     df.sort_values(["run", "problem", "algorithm"], kind="stable").to_csv(out / "moabc_zdt.csv", index=False)
@@ -153,12 +154,7 @@ def report(out: Path, results) -> None:
                 v = g[ind].astype(float)
                 mark = ""
                 if a != "NSGA2" and len(base) > 1 and len(g) > 1:
-                    stat, pval = ranksums(v, base[ind].astype(float))
-                    if pval >= 0.05:
-                        mark = "="
-                    else:
-                        better = (stat < 0) == LOWER_IS_BETTER[ind]
-                        mark = "+" if better else "-"
+                    mark = rank_sum(v, base[ind].astype(float), lower_better=LOWER_IS_BETTER[ind])[2]
                 cells.append(f"{v.mean():.4g} | {v.median():.4g} | {v.std(ddof=1) if len(v) > 1 else 0:.2g} | {mark}")
             lines.append(f"| {a} | {len(g)} | {g.n_eval.mean():.0f} | " + " | ".join(cells)
                          + f" | {g.time_s.mean():.2f} |")
@@ -179,8 +175,7 @@ def report(out: Path, results) -> None:
     axes[0].set_ylabel("f2")
     axes[0].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "moabc_zdt_fronts.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out / "moabc_zdt_fronts.png", dpi=110)
 
     fig, axes = plt.subplots(1, 4, figsize=(18, 4))
     for ax, p in zip(axes, PROBLEMS):
@@ -195,21 +190,18 @@ def report(out: Path, results) -> None:
         ax.set_title(f"{p}: IGD")
         ax.tick_params(axis="x", labelsize=7)
     fig.tight_layout()
-    fig.savefig(out / "moabc_zdt_igd.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out / "moabc_zdt_igd.png", dpi=110)
     lines += ["![fronts](moabc_zdt_fronts.png)", "", "![IGD](moabc_zdt_igd.png)", ""]
     (out / "moabc_zdt.md").write_text("\n".join(lines) + "\n")
     print(f"wrote {out / 'moabc_zdt.md'}")
 
 
 def main() -> None:
+    from pymoo_rail.experiments.scripts import add_study_options
+
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--runs", type=int, default=30)
-    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "reports")
-    parser.add_argument("--workers", type=int, default=2, help="process pool size (at most 2)")
-    parser.add_argument("--work", type=Path, default=Path(__file__).resolve().parents[1] / "out" / "moabc_zdt",
-                        help="study directory: one JSON record per run (not committed)")
-    parser.add_argument("--report-only", action="store_true")
+    add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "moabc_zdt", Path(__file__).parent / "reports",
+                      runs=30, workers=True)
     args = parser.parse_args()
     from pymoo_rail.experiments import load_results, run_study
     from pymoo_rail.experiments.scripts import lower_priority

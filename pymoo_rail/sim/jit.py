@@ -65,6 +65,7 @@ class CompileWatch(event.Listener):
         return module.startswith(PACKAGE)
 
     def on_start(self, ev: event.Event) -> None:
+        """Numba's compile-start event: announce the first compile and start the clock at the outermost one."""
         if not self._ours(ev):
             return
         if self._depth == 0:
@@ -74,6 +75,7 @@ class CompileWatch(event.Listener):
         self._depth += 1
 
     def on_end(self, ev: event.Event) -> None:
+        """Numba's compile-end event: count the outermost compile of our kernels and its time."""
         if not self._ours(ev) or self._depth == 0:
             return
         self._depth -= 1

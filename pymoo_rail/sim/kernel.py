@@ -36,6 +36,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.sim.jit import inlined_internal
 from pymoo_rail.sim.physics import (
     davis_force,
@@ -82,7 +83,6 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
 
 # the three full-force steps of ``full_step`` (public for the DP)
 KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
-_J_PER_KWH = 3.6e6
 
 
 @inlined_internal
@@ -284,9 +284,9 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
         tr_f[count - 1] = 0.0
         tr_r[count - 1] = REGIME_BRAKE if reached else REGIME_COAST
     t = totals[TOTAL_TIME]
-    out[OUT_TRACTION_KWH] = totals[TOTAL_TRACTION_J] / m.traction_efficiency / _J_PER_KWH
-    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J] / _J_PER_KWH
-    out[OUT_AUX_KWH] = m.aux_power_w * t / _J_PER_KWH
+    out[OUT_TRACTION_KWH] = totals[TOTAL_TRACTION_J] / m.traction_efficiency / J_PER_KWH
+    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J] / J_PER_KWH
+    out[OUT_AUX_KWH] = m.aux_power_w * t / J_PER_KWH
     out[OUT_NET_KWH] = out[OUT_TRACTION_KWH] + out[OUT_AUX_KWH] - out[OUT_REGEN_KWH]
     out[OUT_RUNNING_TIME_S] = t
     out[OUT_STOP_POSITION_M] = stop_pos

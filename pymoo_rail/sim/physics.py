@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
 from pymoo_rail.sim.jit import inlined
 
@@ -67,7 +68,7 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
         brake_breaks_ms=bb, brake_coefs=bc, brake_max_n=bf, brake_max_w=bp,
         regen_max_n=train.regen_max_force_kn * 1000.0 if train.regen_max_force_kn is not None else math.inf,
         regen_max_w=train.regen_max_power_kw * 1000.0 if train.regen_max_power_kw is not None else math.inf,
-        regen_min_speed_ms=train.regen_min_speed_kmh / 3.6,
+        regen_min_speed_ms=train.regen_min_speed_kmh / KMH_PER_MS,
         max_accel_ms2=train.max_accel_ms2 if train.max_accel_ms2 is not None else math.inf,
         max_decel_ms2=train.max_decel_ms2 if train.max_decel_ms2 is not None else math.inf,
         traction_efficiency=train.traction_efficiency, regen_efficiency=train.regen_efficiency,
@@ -80,8 +81,8 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
     )
     envelope = braking_envelope(model)
     if model.initial_speed_ms > envelope[0]:
-        raise InfeasibleCaseError("run.initial_speed_kmh", case.initial_speed_ms * 3.6,
-                                  f"is above the braking envelope at the start ({envelope[0] * 3.6:.3f} km/h): "
+        raise InfeasibleCaseError("run.initial_speed_kmh", case.initial_speed_ms * KMH_PER_MS,
+                                  f"is above the braking envelope at the start ({envelope[0] * KMH_PER_MS:.3f} km/h): "
                                   "no braking meets the limits ahead", case.name)
     return model._replace(envelope_ms=envelope)
 
@@ -148,18 +149,6 @@ def electric_braking_capped(m, v, brake_n):
     if v > 0.0 and f * v > m.regen_max_w:
         f = m.regen_max_w / v
     return f
-
-
-@inlined
-def electric_braking(m, v, brake_n):
-    """The part of a braking force the motors take (and regenerate) at speed v; the rest is friction.
-
-    Zero below the regen cut-off speed. (The simulator credits the share of a cell run above the
-    cut-off instead, so that results do not jump with the grid.)
-    """
-    if v < m.regen_min_speed_ms:
-        return 0.0
-    return electric_braking_capped(m, v, brake_n)
 
 
 # Relative tolerance of a landing: the force it needs may exceed what the train has by this much
