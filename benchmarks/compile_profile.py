@@ -37,6 +37,13 @@ def child(cli_args: list[str], top: int, signatures: bool) -> None:
             stages[stage] = stages.get(stage, 0.0) + s
     total = sum(stages.values())
     print(f"exit {code}; process CPU {usage.ru_utime + usage.ru_stime:.1f} s; compile (CPU) {total:.1f} s")
+    modules: dict[str, float] = {}
+    for qualname, s, _ in rows:
+        module = qualname.split(".<locals>")[0].rsplit(".", 1)[0]
+        modules[module] = modules.get(module, 0.0) + s
+    print("\nby module:")
+    for module, s in sorted(modules.items(), key=lambda kv: -kv[1])[:10]:
+        print(f"  {s:7.1f} s  {module}")
     print("\nby stage:")
     for stage, s in sorted(stages.items(), key=lambda kv: -kv[1])[:12]:
         print(f"  {s:7.1f} s  {stage}")

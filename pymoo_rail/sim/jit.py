@@ -122,11 +122,11 @@ class CompileProfile(event.Listener):
     Attributes
     ----------
     seconds : dict
-        ``(function qualname, stage) -> seconds``.
+        ``(module.qualname of the function, stage) -> seconds``.
     compiles : dict
-        ``function qualname -> number of signatures compiled``.
+        ``module.qualname -> number of signatures compiled``.
     signatures : dict
-        ``function qualname -> [argument types of each compilation]`` (to spot specialisations).
+        ``module.qualname -> [argument types of each compilation]`` (to spot specialisations).
     """
 
     def __init__(self) -> None:
@@ -154,12 +154,13 @@ class CompileProfile(event.Listener):
         data = ev.data or {}
         if ev.kind == "numba:compile":
             dispatcher = data.get("dispatcher")
-            qualname = getattr(getattr(dispatcher, "py_func", None), "__qualname__", "?")
+            func = getattr(dispatcher, "py_func", None)
+            qualname = f"{getattr(func, '__module__', '?')}.{getattr(func, '__qualname__', '?')}"
             self.compiles[qualname] = self.compiles.get(qualname, 0) + 1
             self.signatures.setdefault(qualname, []).append(str(data.get("args", "")))
             self._open(qualname, "other")
         else:
-            self._open(data.get("qualname", "?"), data.get("name", "?").split(" [")[0])
+            self._open(f"{data.get('module', '?')}.{data.get('qualname', '?')}", data.get("name", "?").split(" [")[0])
 
     def on_end(self, ev: event.Event) -> None:
         self._close()
