@@ -423,7 +423,26 @@ class OptimalSolver:
         slope_w = 0.5 * (solution.lambda_w + other.lambda_w)
         moved_j = other.energy_j + slope_w * (other.time_s - solution.time_s)
         return (CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) + solution.dual_gap_j
-                + solution.tie_cost_j) / _J_PER_KWH
+                + max(solution.tie_cost_j, self._untied_excess_j(solution))) / _J_PER_KWH
+
+    def _untied_excess_j(self, solution: _Solve) -> float:
+        """How much better, at the run's price of time, the forward run without the tie rule is (J, >= 0).
+
+        Keeping the regime between near-tied controls changes the rest of the run too, so its cost
+        is measured on the whole run: the forward run with ``tie_j = 0`` at the same price, compared
+        in ``energy + lambda x time`` (measured: 5.8 Wh on a 1.7 km metro section, 0.07 %).
+        """
+        if self.tie_j <= 0.0:
+            return 0.0
+        lam = solution.lambda_w
+        prices = lam if self.price_shape is None else lam * self.price_shape
+        run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, 0.0,
+                       self._value)
+        _, _, _, done, energy, time, _ = run
+        if done < self.simulator.grid.n_nodes - 1:
+            return 0.0
+        mean_price = lam if self.price_shape is None else lam * float(np.mean(self.price_shape))
+        return max(solution.energy_j + mean_price * solution.time_s - (energy + mean_price * time), 0.0)
 
     def trajectory(self, solution: _Solve) -> Trajectory:
         """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
