@@ -29,6 +29,8 @@ from pathlib import Path
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
+if str(HERE.parent) not in sys.path:  # this checkout's package, not an installed one
+    sys.path.insert(0, str(HERE.parent))
 REPORT = HERE / "reports" / "peers.md"
 CASES = [  # (case, running time s, ms-eetc track id or None)
     (str(HERE / "cases" / "intercity-var-limit-100.toml"), 1541.0, "00_var_speed_limit_100"),

@@ -400,14 +400,21 @@ class OptimalSolver:
         return best
 
     def energy_bound_kwh(self, solution: _Solve) -> float:
-        """Bound on the run's energy above the optimum at its running time (kWh, >= 0).
+        """Estimated bound on the run's energy above the optimum at its running time (kWh, >= 0).
 
-        The two-grid estimate: the same run solved on a speed grid of half the nodes (same position
-        grid, same controls), moved to this run's time along the front's slope ``lambda``, differs
-        from this run by ``delta``. If the error of the DP falls like ``spacing^p``, the finer
-        solve's error is ``|delta| / (2^p - 1)``; the bound is ``2 |delta|``, which covers any
-        ``p >= 0.58`` (measured p: 1-2 on level track, lower on wuguang-crh3, ``docs/optimal.md``). The optimum meant is that of the simulator's model on this position grid,
-        the model every optimiser's run is evaluated with.
+        The sum of two measured parts (``docs/optimal.md``, "Certificate"):
+
+        - the grid: the same run solved on a speed grid of half the nodes (same position grid,
+          same controls), moved to this run's time along the front's slope ``lambda``, differs from
+          this run by ``delta``; if the DP's error falls like ``spacing^p``, the finer solve's error
+          is ``|delta| / (2^p - 1)``, and ``2 |delta|`` covers any ``p >= 0.58``;
+        - the run above the supporting line at ``lambda``: for a moved run, its weak-duality gap to
+          the bracketing runs (``dual_gap_j``); for any run, how much better the forward run
+          without the tie rule is at the same price; the larger of the two.
+
+        An estimate, not a proven bound: ``benchmarks/reference_check.py`` checks it against every
+        optimiser result the project's studies committed. The optimum meant is that of the
+        simulator's model on this position grid, the model every optimiser's run is evaluated with.
         """
         if self._coarse is None:
             self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
@@ -422,8 +429,10 @@ class OptimalSolver:
             other = coarse.solve_price(solution.lambda_w)
         slope_w = 0.5 * (solution.lambda_w + other.lambda_w)
         moved_j = other.energy_j + slope_w * (other.time_s - solution.time_s)
-        return (CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) + solution.dual_gap_j
-                + max(solution.tie_cost_j, self._untied_excess_j(solution))) / _J_PER_KWH
+        # the duality gap of a moved run and the untied run's advantage both measure how far the run
+        # lies above the supporting line at lambda (on a moved run they coincide): the larger counts
+        above_line_j = max(solution.dual_gap_j, solution.tie_cost_j, self._untied_excess_j(solution))
+        return (CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) + above_line_j) / _J_PER_KWH
 
     def _untied_excess_j(self, solution: _Solve) -> float:
         """How much better, at the run's price of time, the forward run without the tie rule is (J, >= 0).
