@@ -46,6 +46,7 @@ import pandas as pd
 from pymoo.core.problem import Problem
 from pymoo.core.repair import Repair
 
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case, CaseError
 from pymoo_rail.problems.cooperative import (  # noqa: F401 (re-exported for reproduction scripts)
     SEED_001_OFFSETS_S,
@@ -59,8 +60,6 @@ from pymoo_rail.sim import subsections as sub
 from pymoo_rail.sim.physics import KernelModel, davis_force
 from pymoo_rail.sim.trajectory import EnergyBreakdown
 
-KMH_PER_MS = 3.6
-J_PER_KWH = 3.6e6
 CONSTRAINTS = ("time_a", "time_b", "speed_limit", "comfort", "separation", "feasibility")
 SOLO_CONSTRAINTS = ("time", "speed_limit", "comfort", "feasibility")
 SPEED_GENES = ("relative", "absolute")
@@ -85,10 +84,12 @@ class TrainSetup:
 
     @property
     def n_sub(self) -> int:
+        """Number of subsections."""
         return self.sub_start.shape[0]
 
     @property
     def planned_time_s(self) -> float:
+        """Planned running time (s)."""
         return self.case.planned_time_s
 
 
@@ -149,14 +150,17 @@ class CooperativeSolution:
 
     @property
     def shared_kwh(self) -> float:
+        """Regenerated energy used by the other train, both ways (kWh)."""
         return self.shared_a_from_b_kwh + self.shared_b_from_a_kwh
 
     @property
     def traction_kwh(self) -> float:
+        """Traction energy of both trains (kWh)."""
         return self.a.traction_kwh + self.b.traction_kwh
 
     @property
     def feasible(self) -> bool:
+        """True when every constraint is met."""
         return all(v <= 0.0 for v in self.constraints.values())
 
 
@@ -441,6 +445,7 @@ class CooperativeSeedProblem(_SubsectionModel):
         return coop.power_profiles(clocked_pair(self, self.decode(x)), ("a", "b"), 1.0, self.time_step_s)
 
     def describe(self) -> str:
+        """One line naming the case, the offset and the subsections."""
         a, b = self.trains
         return (f"CooperativeSeedProblem({self.case.name}, offset {self.offset_s:g} s: A {a.n_sub} subsections, "
                 f"B {b.n_sub} subsections, {self.n_var} variables, {self.n_ieq_constr} constraints)")
@@ -510,6 +515,7 @@ class PartialProblem(Problem):
                          xl=problem.xl[free].copy(), xu=problem.xu[free].copy(), vtype=float)
 
     def full(self, x: np.ndarray) -> np.ndarray:
+        """Full decision vectors: the reference vector with the free variables taken from ``x``."""
         x = np.atleast_2d(np.asarray(x, dtype=float))
         X = np.repeat(self.x_ref[None, :], x.shape[0], axis=0)
         X[:, self.free] = x

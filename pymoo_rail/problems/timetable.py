@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 from pymoo.core.problem import Problem
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case
 from pymoo_rail.problems.cooperative import PacedTrain, finite_number
 from pymoo_rail.problems.speed_profile import check_decisions
@@ -119,6 +120,7 @@ class TimetableProblem(Problem):
 
     @property
     def period_s(self) -> float:
+        """Period of the timetable: trains x headway (s)."""
         return self.n_trains * self.headway_s
 
     def departures_s(self, X: np.ndarray) -> np.ndarray:
@@ -161,7 +163,7 @@ class TimetableProblem(Problem):
                 journeys.append(coop.chain_runs(runs))
             t0, n_bins = coop.clock_span(journeys, self.time_step_s)
             trac, regen = coop.power_bins(journeys, t0, self.time_step_s, n_bins)
-            shared[r] = coop.shared_energy_bins(trac, regen, self.transmission_efficiency).sum() / coop.J_PER_KWH
+            shared[r] = coop.shared_energy_bins(trac, regen, self.transmission_efficiency).sum() / J_PER_KWH
             order = np.argsort(departures[r], kind="stable")
             for lead, follow in zip(order[:-1], order[1:]):
                 # the leader clears the terminus after a dwell there (turning back or to the depot)
@@ -183,6 +185,7 @@ class TimetableProblem(Problem):
             out[key] = sim[key]
 
     def describe(self) -> str:
+        """One line naming the case, the trains, the headway and the legs."""
         return (f"TimetableProblem({self.case.name}: {self.n_trains} trains every {self.headway_s:g} s "
                 f"+- {self.window_s:g} s, {len(self.legs)} legs, {self.n_var} variables, objectives "
                 f"{', '.join(self.objectives)})")

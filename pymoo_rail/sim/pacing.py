@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case
 from pymoo_rail.sim.drivers import gradient_limit_partition, speed_code_programs
 from pymoo_rail.sim.kernel import OUT_REACHED, OUT_RUNNING_TIME_S
@@ -68,7 +69,7 @@ class PacedSpeedCodes:
         limits = np.empty(bounds.shape[0] - 1)
         for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
             limits[k] = min(v for s, e, v in line.speed_limits if s < b and e > a)
-        limits = np.minimum(limits, case.train.max_speed_kmh) / 3.6
+        limits = np.minimum(limits, case.train.max_speed_kmh) / KMH_PER_MS
         planned = case.planned_time_s if planned_time_s is None else float(planned_time_s)
         if not (np.isfinite(planned) and planned > 0):
             raise ValueError(f"planned_time_s = {planned_time_s!r}: must be a positive number of seconds")
@@ -76,6 +77,7 @@ class PacedSpeedCodes:
 
     @property
     def n_var(self) -> int:
+        """Number of shape variables (one per section)."""
         return self.limits_ms.shape[0]
 
     def programs(self, shapes: np.ndarray, pace: np.ndarray) -> np.ndarray:
@@ -97,6 +99,7 @@ class PacedRuns:
 
     @property
     def running_time_s(self) -> np.ndarray:
+        """Running time of each run (s)."""
         return self.summaries[:, OUT_RUNNING_TIME_S]
 
 

@@ -34,6 +34,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.sim.kernel import REGIME_BRAKE, REGIME_COAST, REGIME_CRUISE, REGIME_TRACTION, trace_cell_energies
 from pymoo_rail.sim.physics import davis_force, max_braking, max_traction
 
@@ -76,7 +77,6 @@ RUN_NAMES = ("traction_kwh", "regen_kwh", "running_time_s", "brake_start_m", "br
              "n_active", "traction_work_j", "brake_work_j", "davis_work_j", "line_work_j")
 
 _LAB_TRACTION, _LAB_HOLD, _LAB_COAST, _LAB_BRAKE, _LAB_MIXED = 0, 1, 2, 3, 4
-_J_PER_KWH = 3.6e6
 _STALL_TIME_S = 1e3  # time charged to a cell the train cannot pass (keeps the sums finite)
 
 
@@ -674,8 +674,8 @@ def drive_one(m, sub_start, sub_end, sub_kind, sub_cap, sub_grade_change, brake_
         if change > accel_change:
             accel_change = change
 
-    summary[RUN_TRACTION_KWH] = e_tr_sum / _J_PER_KWH
-    summary[RUN_REGEN_KWH] = e_rg_sum / _J_PER_KWH
+    summary[RUN_TRACTION_KWH] = e_tr_sum / J_PER_KWH
+    summary[RUN_REGEN_KWH] = e_rg_sum / J_PER_KWH
     summary[RUN_RUNNING_TIME_S] = t
     summary[RUN_BRAKE_START_M] = x_p
     summary[RUN_BRAKE_SPEED_MS] = v_m
