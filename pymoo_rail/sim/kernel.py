@@ -131,7 +131,7 @@ def _decel_step(m, v0, cell, decel_ms2):
 
 
 @inlined_internal
-def _share_above(v0, v1, v_cut):
+def share_above(v0, v1, v_cut):
     """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
     lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
     if lo >= v_cut:
@@ -223,7 +223,7 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
             w_neutral += f * d
     w_brake += brake_n * d
     if brake_n > 0.0:
-        share = _share_above(v, v1, m.regen_min_speed_ms)
+        share = share_above(v, v1, m.regen_min_speed_ms)
         w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
     w_davis += w0 * d
     w_line += m.line_force_n[cell] * d
@@ -258,7 +258,7 @@ def trace_cell_energies(m, x, v, f):
         if f[i] > 0.0:
             trac[i] = f[i] * d / m.traction_efficiency
         elif f[i] < 0.0:
-            share = _share_above(v[i], v[i + 1], m.regen_min_speed_ms)
+            share = share_above(v[i], v[i + 1], m.regen_min_speed_ms)
             regen[i] = m.regen_efficiency * electric_braking_capped(m, 0.5 * (v[i] + v[i + 1]), -f[i]) * d * share
     return trac, regen
 
