@@ -218,3 +218,14 @@ def test_bad_input_names_the_field_and_value(pair, yizhuang):
         CooperativeSeedProblem(pair, 0.0, max_accel_change_ms2=-1.0)
     with pytest.raises(CaseError, match=r"run\.legs.*0 legs"):
         CooperativeSeedProblem(yizhuang, 45.0)
+
+
+@pytest.mark.parametrize("name", ["de", "nsga2"])
+def test_de_and_nsga2_work_unchanged(problem, name):
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.algorithms.soo.nonconvex.de import DE
+    from pymoo.optimize import minimize
+
+    algorithm = DE(pop_size=6) if name == "de" else NSGA2(pop_size=6)
+    res = minimize(problem, algorithm, ("n_eval", 12), seed=1)
+    assert res.pop.get("F").shape == (6, 1) and np.all(res.pop.get("G")[:, 1] <= 0)
