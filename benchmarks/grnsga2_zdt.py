@@ -62,11 +62,10 @@ SBX_SEED = {"operator": "sbx", "prob": 0.9, "eta": 15}
 
 def algorithm_specs() -> dict:
     """The four algorithms as study specs, by label."""
-    from pymoo_rail.experiments import algorithm
+    from pymoo_rail.experiments import algorithm, tang2020_nsga2
 
     return {
-        "NSGA-II": algorithm("nsga2", label="NSGA-II", pop_size=POP_SIZE, crossover=SBX_SEED,
-                             mutation={"operator": "pm", "prob": 1.0, "prob_var": 0.01, "eta": 20}),
+        "NSGA-II": tang2020_nsga2(label="NSGA-II", pop_size=POP_SIZE),
         "GR-NSGA-II": algorithm("grnsga2", label="GR-NSGA-II", pop_size=POP_SIZE, local_size=40, pc_max=0.9,
                                 pm_max=0.1),
         "GR-NSGA-II no LS": algorithm("grnsga2", label="GR-NSGA-II no LS", pop_size=POP_SIZE, local_size=0,
@@ -160,12 +159,13 @@ def summarise(rows: list[dict]):
     return df
 
 
-def plot_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
+def plot_median_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
     """Median-IGD run of NSGA-II and GR-NSGA-II per problem; ``fronts[(problem, algorithm, seed)]`` = F."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import plot_fronts, save_figure
 
     names = []
     for p in problems:
@@ -174,29 +174,23 @@ def plot_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
         for ax, (label, alg) in zip(axes, (("(a) NSGA-II", "NSGA-II"),
                                             ("(b) golden-ratio NSGA-II", "GR-NSGA-II"))):
             sub = df[(df.problem == p) & (df.algorithm == alg)].sort_values(["igd", "seed"])
-            ax.plot(pf[:, 0], pf[:, 1], ".", ms=1.5, color="0.6", label="true Pareto front")
-            if len(sub):
-                row = sub.iloc[(len(sub) - 1) // 2]  # median-IGD run
-                F = fronts.get((p, alg, int(row.seed)))
-                if F is not None:
-                    ax.plot(F[:, 0], F[:, 1], "o", ms=3, mfc="none", color="C0" if alg == "NSGA-II" else "C3",
-                            label=f"obtained (seed {int(row.seed)}, median IGD {row.igd:.2e})")
-            ax.set_title(f"{p.upper()} {label}")
-            ax.set_xlabel("$f_1$")
-            ax.set_ylabel("$f_2$")
-            ax.legend(fontsize=8)
-            ax.grid(alpha=0.3)
+            row = sub.iloc[(len(sub) - 1) // 2] if len(sub) else None  # median-IGD run
+            F = fronts.get((p, alg, int(row.seed))) if row is not None else None
+            if F is None:
+                ax.set_title(f"{p.upper()} {label}: no run")
+                continue
+            plot_fronts({f"obtained (seed {int(row.seed)}, median IGD {row.igd:.2e})": F}, reference=pf,
+                        reference_label="true Pareto front", title=f"{p.upper()} {label}", ax=ax)
         fig.tight_layout()
         name = f"grnsga2_{p}_fronts.png"
-        fig.savefig(out / name, dpi=110)
-        plt.close(fig)
+        save_figure(fig, out / name, dpi=110)
         names.append(name)
     return names
 
 
 def compare(df, problem: str, metric: str, a: str, b: str):
     """(a better?, relative difference of means in %, rank-sum p) of algorithm a vs b."""
-    from scipy.stats import ranksums
+    from pymoo_rail.experiments.stats import rank_sum
 
     x = df[(df.problem == problem) & (df.algorithm == a)][metric].dropna()
     y = df[(df.problem == problem) & (df.algorithm == b)][metric].dropna()
@@ -204,7 +198,7 @@ def compare(df, problem: str, metric: str, a: str, b: str):
         return None
     better = x.mean() > y.mean() if metric == "hv" else x.mean() < y.mean()
     rel = (x.mean() - y.mean()) / abs(y.mean()) * 100 if y.mean() != 0 else float("nan")
-    return bool(better), float(rel), float(ranksums(x, y).pvalue)
+    return bool(better), float(rel), rank_sum(x, y)[1]
 
 
 def pct(rel: float) -> str:
@@ -330,8 +324,6 @@ def pd_mean(frame, column: str) -> float:
 
 def write_report(out: Path, results, problems, algorithms) -> None:
     """The report, the per-run CSV and the front plots from the stored runs (``load_results``)."""
-    from scipy.stats import ranksums
-
     if not len(results):
         print("no runs to report")
         return
@@ -340,7 +332,7 @@ def write_report(out: Path, results, problems, algorithms) -> None:
     df = summarise(table.to_dict("records"))
     df = df[df.problem.isin(problems) & df.algorithm.isin(algorithms)]
     fronts = {(r.problem, r.algorithm, int(r.seed)): r.F for r in results.itertuples()}
-    pngs = plot_fronts(df, fronts, out, problems)
+    pngs = plot_median_fronts(df, fronts, out, problems)
     n_runs = df.groupby(["problem", "algorithm"]).size()
 
     L = []
@@ -373,7 +365,7 @@ def write_report(out: Path, results, problems, algorithms) -> None:
              "nearest distance to the true front (= Deb's convergence metric Upsilon); "
              "`gd_vv` the seed's eq. 13, sqrt(sum d_i^2) / n; `igd` pymoo IGD; `hv` "
              f"hypervolume with reference point ({HV_REF[0]}, {HV_REF[1]}). Smaller is better except hv.")
-    L.append("- p: two-sided Wilcoxon rank-sum test (`scipy.stats.ranksums`) of "
+    L.append("- p: two-sided Wilcoxon rank-sum test (`pymoo_rail.experiments.stats.rank_sum`) of "
              "GR-NSGA-II against NSGA-II (seed settings).\n")
 
     L.append("## Seed 003's table 1 is the NSGA-II paper's table\n")
@@ -410,14 +402,10 @@ def write_report(out: Path, results, problems, algorithms) -> None:
             for a in algorithms:
                 v = df[(df.problem == p) & (df.algorithm == a)][m].dropna()
                 cells.append(f"{fmt(v.mean())} +- {fmt(v.std())} ({fmt(v.median())})" if len(v) else "-")
-            a_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[0])][m].dropna()
-            b_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[1])][m].dropna()
-            pval = ranksums(a_v, b_v).pvalue if len(a_v) > 1 and len(b_v) > 1 else float("nan")
-            L.append(f"| {m} | " + " | ".join(cells) + f" | {pval:.2e} |")
-            if len(a_v) and len(b_v):
-                better = (a_v.mean() > b_v.mean()) if m == "hv" else (a_v.mean() < b_v.mean())
-                rel = (a_v.mean() - b_v.mean()) / abs(b_v.mean()) * 100 if b_v.mean() != 0 else float("nan")
-                verdict.append((p, m, better, rel, pval))
+            pair = compare(df, p, m, *MAIN_PAIR)
+            L.append(f"| {m} | " + " | ".join(cells) + f" | {pair[2] if pair else float('nan'):.2e} |")
+            if pair:
+                verdict.append((p, m, *pair))
         L.append("")
 
     L.append("### Budget actually used (means per run: evaluations, generations after the initial "

@@ -28,6 +28,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from pymoo_rail.constants import J_PER_KWH
+
 HERE = Path(__file__).resolve().parent
 REPORT = HERE / "reports" / "peers.md"
 CASES = [  # (case, running time s, ms-eetc track id or None)
@@ -106,7 +108,7 @@ def pymoo_rail_row(name: str, running_time_s: float) -> dict:
     tr = solver.profile(running_time_s)
     cpu = time.process_time() - start
     lam = tr.summary["lambda_w"]
-    at_request = tr.energy.net_kwh + lam * (tr.running_time_s - running_time_s) / 3.6e6
+    at_request = tr.energy.net_kwh + lam * (tr.running_time_s - running_time_s) / J_PER_KWH
     row = {"case": case.name, "requested_s": running_time_s, "run_s": tr.running_time_s,
            "energy_kwh": tr.energy.net_kwh, "at_request_kwh": at_request,
            "bound_kwh": tr.summary["energy_bound_kwh"], "cpu_s": cpu, "dp_solves": solver.n_solves}

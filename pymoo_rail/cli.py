@@ -15,10 +15,8 @@ import textwrap
 from pathlib import Path
 from typing import Sequence
 
-OBJECTIVE_NAMES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
-OBJECTIVE_COLUMNS = {"energy": "energy_kwh", "running_time": "running_time_s", "time_error": "time_error_s",
-                     "accel_variation": "accel_variation_ms2", "stop_error": "stop_error_m"}
-TIME_OBJECTIVES = ("running_time", "time_error")
+from pymoo_rail.constants import OBJECTIVE_COLUMNS, OBJECTIVES, TIME_OBJECTIVES
+
 DEFAULT_TIME_TOLERANCE_S = 1.0
 
 
@@ -61,37 +59,36 @@ Run 'pymoo-rail COMMAND --help' for the options of a command.
 """
 
 
-def _positive_int(text: str) -> int:
+def _parsed(text: str, kind: type, what: str):
     try:
-        value = int(text)
+        return kind(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"invalid integer: {text!r}") from None
+        raise argparse.ArgumentTypeError(f"invalid {what}: {text!r}") from None
+
+
+def _positive_int(text: str) -> int:
+    value = _parsed(text, int, "integer")
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
     return value
 
 
 def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"invalid number: {text!r}") from None
+    value = _parsed(text, float, "number")
     if not value > 0 or value == float("inf"):
         raise argparse.ArgumentTypeError(f"must be a positive finite number, got {text}")
     return value
 
 
 def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"invalid integer: {text!r}") from None
+    value = _parsed(text, int, "integer")
     if value < 0:
         raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
     return value
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``pymoo-rail`` command with all its subcommands."""
     parser = argparse.ArgumentParser(
         prog="pymoo-rail",
         description="Energy-efficient train driving with pymoo: optimise recommended speed profiles of "
@@ -326,6 +323,7 @@ def _count(n: int, noun: str) -> str:
 
 
 def cmd_cases(args) -> int:
+    """``pymoo-rail cases``: list the built-in cases, or describe one; returns the exit code."""
     from pymoo_rail.cases import list_cases, load_case
 
     if args.case is None:
@@ -364,10 +362,6 @@ def cmd_cases(args) -> int:
 
 
 def _objectives(values: Sequence[str]) -> tuple[str, ...]:
-    try:
-        from pymoo_rail.problems import OBJECTIVES
-    except ImportError:
-        OBJECTIVES = OBJECTIVE_NAMES
     for name in values:
         if name not in OBJECTIVES:
             raise UsageError("--objectives", f"unknown objective {name!r} (choose from {', '.join(OBJECTIVES)})")
@@ -438,6 +432,7 @@ def _case_from_args(args):
 
 
 def cmd_journey(args) -> int:
+    """``pymoo-rail journey``: solve a multi-stop journey with timing points; returns the exit code."""
     from pymoo_rail.journeys.timing import (read_timing_points, solve_timed_journey, timed_journey_from_toml,
                                             timed_journey_from_ttobench)
     from pymoo_rail.plotting.journey import plot_timed_run
@@ -467,6 +462,9 @@ def cmd_journey(args) -> int:
 
 
 def cmd_optimize(args) -> int:
+    """``pymoo-rail optimize``: run one algorithm on one case and write the front, the chosen run and figures;
+    returns the exit code.
+    """
     import numpy as np
     import pandas as pd
     from pymoo.optimize import minimize
@@ -647,6 +645,7 @@ def _default_times(t_min: float, planned_time_s: float, n_points: int):
 
 
 def cmd_reference(args) -> int:
+    """``pymoo-rail reference``: the exact optimal front and profile of a case; returns the exit code."""
     case = _case_from_args(args)
     try:
         from pymoo_rail.optimal import optimal_front, optimal_profile
@@ -697,6 +696,7 @@ def cmd_reference(args) -> int:
 
 
 def cmd_timetable(args) -> int:
+    """``pymoo-rail timetable``: optimise the departure times of a line's trains; returns the exit code."""
     import numpy as np
     import pandas as pd
     from pymoo.algorithms.moo.nsga2 import NSGA2
@@ -753,6 +753,7 @@ def _study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool
 
 
 def cmd_study(args) -> int:
+    """``pymoo-rail study``: run (or resume) a study file and write its tables; returns the exit code."""
     from pymoo_rail.experiments import read_study, run_study
     from pymoo_rail.experiments.spec import StudyError
 
@@ -781,6 +782,7 @@ def cmd_study(args) -> int:
 
 
 def cmd_plot(args, parser: argparse.ArgumentParser) -> int:
+    """``pymoo-rail plot``: draw a front or a trajectory from the files ``optimize`` wrote; returns the exit code."""
     import pandas as pd
 
     from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
@@ -850,6 +852,7 @@ def _objective_of_column(column: str) -> str:
 
 
 def cmd_warmup(args) -> int:
+    """``pymoo-rail warmup``: compile the Numba kernels ahead of the first run; returns the exit code."""
     from pymoo_rail.warmup import WARMUP_PARTS, warmup
 
     parts = WARMUP_PARTS if args.all else ("simulator",)
@@ -871,6 +874,7 @@ def _add_suite_parser(sub) -> None:
 
 
 def cmd_suite(args) -> int:
+    """``pymoo-rail suite``: list, describe or verify the benchmark suite's problems; returns the exit code."""
     from pymoo_rail.problems.reference import find_front
     from pymoo_rail.suite import CASES, list_problems, suite_case, verify
     from pymoo_rail.suite.problems import split

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control import kernel as ck
 from pymoo_rail.control.controllers import Controller, check_controller
 from pymoo_rail.model import Case
@@ -68,6 +69,7 @@ class Tracker:
 
     @property
     def case(self) -> Case:
+        """The case the tracked train runs on."""
         return self.simulator.case
 
     def run(self, reference: Trajectory, speed_noise_ms: np.ndarray | None = None,
@@ -99,7 +101,7 @@ class Tracker:
                                                  self._code, self._params, self.control_period_s,
                                                  noise, float(traction_lag_s))
         summary = summary_dict(out)
-        err_kmh = (v - np.interp(x, x_ref, v_ref_ms, right=0.0)) * 3.6
+        err_kmh = (v - np.interp(x, x_ref, v_ref_ms, right=0.0)) * KMH_PER_MS
         summary["speed_error_rms_kmh"] = float(np.sqrt(np.mean(err_kmh**2)))
         summary["speed_error_max_kmh"] = float(np.max(np.abs(err_kmh)))
         middle = (x >= x_start) & (x < x_stop)

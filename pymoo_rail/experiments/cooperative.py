@@ -15,6 +15,7 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.experiments.spec import Study, algorithm, problem
 from pymoo_rail.experiments.stats import signed_rank_vs
 from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S, scale_gradients
@@ -91,9 +92,9 @@ def sharing_potential(runs, time_step_s: float = 0.1) -> pd.DataFrame:
         for i in others:
             moving |= (mid >= runs[i].departure_s) & (mid < runs[i].arrival_s)
         drawn = trac[others].sum(axis=0)
-        rows.append(dict(regen_kwh=regen[j].sum() / coop.J_PER_KWH,
-                         while_others_move_kwh=regen[j][moving].sum() / coop.J_PER_KWH,
-                         others_draw_kwh=np.minimum(regen[j], drawn).sum() / coop.J_PER_KWH,
+        rows.append(dict(regen_kwh=regen[j].sum() / J_PER_KWH,
+                         while_others_move_kwh=regen[j][moving].sum() / J_PER_KWH,
+                         others_draw_kwh=np.minimum(regen[j], drawn).sum() / J_PER_KWH,
                          braking_from_s=float(mid[regen[j] > 0].min()) if regen[j].any() else np.nan,
                          braking_to_s=float(mid[regen[j] > 0].max()) if regen[j].any() else np.nan))
     return pd.DataFrame(rows)

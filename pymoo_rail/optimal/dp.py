@@ -348,12 +348,14 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float):
 
 
 @njit(cache=True)
-def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value):
+def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, value, floor_k):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
     the energies; one value everywhere for one running time, one per stretch between timing points);
-    ``fixed_u1`` and ``tgt_u1`` hold node positions (:func:`value_position`).
+    ``fixed_u1`` and ``tgt_u1`` hold node positions (:func:`value_position`). ``floor_k`` (n_nodes,)
+    is the lowest speed node allowed at each position (0 everywhere but at a timing point's minimum
+    speed): the nodes below it cost ``PENALTY_J``, so no run passes there slower.
     """
     n, n_speeds = value.shape
     # at the end of the line: the envelope there is the final speed (0 at a platform: one state);
@@ -376,7 +378,7 @@ def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, t
                     cost = e + time_price_w[i] * tgt_dt[p] + interp_at(v_next, tgt_u1[p])
                     if cost < best:
                         best = cost
-            value[i, j] = best if best < PENALTY_J else PENALTY_J
+            value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
 
 
 @njit(cache=True)
@@ -425,11 +427,13 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     return n - 1, energy, time
 
 
-def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray):
+def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray,
+          floor_k: np.ndarray | None = None):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
-    stretch between them its own price.
+    stretch between them its own price. ``floor_k`` (n_nodes,), optional, is the lowest speed node
+    allowed at each position (:func:`speed_floor_nodes`): a journey's minimum speeds.
 
     ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
     cost-to-go. Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s).
@@ -438,7 +442,9 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     """
     n = model.position_m.shape[0]
     prices = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,)))
-    backward_sweep(prices, *tables, value)
+    if floor_k is None:
+        floor_k = np.zeros(n, dtype=np.int64)
+    backward_sweep(prices, *tables, value, floor_k)
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)
@@ -446,3 +452,19 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     done, energy, time = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j), modes,
                                          targets, speeds)
     return modes, targets, speeds, done, energy, time
+
+
+def speed_floor_nodes(model, floor_ms: np.ndarray, n_speeds: int, bias: float) -> np.ndarray:
+    """The lowest speed node at or above ``floor_ms`` at each position (n_nodes,), for :func:`solve`.
+
+    A node above the top one (a floor above the braking envelope) is ``n_speeds``: no state is
+    allowed there. Rounding up to a node makes the floor hold in the forward run, at most one node
+    spacing above the bound asked for.
+    """
+    out = np.zeros(model.position_m.shape[0], dtype=np.int64)
+    k_max = n_speeds - 1
+    for i in np.flatnonzero(floor_ms > 0.0):
+        top_u = model.envelope_ms[i] ** 2
+        u = floor_ms[i] ** 2
+        out[i] = n_speeds if u > top_u or top_u <= 0.0 else int(math.ceil(node_position(top_u, u, k_max, bias) - 1e-9))
+    return out

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.optimal import dp
 from pymoo_rail.sim import Simulator, Trajectory
@@ -47,7 +48,6 @@ CERTIFICATE_FACTOR = 2.0
 DEFAULT_TIE_J = 100.0
 LAMBDA_MIN_W = 1.0e2
 LAMBDA_MAX_W = 1.0e10
-_J_PER_KWH = 3.6e6
 
 
 @dataclass(frozen=True)
@@ -104,12 +104,15 @@ class OptimalSolver:
     price_shape : array (n_cells,), optional
         Relative price of time per grid cell, scaled by the ``lambda`` search: a journey's timing
         points give each stretch between them its own price (:meth:`set_price_shape`).
+    speed_floor_ms : array (n_nodes,), optional
+        Lowest speed allowed at each grid node (0: none): a journey's minimum speeds at its timing
+        points (:meth:`set_speed_floor`).
     """
 
     def __init__(self, case: Case, dx_m: float | None = None, n_speeds: int = DEFAULT_N_SPEEDS,
                  max_targets: int = DEFAULT_MAX_TARGETS, time_tol_s: float = DEFAULT_TIME_TOL_S,
                  top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J, certify: bool = True,
-                 price_shape: np.ndarray | None = None):
+                 price_shape: np.ndarray | None = None, speed_floor_ms: np.ndarray | None = None):
         if isinstance(n_speeds, bool) or not isinstance(n_speeds, (int, np.integer)) or n_speeds < 3:
             raise ValueError(f"n_speeds = {n_speeds!r}: must be an integer >= 3")
         if isinstance(max_targets, bool) or not isinstance(max_targets, (int, np.integer)) or max_targets < 1:
@@ -134,6 +137,9 @@ class OptimalSolver:
         self._history: list[_Solve] = []  # every solve so far: time depends on lambda alone
         self.price_shape: np.ndarray | None = None
         self.set_price_shape(price_shape)
+        self.speed_floor_ms: np.ndarray | None = None
+        self._floor_k: np.ndarray | None = None
+        self.set_speed_floor(speed_floor_ms)
 
     def set_price_shape(self, price_shape: np.ndarray | None) -> None:
         """Price time per cell as ``lambda x price_shape`` (None: one price everywhere).
@@ -151,8 +157,36 @@ class OptimalSolver:
         if self._coarse is not None:
             self._coarse.set_price_shape(price_shape)
 
+    def set_speed_floor(self, speed_floor_ms: np.ndarray | None) -> None:
+        """Forbid runs slower than ``speed_floor_ms`` (n_nodes,) at each grid node (None: no floor).
+
+        The DP rounds each floor up to its next speed node, so every run found holds it; a floor
+        above the braking envelope leaves no run. Earlier solves no longer guide the search.
+        """
+        floor_k = None
+        if speed_floor_ms is not None:
+            floor = np.asarray(speed_floor_ms, dtype=float)
+            n_nodes = self.simulator.grid.n_nodes
+            if floor.shape != (n_nodes,) or not np.all(np.isfinite(floor) & (floor >= 0)):
+                raise ValueError(f"speed_floor_ms: needs {n_nodes} finite values >= 0, one per grid node")
+            speed_floor_ms = floor if np.any(floor > 0) else None
+            if speed_floor_ms is not None:
+                floor_k = dp.speed_floor_nodes(self.simulator.model, floor, self.n_speeds, self.top_bias)
+        self.speed_floor_ms = speed_floor_ms
+        self._floor_k = floor_k
+        self._history = []
+        if self._coarse is not None:
+            self._coarse.set_speed_floor(speed_floor_ms)
+
+    def holds_speed_floor(self, speed_ms: np.ndarray) -> bool:
+        """Whether a run's node speeds hold the speed floor (always true without one)."""
+        if self.speed_floor_ms is None:
+            return True
+        return bool(np.all(speed_ms[: self.speed_floor_ms.shape[0]] >= self.speed_floor_ms - 1e-9))
+
     @property
     def dx_m(self) -> float:
+        """Step of the distance grid (m)."""
         return self.simulator.grid.dx_m
 
     def min_running_time_s(self) -> float:
@@ -168,7 +202,7 @@ class OptimalSolver:
         self.n_solves += 1
         prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, self.tie_j,
-                       self._value)
+                       self._value, self._floor_k)
         solution = self._record(lambda_w, run)
         self._history.append(solution)
         return solution
@@ -222,7 +256,7 @@ class OptimalSolver:
             p = moved(j)
             out = self.simulator.run_batch(p[None])[0]
             time = out[OUT_RUNNING_TIME_S] if out[OUT_REACHED] > 0 else math.inf
-            return p, out[OUT_NET_KWH] * _J_PER_KWH, time
+            return p, out[OUT_NET_KWH] * J_PER_KWH, time
 
         runs = {slow_end: run(slow_end), fast_end: run(fast_end)}
         if not runs[slow_end][2] >= target >= runs[fast_end][2]:
@@ -236,6 +270,8 @@ class OptimalSolver:
             else:
                 hi = mid
         p, energy, time = min((runs[lo], runs[hi]), key=lambda r: abs(r[2] - target))
+        if not self.holds_speed_floor(self.simulator.run(p).speed_ms):
+            return None  # coasting earlier passes a timing point too slowly
         return _Solve(solution.lambda_w, p, None, energy, time, solution.value_j)
 
     def _cold_guess_w(self, target: float) -> float:
@@ -394,7 +430,7 @@ class OptimalSolver:
         if self._coarse is None:
             self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
                                          self.time_tol_s, self.top_bias, self.tie_j, certify=False,
-                                         price_shape=self.price_shape)
+                                         price_shape=self.price_shape, speed_floor_ms=self.speed_floor_ms)
             self._coarse.simulator = self.simulator  # same grid and model: share them
             self._coarse._min_time_s = self._min_time_s
         coarse = self._coarse
@@ -404,19 +440,19 @@ class OptimalSolver:
             other = coarse.solve_price(solution.lambda_w)
         slope_w = 0.5 * (solution.lambda_w + other.lambda_w)
         moved_j = other.energy_j + slope_w * (other.time_s - solution.time_s)
-        return CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) / _J_PER_KWH
+        return CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) / J_PER_KWH
 
     def trajectory(self, solution: _Solve) -> Trajectory:
         """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
         tr = self.simulator.run(solution.program)
         speeds = tr.speed_ms if solution.speeds is None else solution.speeds
         mismatch = float(np.max(np.abs(tr.speed_ms - speeds[: tr.speed_ms.shape[0]])))
-        energy_j = tr.energy.net_kwh * _J_PER_KWH
+        energy_j = tr.energy.net_kwh * J_PER_KWH
         if (not tr.reached or tr.speed_ms.shape[0] != speeds.shape[0] or mismatch > 1e-9
                 or abs(energy_j - solution.energy_j) > 1e-9 * max(abs(energy_j), 1.0)):
             raise RuntimeError(f"the simulator's replay of the optimal controls departs from the solver's run "
                                f"(max speed difference {mismatch:.3g} m/s, energy {tr.energy.net_kwh:.6f} against "
-                               f"{solution.energy_j / _J_PER_KWH:.6f} kWh): solver and simulator disagree")
+                               f"{solution.energy_j / J_PER_KWH:.6f} kWh): solver and simulator disagree")
         summary = dict(tr.summary, lambda_w=solution.lambda_w, dp_value_j=solution.value_j,
                        n_speeds=float(self.n_speeds), dx_m=float(self.dx_m),
                        adjusted=float(solution.speeds is None))
@@ -438,7 +474,7 @@ class OptimalSolver:
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
                                    f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
-                                  self.top_bias, self.tie_j, self.certify, self.price_shape)
+                                  self.top_bias, self.tie_j, self.certify, self.price_shape, self.speed_floor_ms)
             return finer.profile(running_time_s, solution.lambda_w)
         tr = self.trajectory(solution)
         if self.certify:
@@ -522,7 +558,7 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
         tr = solver.profile(float(t), lambda_guess_w=guess)
         guess = tr.summary["lambda_w"]
         e = tr.energy
-        slope = guess / _J_PER_KWH
+        slope = guess / J_PER_KWH
         rows.append({"running_time_s": tr.running_time_s, "energy_kwh": e.net_kwh, "requested_time_s": float(t),
                      "traction_kwh": e.traction_kwh, "regen_kwh": e.regen_kwh, "aux_kwh": e.aux_kwh,
                      "lambda_kwh_per_s": slope,

@@ -96,9 +96,11 @@ class PacedTrain:
 
     @property
     def n_var(self) -> int:
+        """Number of shape variables."""
         return self.encoding.n_var
 
     def paced(self, shapes: np.ndarray, time_tol_s: float = DEFAULT_TIME_TOL_S) -> PacedRuns:
+        """The runs of the speed-code shapes, each scaled to its running time (:func:`solve_pace`)."""
         return solve_pace(self.simulator, self.encoding, shapes, time_tol_s)
 
     def clocked(self, program: np.ndarray, departure_s: float) -> coop.ClockedRun:
@@ -134,14 +136,17 @@ class CooperativeSolution:
 
     @property
     def traction_kwh(self) -> float:
+        """Traction energy of both trains (kWh)."""
         return self.traction_a_kwh + self.traction_b_kwh
 
     @property
     def net_kwh(self) -> float:
+        """Traction energy minus the shared regenerated energy (kWh)."""
         return self.traction_kwh - self.shared_kwh
 
     @property
     def feasible(self) -> bool:
+        """True when every constraint is met."""
         return all(v <= 0.0 for v in self.constraints.values())
 
 
@@ -222,6 +227,7 @@ class CooperativeTrainsProblem(Problem):
 
     @property
     def departures_s(self) -> tuple[float, float]:
+        """Departure times of the leading and the trailing train (s)."""
         return 0.0, self.offset_s
 
     def simulate(self, X: np.ndarray) -> dict:
@@ -285,6 +291,7 @@ class CooperativeTrainsProblem(Problem):
         return coop.power_profiles(runs, ("a", "b"), 1.0, self.time_step_s)
 
     def describe(self) -> str:
+        """One line naming the case, the offset and the variables."""
         a, b = self.trains
         return (f"{type(self).__name__}({self.case.name}, offset {self.offset_s:g} s, {self.encoding}: {a.n_var} + "
                 f"{b.n_var} genes, paced to {a.case.planned_time_s:g} s and {b.case.planned_time_s:g} s)")

@@ -37,6 +37,7 @@ class ExactBaseline:
 
     @property
     def energies_kwh(self) -> tuple[float, ...]:
+        """Traction energy of each train's exact optimum (kWh)."""
         return tuple(t.energy.traction_kwh for t in self.trajectories)
 
     @property

@@ -143,6 +143,7 @@ class PartialProblem(Problem):
                          xl=problem.xl[free].copy(), xu=problem.xu[free].copy(), vtype=float)
 
     def full(self, x: np.ndarray) -> np.ndarray:
+        """Full decision vectors: the reference vector with the free variables taken from ``x``."""
         x = np.atleast_2d(np.asarray(x, dtype=float))
         X = np.repeat(self.x_ref[None, :], x.shape[0], axis=0)
         X[:, self.free] = x

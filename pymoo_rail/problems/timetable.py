@@ -33,6 +33,7 @@ from dataclasses import replace
 import numpy as np
 from pymoo.core.problem import Problem
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, Leg
 from pymoo_rail.problems.cooperative import PacedTrain, finite_number
 from pymoo_rail.problems.speed_profile import check_decisions
@@ -166,6 +167,7 @@ class TimetableProblem(Problem):
 
     @property
     def period_s(self) -> float:
+        """Period of the timetable: trains x headway (s)."""
         return self.n_trains * self.headway_s
 
     def departures_s(self, X: np.ndarray) -> np.ndarray:
@@ -228,7 +230,7 @@ class TimetableProblem(Problem):
                     separation[r] = max(separation[r], excess)
             t0, n_bins = coop.clock_span(journeys, self.time_step_s)
             trac, regen = coop.power_bins(journeys, t0, self.time_step_s, n_bins)
-            shared[r] = coop.shared_energy_bins(trac, regen, self.transmission_efficiency).sum() / coop.J_PER_KWH
+            shared[r] = coop.shared_energy_bins(trac, regen, self.transmission_efficiency).sum() / J_PER_KWH
             journeys_all.append(journeys)
         waiting = np.mean([mean_waiting_time_s(departures[:, self.trains_of(d)], self.period_s)
                            for d in range(self.directions)], axis=0)
@@ -245,6 +247,7 @@ class TimetableProblem(Problem):
             out[key] = sim[key]
 
     def describe(self) -> str:
+        """One line naming the case, the trains, the headway and the legs."""
         return (f"TimetableProblem({self.case.name}: {self.n_trains} trains every {self.headway_s:g} s "
                 f"+- {self.window_s:g} s, {self.directions} direction(s), {len(self.legs)} legs, {self.n_var} variables, objectives "
                 f"{', '.join(self.objectives)})")

@@ -42,6 +42,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
@@ -87,10 +88,9 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
 
 # the three full-force steps of ``full_step`` (public for the DP)
 KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
-_J_PER_KWH = 3.6e6
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def full_step(m, v0, cell, kind):
     """Two-stage step over one cell at maximum traction, coasting or maximum braking.
 
@@ -99,7 +99,7 @@ def full_step(m, v0, cell, kind):
     return scaled_step(m, v0, cell, kind, 1.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def _traction(m, v, cell, share):
     """``share`` of the maximum traction, but at least the force that holds the speed (Chen et al.
     (2017): gamma above the holding ratio); exactly the maximum when ``share`` is 1."""
@@ -113,7 +113,7 @@ def _traction(m, v, cell, share):
     return f
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def scaled_step(m, v0, cell, kind, share):
     """:func:`full_step` with the traction step at ``share`` of the maximum force (see ``_traction``)."""
     wl = m.line_force_n[cell]
@@ -135,7 +135,7 @@ def scaled_step(m, v0, cell, kind, share):
     return u1, f, w0, v_half
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def _decel_step(m, v0, cell, decel_ms2):
     """One cell braking at the constant deceleration ``decel_ms2`` (MODE_DECEL).
 
@@ -155,7 +155,7 @@ def _decel_step(m, v0, cell, decel_ms2):
     return u1, f, w0, REGIME_BRAKE
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def _share_above(v0, v1, v_cut):
     """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
     lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
@@ -187,7 +187,7 @@ def new_totals():
     return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     """Keep a step under the braking envelope and name its regime by the force applied.
 
@@ -218,7 +218,7 @@ def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     return u1, f, w0, regime, clamped
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def complete_cell(m, totals, cell, v, u1, f, w0, regime):
     """Finish one cell: standstill inside it, time, energy accounting, comfort.
 
@@ -309,9 +309,9 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
         tr_f[count - 1] = 0.0
         tr_r[count - 1] = REGIME_BRAKE if reached else REGIME_COAST
     t = totals[TOTAL_TIME]
-    out[OUT_TRACTION_KWH] = totals[TOTAL_TRACTION_J] / m.traction_efficiency / _J_PER_KWH
-    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J] / _J_PER_KWH
-    out[OUT_AUX_KWH] = m.aux_power_w * t / _J_PER_KWH
+    out[OUT_TRACTION_KWH] = totals[TOTAL_TRACTION_J] / m.traction_efficiency / J_PER_KWH
+    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J] / J_PER_KWH
+    out[OUT_AUX_KWH] = m.aux_power_w * t / J_PER_KWH
     out[OUT_NET_KWH] = out[OUT_TRACTION_KWH] + out[OUT_AUX_KWH] - out[OUT_REGEN_KWH]
     out[OUT_RUNNING_TIME_S] = t
     out[OUT_STOP_POSITION_M] = stop_pos
@@ -331,7 +331,7 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
     out[OUT_NEUTRAL_TRACTION_J] = totals[TOTAL_NEUTRAL_TRACTION_J]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True, _nrt=False)
 def drive_cell(m, program, totals, i, v, row, hold_speed):
     """One cell of a driving program: the program's control, the envelope, the accounting.
 
@@ -412,7 +412,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     n = m.position_m.shape[0]
     totals = new_totals()
     v = m.initial_speed_ms
-    row = 0
+    row = n - n  # a run-time 0, not the literal: one compiled drive_cell for both loops
     hold_speed = -1.0
     reached = True
     stop_pos = m.position_m[n - 1]
@@ -450,8 +450,8 @@ def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
     totals_b = new_totals()
     v_a = m.initial_speed_ms
     v_b = m.initial_speed_ms
-    row_a = 0
-    row_b = 0
+    row_a = n - n  # run-time zeros, not literals (see run_program)
+    row_b = n - n
     hold_a = -1.0
     hold_b = -1.0
     moving_a = True
@@ -473,8 +473,9 @@ def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
                 stop_b = x1
         if not (moving_a or moving_b):
             break
-    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, 0, record, empty, empty, empty_r)
-    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, 0, record, empty, empty, empty_r)
+    no_count = n - n  # no trace nodes; a run-time 0: one compiled write_summary for every caller
+    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, no_count, record, empty, empty, empty_r)
+    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, no_count, record, empty, empty, empty_r)
 
 
 @njit(cache=True)
@@ -506,17 +507,23 @@ def simulate_batch(m, programs):
     return out
 
 
-@njit(cache=True)
 def simulate_batch_serial(m, programs):
-    """:func:`simulate_batch` in the calling thread: no thread start-up cost for small batches."""
+    """:func:`simulate_batch` in the calling thread: no thread start-up cost for small batches.
+
+    Plain Python around :func:`simulate_serial`: a compiled wrapper would be one more Numba
+    function (and one more copy of the run loops for LLVM) in the first run's compile.
+    """
     out = np.empty((programs.shape[0], N_OUT))
     simulate_serial(m, programs, out)
     return out
 
 
-@njit(cache=True)
 def simulate_trace(m, program):
-    """One run with its full trace: (summary, x, v, t, a, force, regime), trimmed to the run."""
+    """One run with its full trace: (summary, x, v, t, a, force, regime), trimmed to the run.
+
+    Plain Python around :func:`run_program` (see :func:`simulate_batch_serial`); called from
+    Python, ``record`` is typed ``bool``, so the batch kernels' ``run_program`` serves it too.
+    """
     n = m.position_m.shape[0]
     out = np.empty(N_OUT)
     x = np.empty(n)
@@ -525,6 +532,5 @@ def simulate_trace(m, program):
     a = np.empty(n)
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
-    record = n >= 0  # a run-time True: one compiled run_program for both callers (see simulate_batch)
-    count = run_program(m, program, out, record, x, v, t, a, f, r)
+    count = run_program(m, program, out, True, x, v, t, a, f, r)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]

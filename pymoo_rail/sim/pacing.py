@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case
 from pymoo_rail.sim.drivers import gradient_limit_partition, speed_code_programs
 from pymoo_rail.sim.kernel import (
@@ -49,6 +50,14 @@ def split_long_sections(boundaries_m: np.ndarray, max_section_m: float | None) -
     return np.asarray(out)
 
 
+def section_limits_ms(case: Case, boundaries_m: np.ndarray) -> np.ndarray:
+    """The highest speed over each section (m/s): its lowest limit, at most the train's maximum speed."""
+    limits = np.empty(boundaries_m.shape[0] - 1)
+    for k, (a, b) in enumerate(zip(boundaries_m[:-1], boundaries_m[1:])):
+        limits[k] = min(v for s, e, v in case.line.speed_limits if s < b and e > a)
+    return np.minimum(limits, case.train.max_speed_kmh) / KMH_PER_MS
+
+
 @dataclass(frozen=True, eq=False)
 class PacedSpeedCodes:
     """Speed-code shapes of one run, timed by a pace (see the module docstring).
@@ -72,12 +81,8 @@ class PacedSpeedCodes:
     def build(cls, case: Case, max_section_m: float | None = 200.0,
               planned_time_s: float | None = None) -> PacedSpeedCodes:
         """The shape encoding of a single-run case, paced to ``planned_time_s`` (default: its plan)."""
-        line = case.line
-        bounds = split_long_sections(gradient_limit_partition(line), max_section_m)
-        limits = np.empty(bounds.shape[0] - 1)
-        for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
-            limits[k] = min(v for s, e, v in line.speed_limits if s < b and e > a)
-        limits = np.minimum(limits, case.train.max_speed_kmh) / 3.6
+        bounds = split_long_sections(gradient_limit_partition(case.line), max_section_m)
+        limits = section_limits_ms(case, bounds)
         planned = case.planned_time_s if planned_time_s is None else float(planned_time_s)
         if not (np.isfinite(planned) and planned > 0):
             raise ValueError(f"planned_time_s = {planned_time_s!r}: must be a positive number of seconds")
@@ -85,14 +90,17 @@ class PacedSpeedCodes:
 
     @property
     def n_var(self) -> int:
+        """Number of shape variables (one per section)."""
         return self.limits_ms.shape[0]
 
     @property
     def xl(self) -> np.ndarray:
+        """Lower bounds of the shape (0)."""
         return np.zeros(self.n_var)
 
     @property
     def xu(self) -> np.ndarray:
+        """Upper bounds of the shape (1)."""
         return np.ones(self.n_var)
 
     def names(self, label: str = "") -> list[str]:
@@ -153,7 +161,7 @@ class PacedSubsections:
         case, m = simulator.case, simulator.model
         line = case.line
         bounds = gradient_limit_partition(line)
-        caps = np.empty(bounds.shape[0] - 1)
+        caps = section_limits_ms(case, bounds)
         descent = np.zeros(caps.shape[0], dtype=bool)
         change = np.zeros(caps.shape[0], dtype=bool)
         grades = [g for _, _, g in line.gradients]
@@ -165,7 +173,6 @@ class PacedSubsections:
             return grades[-1]
 
         for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
-            caps[k] = min(min(v for s, e, v in line.speed_limits if s < b and e > a), case.train.max_speed_kmh) / 3.6
             cells = (m.position_m[:-1] >= a) & (m.position_m[:-1] < b)
             # type 3 when coasting accelerates the train here even at its highest speed (the line force
             # is the one the train feels: averaged over its length, curves included)
@@ -178,18 +185,22 @@ class PacedSubsections:
 
     @property
     def n_sub(self) -> int:
+        """Number of subsections."""
         return self.caps_ms.shape[0]
 
     @property
     def n_var(self) -> int:
+        """Number of genes: the braking distance and three per subsection."""
         return 1 + 3 * self.n_sub
 
     @property
     def xl(self) -> np.ndarray:
+        """Lower bounds: the shortest braking distance (m), then zeros."""
         return np.concatenate([[self.brake_bounds_m[0]], np.zeros(3 * self.n_sub)])
 
     @property
     def xu(self) -> np.ndarray:
+        """Upper bounds: the longest braking distance (m), then ones."""
         return np.concatenate([[self.brake_bounds_m[1]], np.ones(3 * self.n_sub)])
 
     def names(self, label: str = "") -> list[str]:
@@ -234,6 +245,7 @@ class PacedRuns:
 
     @property
     def running_time_s(self) -> np.ndarray:
+        """Running time of each run (s)."""
         return self.summaries[:, OUT_RUNNING_TIME_S]
 
 

@@ -36,6 +36,7 @@ class Simulator:
 
     @property
     def length_m(self) -> float:
+        """Length of the line (m)."""
         return float(self.case.line.length_m)
 
     def run_batch(self, programs: np.ndarray) -> np.ndarray:
