@@ -7,8 +7,10 @@ integrator and the problem around it from the git history, decodes on-time strat
 kernel rows (traction share ``gamma`` up to the decoded turning speed, then coasting or regenerative
 holding from where the old run entered its last phase, then ``MODE_STOP`` from the decoded braking
 point) and runs them on the kernel. It prints, per strategy and train, the traction and
-regenerated energy and the running time of both, and the largest speed difference. Nothing is
-paced here: the same strategy, two integrators.
+regenerated energy and the running time of both, the largest speed difference, and whether the
+old decoding was physically valid (its feasibility constraint: no force beyond the train's traction
+or braking limit, every exit speed reachable). Nothing is paced here: the same strategy, two
+integrators.
 
 Usage: ``python benchmarks/cooperative_seed_kernel.py [--vectors 8]`` (needs the git history).
 """
@@ -86,9 +88,9 @@ def main() -> None:
         cases = [("example", absolute, np.array(example))] + [
             (f"random {i}", relative, x) for i, x in enumerate(X[on_time][:args.vectors])]
         sims = [Simulator(pair.leg(k)) for k in (0, 1)]
-        print("| strategy | train | traction old / kernel (kWh) | regen old / kernel (kWh) | time old / kernel (s) "
-              "| largest speed difference (km/h) |")
-        print("|---|---|---|---|---|---|")
+        print("| strategy | train | old run valid | traction old / kernel (kWh) | regen old / kernel (kWh) | "
+              "time old / kernel (s) | largest speed difference (km/h) |")
+        print("|---|---|---|---|---|---|---|")
         diffs = []
         for label, problem, x in cases:
             sol = problem.decode(x)
@@ -98,12 +100,17 @@ def main() -> None:
                 n = min(tr_new.speed_ms.shape[0], tr_old.speed_ms.shape[0])
                 dv = 3.6 * float(np.max(np.abs(tr_new.speed_ms[:n] - tr_old.speed_ms[:n])))
                 rel = tr_new.energy.traction_kwh / run.traction_kwh - 1.0
-                diffs.append((rel, tr_new.running_time_s - tr_old.running_time_s))
-                print(f"| {label} | {name} | {run.traction_kwh:.3f} / {tr_new.energy.traction_kwh:.3f} | "
+                s = run.summary
+                valid = s["force_excess_ms2"] <= 1e-3 and s["decode_excess_ms"] <= 1e-9
+                if valid:
+                    diffs.append((rel, tr_new.running_time_s - tr_old.running_time_s, dv))
+                verdict = "yes" if valid else f"no (force {s['force_excess_ms2']:.2g} m/s2 over)"
+                print(f"| {label} | {name} | {verdict} | {run.traction_kwh:.3f} / {tr_new.energy.traction_kwh:.3f} | "
                       f"{run.regen_kwh:.3f} / {tr_new.energy.regen_kwh:.3f} | {tr_old.running_time_s:.2f} / "
                       f"{tr_new.running_time_s:.2f} | {dv:.2f} |")
         rel = np.array(diffs)
-        print(f"\ntraction kernel / old - 1: median {100 * np.median(rel[:, 0]):+.2f} %, range "
+        print(f"\nover the {len(rel)} valid old runs: largest speed difference {rel[:, 2].max():.2f} km/h; "
+              f"traction kernel / old - 1: median {100 * np.median(rel[:, 0]):+.2f} %, range "
               f"{100 * rel[:, 0].min():+.2f} to {100 * rel[:, 0].max():+.2f} %; running time kernel - old: median "
               f"{np.median(rel[:, 1]):+.2f} s, range {rel[:, 1].min():+.2f} to {rel[:, 1].max():+.2f} s")
 

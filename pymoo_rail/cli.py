@@ -718,9 +718,7 @@ def cmd_timetable(args) -> int:
     for i in range(args.trains - 1):
         front[f"shift_{i + 1}_s"] = opt.get("X")[:, i]
     if args.reference:
-        from pymoo_rail.problems.cooperative_baseline import exact_baseline
-
-        reference = args.trains * exact_baseline(case).energy_kwh
+        reference = problem.reference_kwh()
         front["reference_kwh"] = reference
         front["saving_pct"] = 100.0 * (1.0 - front["net_kwh"] / reference)
         _say(f"reference (every train exactly optimal alone, nothing shared): {reference:.3f} kWh")

@@ -143,8 +143,9 @@ class TimetableProblem(Problem):
         if isinstance(directions, bool) or directions not in (1, 2):
             raise ValueError(f"directions = {directions!r}: must be 1 or 2")
         self.directions = int(directions)
-        cases = [case, opposite_direction(case)][:self.directions]
-        self.routes = tuple(self._route(c, max_section_m, dx_m) for c in cases)
+        self.cases = (case, opposite_direction(case))[:self.directions]
+        self.dx_m = dx_m
+        self.routes = tuple(self._route(c, max_section_m, dx_m) for c in self.cases)
         self.legs = self.routes[0]
         self.direction_of = np.arange(self.n_trains) % self.directions
         sizes = [sum(leg.n_var for leg in self.routes[d]) for d in self.direction_of]
@@ -164,6 +165,21 @@ class TimetableProblem(Problem):
         else:
             legs = [(case, 0.0)]
         return tuple(PacedTrain.build(leg, start, max_section_m, dx_m) for leg, start in legs)
+
+    def references_per_train_kwh(self) -> list[float]:
+        """Per direction, one train's exact optimum alone over all legs, nothing shared (kWh).
+
+        Solves each direction's legs with the exact solver on the problem's grid (about a CPU
+        second per direction once compiled)."""
+        from pymoo_rail.problems.cooperative_baseline import exact_baseline
+
+        settings = {} if self.dx_m is None else {"dx_m": self.dx_m}
+        return [exact_baseline(c, **settings).energy_kwh for c in self.cases]
+
+    def reference_kwh(self) -> float:
+        """The reference line (kWh): every train exactly optimal alone in its direction, nothing shared."""
+        per_train = self.references_per_train_kwh()
+        return float(sum(per_train[d] for d in self.direction_of))
 
     @property
     def period_s(self) -> float:

@@ -102,3 +102,14 @@ def test_both_directions_alternate_and_share_across(pair):
     assert down.arrival_s - down.departure_s == pytest.approx(100.0 + both.dwell_s + 190.0, abs=0.05)
     with pytest.raises(ValueError, match=r"directions = 3"):
         TimetableProblem(pair, 2, 120.0, directions=3)
+
+
+@pytest.mark.slow
+def test_reference_counts_each_train_in_its_own_direction(pair):
+    from pymoo_rail.problems.cooperative_baseline import exact_baseline
+    from pymoo_rail.problems.timetable import opposite_direction
+
+    both = TimetableProblem(pair, 3, 120.0, directions=2, dx_m=2.0)
+    up, down = (exact_baseline(c, dx_m=2.0).energy_kwh for c in (pair, opposite_direction(pair)))
+    assert up != pytest.approx(down, rel=1e-3)  # descents become climbs
+    assert both.reference_kwh() == pytest.approx(2 * up + down, rel=1e-12)
