@@ -25,6 +25,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
+
 REPORT = Path(__file__).resolve().parent / "reports" / "optimal.md"
 
 
@@ -53,7 +55,7 @@ def level_case():
 
 def _at(tr, t):
     """Net energy of a run moved to exactly t along the front's slope lambda (kWh)."""
-    return tr.energy.net_kwh + tr.summary["lambda_w"] / 3.6e6 * (tr.running_time_s - t)
+    return tr.energy.net_kwh + tr.summary["lambda_w"] / J_PER_KWH * (tr.running_time_s - t)
 
 
 def timing(case):
@@ -109,8 +111,8 @@ def level_track():
         e = _at(tr, t)
         rows.append({"running time s": t, "closed form kWh": exact.energy_kwh, "DP kWh": e,
                      "difference %": 100 * (e / exact.energy_kwh - 1),
-                     "hold speed km/h (closed form)": exact.hold_speed_ms * 3.6,
-                     "brake speed km/h (closed form)": exact.brake_speed_ms * 3.6})
+                     "hold speed km/h (closed form)": exact.hold_speed_ms * KMH_PER_MS,
+                     "brake speed km/h (closed form)": exact.brake_speed_ms * KMH_PER_MS})
     return pd.DataFrame(rows)
 
 
@@ -126,7 +128,7 @@ def direct_search(case, quick: bool):
         t0 = time.perf_counter()
         hc = hold_coast_search(case, t)
         row = {"running time s": t, "DP kWh": e, "hold-coast kWh": hc.energy_kwh,
-               "hold speed km/h": hc.params[0] * 3.6}
+               "hold speed km/h": hc.params[0] * KMH_PER_MS}
         if not quick:
             th = two_holds_search(case, t, start=hc)
             row["two-holds kWh"] = th.energy_kwh
@@ -147,7 +149,7 @@ def main() -> None:
     matplotlib.use("Agg")
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import optimal_profile
-    from pymoo_rail.optimal.plots import plot_front, plot_profile
+    from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
     from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs
 
     case = load_case("yizhuang")
@@ -190,13 +192,19 @@ def main() -> None:
 
     REPORT.parent.mkdir(parents=True, exist_ok=True)
     bounds = gradient_limit_partition(case.line)
-    codes = Simulator(case).run(speed_code_programs(bounds, np.full(8, 60 / 3.6))[0])
+    codes = Simulator(case).run(speed_code_programs(bounds, np.full(8, 60 / KMH_PER_MS))[0])
     seeds = pd.DataFrame({"running_time_s": [150.0, 149.89, 149.6], "energy_kwh": [19.68, 19.55, 20.43]})
-    plot_front(front, {"60 km/h speed codes (simulator)": [[codes.running_time_s, codes.energy.net_kwh]],
-                       "seed 000 results (own MATLAB model)": seeds},
-               path=REPORT.parent / "optimal_front.png", title="yizhuang: minimum net energy against running time")
-    plot_profile(planned, {"60 km/h speed codes": codes}, path=REPORT.parent / "optimal_profile.png",
-                 title="yizhuang: optimal profile at 150 s")
+    columns = ["running_time_s", "energy_kwh"]
+    fig = plot_fronts({"60 km/h speed codes (simulator)": np.array([[codes.running_time_s, codes.energy.net_kwh]]),
+                       "seed 000 results (own MATLAB model)": seeds[columns].to_numpy()},
+                      objectives=("running_time", "energy"), reference=front[columns], reference_label="optimum (DP)",
+                      title="yizhuang: minimum net energy against running time")
+    save_figure(fig, REPORT.parent / "optimal_front.png")
+    codes_label = f"60 km/h speed codes: {codes.running_time_s:.1f} s, {codes.energy.net_kwh:.2f} kWh"
+    save_figure(plot_speed_profile(planned, case, others=[codes], other_labels=[codes_label],
+                                   title=f"yizhuang: optimal profile at 150 s ({planned.running_time_s:.1f} s, "
+                                         f"{planned.energy.net_kwh:.2f} kWh)"),
+                REPORT.parent / "optimal_profile.png")
     out += ["![front](optimal_front.png)", "", "![profile](optimal_profile.png)", ""]
     REPORT.write_text("\n".join(out))
     print(f"written {REPORT}")

@@ -22,13 +22,15 @@ import time
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
+
 
 def _programs(case, pop: int, seed: int = 0) -> np.ndarray:
     from pymoo_rail.sim import gradient_limit_partition, speed_code_programs
 
     bounds = gradient_limit_partition(case.line)
     rng = np.random.default_rng(seed)
-    return speed_code_programs(bounds, rng.uniform(30 / 3.6, 80 / 3.6, size=(pop, bounds.shape[0] - 1)))
+    return speed_code_programs(bounds, rng.uniform(30 / KMH_PER_MS, 80 / KMH_PER_MS, size=(pop, bounds.shape[0] - 1)))
 
 
 def worker(pop: int, repeats: int) -> dict:

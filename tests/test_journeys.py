@@ -14,6 +14,7 @@ from pymoo_rail.journeys import (
     RunningTimeAllocationProblem,
     allocate_on_fronts,
     allocate_running_time,
+    as_journey,
     convex_front,
     front_energy,
     project_to_budget,
@@ -21,7 +22,7 @@ from pymoo_rail.journeys import (
     strategy_programs,
     supplement_split,
 )
-from pymoo_rail.model import CaseError, InfeasibleCaseError
+from pymoo_rail.model import Case, CaseError, InfeasibleCaseError
 from pymoo_rail.sim import Simulator
 from pymoo_rail.sim import kernel as k
 
@@ -106,7 +107,7 @@ def test_bad_journeys(journey, kwargs, field):
     base = dict(name="j", sections=journey.sections[:2], dwell_s=(30.0,))
     base.update(kwargs)
     with pytest.raises(CaseError) as err:
-        Journey(**base)
+        Journey.from_sections(**base)
     assert err.value.field == field
 
 
@@ -114,7 +115,7 @@ def test_journey_needs_one_train(journey):
     other = journey.sections[1].train.__class__(**{**journey.train.__dict__, "mass_t": 300.0})
     mixed = (journey.sections[0], journey.sections[1].__class__(**{**journey.sections[1].__dict__, "train": other}))
     with pytest.raises(CaseError) as err:
-        Journey(name="mixed", sections=mixed, dwell_s=(30.0,))
+        Journey.from_sections(name="mixed", sections=mixed, dwell_s=(30.0,))
     assert err.value.field == "sections[1].train"
 
 
@@ -255,7 +256,7 @@ def test_metaheuristic_with_repair_approaches_the_exact_split(journey, fronts):
 
 
 def test_callable_front_source_gets_times_above_the_minimum_and_the_flat_out_point(journey):
-    short = Journey(name="two", sections=journey.sections[9:11], dwell_s=(30.0,))
+    short = Journey.from_sections(name="two", sections=journey.sections[9:11], dwell_s=(30.0,))
     seen = []
 
     def source(case, running_times):  # the signature of pymoo_rail.optimal.optimal_front
@@ -276,7 +277,7 @@ def test_callable_front_source_gets_times_above_the_minimum_and_the_flat_out_poi
 
 
 def test_front_cache_keeps_finished_sections(journey, tmp_path):
-    short = Journey(name="two", sections=journey.sections[4:6], dwell_s=(30.0,))
+    short = Journey.from_sections(name="two", sections=journey.sections[4:6], dwell_s=(30.0,))
     calls = []
 
     def source(case, running_times):
@@ -307,7 +308,7 @@ def test_default_fronts_are_the_exact_solver():
 def test_exact_fronts_on_two_sections(journey):
     from pymoo_rail.journeys import section_fronts
 
-    short = Journey(name="two", sections=journey.sections[4:6], dwell_s=(30.0,))
+    short = Journey.from_sections(name="two", sections=journey.sections[4:6], dwell_s=(30.0,))
     exact = section_fronts(short, "optimal", n_times=6)
     simulated = [strategy_front(c) for c in short.sections]
     for fe, fs in zip(exact, simulated):
@@ -327,3 +328,19 @@ def test_exact_fronts_on_two_sections(journey):
     for fc, fe, fs in zip(combined, exact, simulated):
         t = np.linspace(fc.running_time_s.iloc[0], min(fe.running_time_s.iloc[-1], fs.running_time_s.iloc[-1]), 25)
         assert (front_energy(fc, t) <= np.minimum(front_energy(fe, t), front_energy(fs, t)) + 1e-9).all()
+
+
+def test_a_journey_is_a_case_with_legs(journey, fronts):
+    case = journey.case
+    assert isinstance(case, Case) and len(case.legs) == journey.n_sections == 13
+    assert [leg.dwell_s for leg in case.legs] == [30.0] * 12 + [0.0]
+    assert case.line.length_m == journey.length_m and case.planned_time_s == pytest.approx(
+        journey.planned_running_times_s.sum())
+    for k in (0, 9, 12):  # each section is the case's leg
+        assert journey.sections[k].line == case.leg(k).line
+        assert journey.sections[k].line == from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, k, k + 1, 1.0).line
+    total = journey.running_time_s(30 * 60)
+    by_case = allocate_running_time(case, total, fronts=fronts)  # the case itself, no Journey needed
+    by_journey = allocate_running_time(journey, total, fronts=fronts)
+    np.testing.assert_array_equal(by_case.running_times_s, by_journey.running_times_s)
+    assert as_journey(case).stops_m == tuple(s - journey.stops_m[0] for s in journey.stops_m)

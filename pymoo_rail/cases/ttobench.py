@@ -59,7 +59,7 @@ from typing import Any, Union
 import numpy as np
 
 from pymoo_rail.model import Case, CaseError, DavisResistance, ForceCurve, Line, Train
-from pymoo_rail.model.curves import KMH_PER_MS
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.line import CURVE_MODELS
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
@@ -263,6 +263,7 @@ class TTOBenchTrack:
 
     @property
     def length_m(self) -> float:
+        """Length of the track (m): the position of the last stop."""
         return self.stops_m[-1]
 
     def line(self, gradient_model: str = "point_mass", *, curve_model: str = "tang2020",
@@ -361,7 +362,7 @@ def read_track(source: Source) -> TTOBenchTrack:
     curves = _curvatures(data["curvatures"], length, label) if "curvatures" in data else ()
     tunnels = _tunnels(data["tunnels"], length, label) if "tunnels" in data else ()
     if "ETCS braking data" in data:
-        _etcs(data["ETCS braking data"], ("M_NVAVADH", "Kt_int"), label)
+        _etcs(data["ETCS braking data"], _TRACK_ETCS, label)
     altitude = _scalar(data, "altitude", _LENGTH, label, default=0.0)
     return TTOBenchTrack(id=data["metadata"]["id"], stops_m=tuple(stops_m), speed_limits=limits,
                          gradients=gradients, altitude_m=altitude, metadata=dict(data["metadata"]),
@@ -483,6 +484,21 @@ _JOURNEY_COLUMNS = (("position", _LENGTH), ("lower time constraint", _TIME_S), (
                     ("lower speed constraint", _SPEED_KMH), ("upper speed constraint", _SPEED_KMH))
 
 
+_TRACK_ETCS = ("M_NVAVADH", "Kt_int")
+_TRAIN_ETCS = ("A_brake_emergency", "A_brake_service", "K_dry_rst", "K_wet_rst", "T_traction", "T_be", "T_bs",
+               "v_uncertainty")
+
+
+def known_fields() -> dict[str, tuple[str, ...]]:
+    """Every field the importer accepts, by file kind (``track``, ``train``, ``journey``) and for the
+    ETCS sub-objects and the columns of a journey's timing points; anything else is refused."""
+    return {"track": tuple(_TRACK_REQUIRED) + tuple(sorted(_TRACK_OPTIONAL)),
+            "train": tuple(_TRAIN_REQUIRED) + tuple(sorted(_TRAIN_USED | _TRAIN_INFORMATIONAL)),
+            "journey": ("metadata", "timing points"),
+            "track.ETCS braking data": _TRACK_ETCS, "train.ETCS braking data": _TRAIN_ETCS,
+            "journey.timing points": tuple(name for name, _ in _JOURNEY_COLUMNS)}
+
+
 def read_journey(source: Source) -> tuple[str, str | None, list[tuple[float | None, ...]], dict, str]:
     """Read a TTOBench journey file: ``(id, associated track id, rows, metadata, label)``.
 
@@ -551,8 +567,7 @@ def read_train(source: Source, *, train_length_m: float | None = None) -> TTOBen
     counts = {key: _count(data, key, label) for key in ("num seats", "num coaches")}
     tunnel_resistance = _tunnel_resistance(data["tunnel resistance"], label) if "tunnel resistance" in data else ()
     if "ETCS braking data" in data:
-        _etcs(data["ETCS braking data"], ("A_brake_emergency", "A_brake_service", "K_dry_rst", "K_wet_rst",
-                                          "T_traction", "T_be", "T_bs", "v_uncertainty"), label)
+        _etcs(data["ETCS braking data"], _TRAIN_ETCS, label)
     mass_t = _scalar(data, "mass", _MASS_T, label)
     rho = _fraction(data, "rho", label, default=0.0)
     vmax = _scalar(data, "max speed", _SPEED_KMH, label)

@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control.controllers import Controller
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S, Tracker
 from pymoo_rail.model import Case
@@ -55,7 +56,7 @@ class Disturbance:
         """Measurement noise (m/s) at successive control instants."""
         if self.speed_noise_kmh == 0.0:
             return np.zeros(0)
-        return np.random.default_rng(self.noise_seed).normal(0.0, self.speed_noise_kmh / 3.6, _N_NOISE)
+        return np.random.default_rng(self.noise_seed).normal(0.0, self.speed_noise_kmh / KMH_PER_MS, _N_NOISE)
 
 
 def draw_disturbances(n: int, seed: int, ranges: dict | None = None) -> list[Disturbance]:
@@ -91,7 +92,7 @@ def _peak_force(model, traction: bool) -> float:
     """Largest force of a curve over 0-120 km/h (the level the adhesion factor scales)."""
     from pymoo_rail.sim.physics import curve_force
 
-    v = np.linspace(0.0, 120 / 3.6, 241)
+    v = np.linspace(0.0, 120 / KMH_PER_MS, 241)
     if traction:
         return max(curve_force(x, model.traction_breaks_ms, model.traction_coefs, model.traction_max_n,
                                model.traction_max_w) for x in v)

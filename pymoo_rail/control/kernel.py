@@ -24,6 +24,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control.controllers import CTRL_HYSTERESIS, CTRL_PID
 from pymoo_rail.sim.kernel import (
     N_OUT,
@@ -41,7 +42,6 @@ from pymoo_rail.sim.kernel import (
 )
 from pymoo_rail.sim.physics import davis_force, max_braking, max_traction
 
-_MS_TO_KMH = 3.6
 _N_STATE = 4
 # controller state slots
 _S_MODE, _S_INTEGRAL, _S_PREV_E, _S_HAS_PREV = 0, 1, 2, 3
@@ -255,7 +255,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             if n_noise > 0:
                 v_meas = v + noise_ms[k_instant % n_noise]
                 k_instant += 1
-            u_cmd = controller_command(code, params, state, (v_ref[i] - v_meas) * _MS_TO_KMH, t - t_last)
+            u_cmd = controller_command(code, params, state, (v_ref[i] - v_meas) * KMH_PER_MS, t - t_last)
             t_last = t
             while t_next <= t + 1e-12:
                 t_next += period_s

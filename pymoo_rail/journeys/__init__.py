@@ -1,5 +1,8 @@
 """Whole-line journeys: consecutive sections, one train, and the energy-minimal split of the trip time.
 
+A journey is a :class:`~pymoo_rail.model.Case` with one leg per stop-to-stop section; :class:`Journey`
+is its view with stop names and track positions, and every function here takes either.
+
 >>> from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
 >>> from pymoo_rail.journeys import Journey, allocate_running_time, section_fronts
 >>> journey = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
@@ -25,7 +28,7 @@ from pymoo_rail.journeys.fronts import (
     strategy_front,
     strategy_programs,
 )
-from pymoo_rail.journeys.journey import Journey
+from pymoo_rail.journeys.journey import Journey, as_journey, join_lines
 from pymoo_rail.journeys.timing import (
     TimedJourney,
     TimedRun,
@@ -39,7 +42,7 @@ from pymoo_rail.journeys.timing import (
 from pymoo_rail.journeys.timed_problem import TimedSectionProblem
 from pymoo_rail.journeys.problem import BudgetRepair, RunningTimeAllocationProblem, project_to_budget
 
-__all__ = ["Journey", "Allocation", "allocate_running_time", "allocate_on_fronts", "supplement_split",
+__all__ = ["Journey", "as_journey", "join_lines", "Allocation", "allocate_running_time", "allocate_on_fronts", "supplement_split",
            "section_fronts", "marginal_slopes", "strategy_front", "strategy_programs", "convex_front",
            "check_front", "front_energy", "front_slopes", "RunningTimeAllocationProblem", "BudgetRepair",
            "project_to_budget", "DEFAULT_FRONT_SOURCE", "TimingPoint", "TimedJourney", "TimedRun", "TimingError",

@@ -27,7 +27,7 @@ from pymoo_rail.journeys.fronts import (
     front_slopes,
     strategy_front,
 )
-from pymoo_rail.journeys.journey import Journey
+from pymoo_rail.journeys.journey import Journey, as_journey
 from pymoo_rail.model import Case, CaseError, InfeasibleCaseError
 from pymoo_rail.sim import Simulator
 
@@ -50,7 +50,7 @@ _ABOVE_MIN = 0.005  # the flat-out run itself is added from the simulator (it is
 _GRID = "quadratic"  # recorded in front caches: a cache made with another spacing is not reused
 
 
-def section_fronts(journey: Journey, fronts: FrontSource = DEFAULT_FRONT_SOURCE, *, n_times: int = 16,
+def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_SOURCE, *, n_times: int = 16,
                    max_time_factor: float = 1.5, dx_m: float | None = None,
                    running_times: Callable[[Case], np.ndarray] | None = None,
                    cache_path: str | Path | None = None) -> list[pd.DataFrame]:
@@ -83,6 +83,7 @@ def section_fronts(journey: Journey, fronts: FrontSource = DEFAULT_FRONT_SOURCE,
         loses nothing that had finished. The cache keeps the columns ``running_time_s`` and
         ``energy_kwh`` of each convex front.
     """
+    journey = as_journey(journey)
     if isinstance(fronts, str):
         if fronts == "simulated":
             def compute(k: int, case: Case) -> pd.DataFrame:
@@ -238,10 +239,12 @@ class Allocation:
 
     @property
     def running_times_s(self) -> np.ndarray:
+        """Running time of each section (s)."""
         return self.table["running_time_s"].to_numpy(dtype=float)
 
     @property
     def energies_kwh(self) -> np.ndarray:
+        """Net energy of each section (kWh)."""
         return self.table["energy_kwh"].to_numpy(dtype=float)
 
     def marginal_violation(self) -> float:
@@ -282,13 +285,14 @@ def _fronts_for(journey: Journey, fronts: FrontSource | list[pd.DataFrame], **kw
     return section_fronts(journey, fronts, **kwargs)
 
 
-def allocate_running_time(journey: Journey, total_time_s: float,
+def allocate_running_time(journey: Journey | Case, total_time_s: float,
                           fronts: FrontSource = DEFAULT_FRONT_SOURCE, **front_options) -> Allocation:
     """The energy-minimal split of a total running time over a journey's sections.
 
     Parameters
     ----------
-    journey : Journey
+    journey : Journey or Case
+        A journey, or a case with legs (one section per leg).
     total_time_s : float
         Sum of the sections' running times (the trip time minus the dwells; see
         :meth:`Journey.running_time_s`).
@@ -304,15 +308,17 @@ def allocate_running_time(journey: Journey, total_time_s: float,
         Exact on the convex (piecewise-linear) fronts: per-section times and energies, the line
         total and the common marginal price.
     """
+    journey = as_journey(journey)
     convex = _fronts_for(journey, fronts, **front_options)
     times, energies, price = allocate_on_fronts(convex, total_time_s)
     return _allocation(journey, convex, times, energies, "energy-optimal", price)
 
 
-def supplement_split(journey: Journey, total_time_s: float, fronts: FrontSource = DEFAULT_FRONT_SOURCE,
+def supplement_split(journey: Journey | Case, total_time_s: float, fronts: FrontSource = DEFAULT_FRONT_SOURCE,
                      rule: str = "equal", **front_options) -> Allocation:
     """A timetable rule of thumb: the same extra time on every section (``"equal"``) or the same
     percentage of each minimum running time (``"proportional"``), evaluated on the same fronts."""
+    journey = as_journey(journey)
     convex = _fronts_for(journey, fronts, **front_options)
     lo = np.array([f["running_time_s"].iloc[0] for f in convex])
     hi = np.array([f["running_time_s"].iloc[-1] for f in convex])

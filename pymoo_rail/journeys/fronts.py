@@ -15,6 +15,7 @@ from typing import Callable, Sequence, Union
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, CaseError
 from pymoo_rail.sim import Simulator
 from pymoo_rail.sim import kernel as k
@@ -138,7 +139,7 @@ def strategy_front(case: Case, *, dx_m: float | None = None, n_speeds: int = 31,
     points = pd.DataFrame({
         "running_time_s": np.append(times[keep], fastest.running_time_s),
         "energy_kwh": np.append(out[keep, k.OUT_NET_KWH], fastest.energy.net_kwh),
-        "cruise_kmh": np.append(cruise[keep], vmax) * 3.6,
+        "cruise_kmh": np.append(cruise[keep], vmax) * KMH_PER_MS,
         "coast_from_m": np.append(coast_from[keep], length),
     })
     return convex_front(points, f"front of {case.name}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.journeys.timing import TimedJourney, window_start_s, window_end_s
 from pymoo_rail.model import CaseError
 from pymoo_rail.problems import SpeedProfileProblem
@@ -63,6 +64,6 @@ class TimedSectionProblem(SpeedProfileProblem):
                 else:
                     x_m = self.passing[j].position_m - self.start_m
                     t = self.departure_s + float(np.interp(x_m, traj.position_m, traj.time_s))
-                    v = float(np.interp(x_m, traj.position_m, traj.speed_ms)) * 3.6
+                    v = float(np.interp(x_m, traj.position_m, traj.speed_ms)) * KMH_PER_MS
                 extra[i, c] = {"latest": t - bound, "earliest": bound - t, "min_speed": bound - v}[kind]
         out["G"] = np.column_stack([out["G"], extra])

@@ -4,16 +4,16 @@ A TTOBench *journey* file lists timing points ``[position, earliest, latest, min
 (times from the journey's start, ``null`` where unset). Two consecutive points at one position with
 both speed bounds 0 are the arrival at and the departure from an intermediate stop; a point with
 both speed bounds 0 is a stopping point, any other a passing point. The stopping points cut the
-journey into stop-to-stop sections (each a :class:`~pymoo_rail.model.Case`), so one model serves:
-a :class:`~pymoo_rail.journeys.Journey` with its timing points.
+journey into stop-to-stop sections: a :class:`~pymoo_rail.journeys.Journey`, i.e. a
+:class:`~pymoo_rail.model.Case` with one leg per section, with its timing points.
 
 :func:`solve_timed_journey` finds the least-energy run meeting every window. Each section's run is
 the exact solver's optimum for a running time: departures are as early as their windows allow
 (a longer dwell never saves energy), the running time as long as the arrival window and the next
-departure window allow (energy falls with running time), and passing-point windows are met by
-bisection on the section's running time: passing points inside a section share the section's
-single price of time. When one price cannot meet them all (a window that needs a faster first
-part and a slower second part), the function raises :class:`TimingError` naming the point.
+departure window allow (energy falls with running time). Passing points split a section into
+stretches, each with its own price of time, and each missed window gets the ratio of the prices
+around its point that puts the run on the window's bound. Minimum speeds are a speed floor of the
+exact solver at their points. When no run meets a point, :class:`TimingError` names it.
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from pymoo_rail.cases import ttobench
-from pymoo_rail.model import CaseError
+from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.model import CaseError, InfeasibleCaseError
 from pymoo_rail.sim import Trajectory
 
 TIME_TOL_S = 0.5  # the exact solver returns runs within 0.5 s of the request
@@ -52,13 +53,16 @@ class TimingPoint:
 
     @property
     def is_stop(self) -> bool:
+        """True when the point is a stop (speed window 0-0 km/h)."""
         return self.min_speed_kmh == 0.0 and self.max_speed_kmh == 0.0
 
     def time_ok(self, time_s: float, tol_s: float = 1e-6) -> bool:
+        """True when ``time_s`` is inside the time window (within ``tol_s``)."""
         return (self.earliest_s is None or time_s >= self.earliest_s - tol_s) and \
             (self.latest_s is None or time_s <= self.latest_s + tol_s)
 
     def speed_ok(self, speed_kmh: float, tol_kmh: float = 1e-6) -> bool:
+        """True when ``speed_kmh`` is inside the speed window (within ``tol_kmh``)."""
         return (self.min_speed_kmh is None or speed_kmh >= self.min_speed_kmh - tol_kmh) and \
             (self.max_speed_kmh is None or speed_kmh <= self.max_speed_kmh + tol_kmh)
 
@@ -110,6 +114,7 @@ class TimedJourney:
 
     @property
     def timing_points(self) -> tuple[TimingPoint, ...]:
+        """All timing points of the journey, section by section."""
         out: list[TimingPoint] = []
         for section in self.windows:
             out.extend(section)
@@ -154,8 +159,7 @@ def timed_journey_from_ttobench(journey_path: ttobench.Source, track_path: ttobe
         if k > 0:
             arrival = merged[k - 1][-1]
             dwell.append(max(0.0, window_start_s(group[0]) - window_end_s(arrival)))
-    journey = Journey(name=journey_id, sections=tuple(sections), dwell_s=tuple(dwell),
-                      stops_m=tuple(stops), source=sections[0].source)
+    journey = Journey.from_sections(journey_id, sections, dwell, stops, source=sections[0].source)
     return TimedJourney(journey=journey, windows=tuple(tuple(g) for g in merged))
 
 
@@ -241,16 +245,18 @@ class TimedRun:
 
     @property
     def energy_kwh(self) -> float:
+        """Net energy of the whole journey (kWh)."""
         return float(sum(t.energy.net_kwh for t in self.trajectories))
 
     @property
     def all_met(self) -> bool:
+        """True when every timing point's time and speed windows are met."""
         return all(c["time_ok"] and c["speed_ok"] for c in self.checks)
 
 
 def _time_and_speed_at(trajectory: Trajectory, x_m: float) -> tuple[float, float]:
     t = float(np.interp(x_m, trajectory.position_m, trajectory.time_s))
-    v = float(np.interp(x_m, trajectory.position_m, trajectory.speed_ms)) * 3.6
+    v = float(np.interp(x_m, trajectory.position_m, trajectory.speed_ms)) * KMH_PER_MS
     return t, v
 
 
@@ -264,7 +270,7 @@ def check_run(timed: TimedJourney, trajectories: Sequence[Trajectory], departure
             if j == 0:
                 t, v = departures_s[k], 0.0
             elif j == len(group) - 1:
-                t, v = departures_s[k] + traj.running_time_s, float(traj.speed_ms[-1]) * 3.6
+                t, v = departures_s[k] + traj.running_time_s, float(traj.speed_ms[-1]) * KMH_PER_MS
             else:
                 tau, v = _time_and_speed_at(traj, point.position_m - start)
                 t = departures_s[k] + tau
@@ -281,16 +287,26 @@ def limit_time_bound_s(line, start_m: float, end_m: float) -> float:
     for s, e, v in line.speed_limits:
         a, b = max(s, start_m), min(e, end_m)
         if b > a:
-            total += (b - a) / (v / 3.6)
+            total += (b - a) / (v / KMH_PER_MS)
     return total
 
 
 def check_windows_reachable(timed: TimedJourney) -> None:
     """Raise :class:`TimingError` when two timing points' windows leave less time than the speed
-    limits allow between them (a bound independent of the train)."""
+    limits allow between them (a bound independent of the train), or a minimum speed is above the
+    speed limit (or the train's top speed) at its point."""
     for k, group in enumerate(timed.windows):
         start = timed.journey.stops_m[k]
-        line = timed.journey.sections[k].line
+        case = timed.journey.sections[k]
+        line = case.line
+        for p in group[1:-1]:
+            if p.min_speed_kmh:
+                cap = min(case.train.max_speed_kmh, min(v for s, e, v in line.speed_limits
+                                                        if s <= p.position_m - start <= e))
+                if p.min_speed_kmh > cap:
+                    raise TimingError(f"timing point at {p.position_m:g} m", p.min_speed_kmh,
+                                      f"cannot be met: the minimum speed {p.min_speed_kmh:g} km/h is above the "
+                                      f"limit of {cap:g} km/h there")
         for i, p in enumerate(group):
             for q in group[i + 1:]:
                 if p.earliest_s is None or q.latest_s is None:
@@ -302,6 +318,20 @@ def check_windows_reachable(timed: TimedJourney) -> None:
                                       f"{p.position_m} m, {q.position_m - p.position_m:.1f} m take at least "
                                       f"{need:.1f} s at the speed limits, but the windows leave "
                                       f"{q.latest_s - p.earliest_s:.1f} s")
+
+
+def speed_floor_ms(nodes_m: np.ndarray, passing: Sequence[TimingPoint], start_m: float) -> np.ndarray | None:
+    """The passing points' minimum speeds (m/s) at the grid nodes on either side of each point.
+
+    A run is checked at a point by linear interpolation between those two nodes, so a floor on
+    both makes the interpolated speed hold it. None when no point has a minimum speed.
+    """
+    floor = np.zeros(nodes_m.shape[0])
+    for p in passing:
+        if p.min_speed_kmh:
+            i = int(np.clip(np.searchsorted(nodes_m, p.position_m - start_m), 1, nodes_m.shape[0] - 1))
+            floor[i - 1:i + 1] = np.maximum(floor[i - 1:i + 1], p.min_speed_kmh / KMH_PER_MS)
+    return floor if np.any(floor > 0) else None
 
 
 def _passing_times(traj: Trajectory, passing: Sequence[TimingPoint], start_m: float, depart_s: float) -> list[float]:
@@ -330,6 +360,7 @@ def _meet_passing_windows(solver, case, passing: Sequence[TimingPoint], start_m:
     """
     cells_mid = 0.5 * (solver.simulator.grid.position_m[:-1] + solver.simulator.grid.position_m[1:])
     point_x = np.array([p.position_m - start_m for p in passing])
+    solver.set_speed_floor(speed_floor_ms(solver.simulator.grid.position_m, passing, start_m))
     log_ratio = np.zeros(len(passing))
 
     def run(ratios):
@@ -409,7 +440,16 @@ def solve_timed_journey(timed: TimedJourney, *, n_bisect: int = 12, **settings) 
         if t_hi < t_lo:
             raise TimingError(f"section {k} arrival", arr_point, f"needs a running time <= {t_hi:.1f} s; the "
                                                                  f"minimum is {t_min:.1f} s")
-        best = _meet_passing_windows(solver, case, passing, timed.journey.stops_m[k], depart, t_hi, n_bisect)
+        try:
+            best = _meet_passing_windows(solver, case, passing, timed.journey.stops_m[k], depart, t_hi, n_bisect)
+        except InfeasibleCaseError as err:
+            floors = [p for p in passing if p.min_speed_kmh]
+            if not floors:
+                raise
+            raise TimingError(f"timing point at {floors[0].position_m:g} m", floors[0].min_speed_kmh,
+                              f"no run of section {k} holds the minimum speeds "
+                              f"({', '.join(f'{p.min_speed_kmh:g} km/h at {p.position_m:g} m' for p in floors)}) "
+                              f"and reaches the platform: {err}") from None
         trajectories.append(best)
         departures.append(depart)
         arrival_prev = depart + best.running_time_s

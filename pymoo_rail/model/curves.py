@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.errors import CaseError, check_number
 
-KMH_PER_MS = 3.6
 
 
 @dataclass(frozen=True)

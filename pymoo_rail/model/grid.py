@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pymoo_rail.model.case import Case
-from pymoo_rail.model.curves import KMH_PER_MS
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.errors import CaseError
 from pymoo_rail.model.train import GRAVITY_MS2
 
@@ -49,6 +49,7 @@ class TrackGrid:
 
     @property
     def n_nodes(self) -> int:
+        """Number of grid nodes (cells + 1)."""
         return self.position_m.shape[0]
 
     @property

@@ -12,7 +12,8 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 from pymoo_rail.model.case import Case, Leg
-from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
+from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.model.curves import DavisResistance, ForceCurve
 from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pymoo_rail.model.curves import KMH_PER_MS, DavisResistance, ForceCurve
+from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.model.curves import DavisResistance, ForceCurve
 from pymoo_rail.model.errors import CaseError, check_number
 
 GRAVITY_MS2 = 9.81
@@ -60,6 +61,7 @@ class Train:
 
     @property
     def mass_kg(self) -> float:
+        """Mass (kg)."""
         return self.mass_t * 1000.0
 
     @property
@@ -69,8 +71,10 @@ class Train:
 
     @property
     def max_speed_ms(self) -> float:
+        """Maximum speed (m/s)."""
         return self.max_speed_kmh / KMH_PER_MS
 
     @property
     def weight_kn(self) -> float:
+        """Weight ``m g`` (kN)."""
         return self.mass_kg * GRAVITY_MS2 / 1000.0

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case
 
 
@@ -73,17 +74,17 @@ def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
     a_max = train.max_accel_ms2 if train.max_accel_ms2 is not None else math.inf
     d_max = train.max_decel_ms2 if train.max_decel_ms2 is not None else math.inf
     length = case.line.length_m
-    limit = min(min(row[2] for row in case.line.speed_limits), train.max_speed_kmh) / 3.6
+    limit = min(min(row[2] for row in case.line.speed_limits), train.max_speed_kmh) / KMH_PER_MS
 
     def resist(v):
         return a + b * v + c * v * v
 
     def traction(v):
-        f = float(train.traction.force_kn(v * 3.6)[0]) * 1000.0
+        f = float(train.traction.force_kn(v * KMH_PER_MS)[0]) * 1000.0
         return min(f, m * a_max + resist(v))
 
     def braking(v):
-        f = float(train.braking.force_kn(v * 3.6)[0]) * 1000.0
+        f = float(train.braking.force_kn(v * KMH_PER_MS)[0]) * 1000.0
         return min(f, m * d_max - resist(v))
 
     def brake_speed(hold, price):
@@ -125,7 +126,7 @@ def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
     hold, brake, s_a, s_h, s_c, t, e = phases(lam)
     return FlatTrackOptimum(lambda_w=lam, hold_speed_ms=hold, brake_speed_ms=brake, traction_end_m=s_a,
                             coast_start_m=s_a + s_h, brake_start_m=s_a + s_h + s_c, running_time_s=t,
-                            energy_kwh=e / 3.6e6)
+                            energy_kwh=e / J_PER_KWH)
 
 
 def no_resistance_optimum(case: Case, running_time_s: float) -> tuple[float, float]:
@@ -151,5 +152,5 @@ def no_resistance_optimum(case: Case, running_time_s: float) -> tuple[float, flo
     if disc < 0:
         raise ValueError(f"running_time_s = {running_time_s}: below the minimum {math.sqrt(4 * k * case.line.length_m):.2f} s")
     v = (running_time_s - math.sqrt(disc)) / (2 * k)
-    return v, 0.5 * m * v * v / train.traction_efficiency / 3.6e6
+    return v, 0.5 * m * v * v / train.traction_efficiency / J_PER_KWH
 

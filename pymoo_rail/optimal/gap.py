@@ -13,11 +13,11 @@ import math
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.indicators.energy import ENERGY_COLUMN, TIME_COLUMN, as_front, gap_summary
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.optimal.solver import OptimalSolver
 
-_J_PER_KWH = 3.6e6
 
 
 class ReferenceAtTime:
@@ -56,10 +56,10 @@ class ReferenceAtTime:
         else:
             lam = tr.summary["lambda_w"]
             self._last_lambda_w = lam
-            shift_kwh = lam * (tr.running_time_s - key) / _J_PER_KWH
+            shift_kwh = lam * (tr.running_time_s - key) / J_PER_KWH
             bound = tr.summary.get("energy_bound_kwh", math.nan)
             out = {"optimal_kwh": tr.energy.net_kwh + shift_kwh, "energy_bound_kwh": bound + abs(shift_kwh),
-                   "lambda_kwh_per_s": lam / _J_PER_KWH}
+                   "lambda_kwh_per_s": lam / J_PER_KWH}
         self._cache[key] = out
         return out
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pymoo_rail.constants import KMH_PER_MS
+
 
 def plot_timed_run(timed, run):
     """Two panels over track position: speed (with speed bounds) and time (with time windows).
@@ -16,7 +18,7 @@ def plot_timed_run(timed, run):
     fig, (ax_v, ax_t) = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
     for k, traj in enumerate(run.trajectories):
         x = traj.position_m + timed.journey.stops_m[k]
-        ax_v.plot(x / 1000, traj.speed_ms * 3.6, color="C0")
+        ax_v.plot(x / 1000, traj.speed_ms * KMH_PER_MS, color="C0")
         ax_t.plot(x / 1000, traj.time_s + run.departures_s[k], color="C0")
     t_top = max(c["time_s"] for c in run.checks) * 1.05
     for c in run.checks:

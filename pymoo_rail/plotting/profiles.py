@@ -13,6 +13,7 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.plotting.style import LIMIT_COLOR, NEUTRAL_COLOR, REGIME_COLORS, REGIME_NAMES, new_figure
 
 
@@ -52,8 +53,8 @@ def as_trace(run) -> Trace:
                      running_time_s=float(time_s[-1]))
     try:
         return Trace(np.asarray(run.position_m, float), np.asarray(run.time_s, float),
-                     np.asarray(run.speed_ms, float) * 3.6, np.asarray(run.regime, int),
-                     np.asarray(run.limit_ms, float) * 3.6, energy_kwh=float(run.energy.net_kwh),
+                     np.asarray(run.speed_ms, float) * KMH_PER_MS, np.asarray(run.regime, int),
+                     np.asarray(run.limit_ms, float) * KMH_PER_MS, energy_kwh=float(run.energy.net_kwh),
                      running_time_s=float(run.running_time_s))
     except AttributeError:
         raise TypeError(f"cannot plot a {type(run).__name__}: give a Trajectory or its table") from None

@@ -4,10 +4,13 @@ An encoding turns a population of decision vectors into kernel programs. Two fam
 
 - ``SpeedCodes``: one target speed (km/h) per section of a partition of the line (Liu (2019)
   4.3.3): ``"gradient_limit"`` cuts at every gradient, limit and neutral-section change (the
-  non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``
-  (by default 1 km on long sparse lines, whose sections average more than 2 km);
+  non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``;
   ``"equal"`` cuts ``n_sections`` equal pieces (fig. 4-3). Bounds run from a floor to the highest
   limit in the section; sections inside a neutral section are fixed at the floor (coasting).
+  On long sparse lines (sections averaging more than 2 km, ``max_section_m`` not given) each
+  section also gets a coasting point (m): the train heads for its code up to that point and coasts
+  from there to the section's end, so one section holds the optimal structure of a long stretch
+  (reach a speed, hold it, coast into the next limit or the stop) with two variables.
 - ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (Meng et al. (2017) and Tang et al. (2020)),
   by default ``traction, hold, coast`` per speed-limit zone and a final ``brake``.
 - ``BrakingOnset``: the phases of Meng et al. (2017) (traction, cruise, coast) with the braking
@@ -26,6 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, Line
 from pymoo_rail.sim import (
     Simulator,
@@ -39,23 +43,29 @@ from pymoo_rail.sim import (
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.pacing import split_long_sections
 
-KMH_PER_MS = 3.6
 PARTITIONS = ("gradient_limit", "equal")
-# Long sparse lines: a gradient/limit partition whose sections average more than this is cut into
-# sections of at most SPARSE_MAX_SECTION_M unless max_section_m is given (the 48.5 km TTOBench
-# reference would otherwise be one variable: one cruise speed, no coasting).
+# Long sparse lines: a gradient/limit partition whose sections average more than this keeps its
+# sections and gives each a coasting point, unless max_section_m is given (the 48.5 km TTOBench
+# reference: a code and a coasting point, where it had one variable: one cruise speed, no
+# coasting). Cutting such sections into 1 km pieces instead (49 codes on the reference) left NSGA2
+# up to 5 % above the optimum on the reference family: holding a speed over many pieces needs many
+# equal codes (benchmarks/sparse_encoding.py prints both).
 SPARSE_MEAN_SECTION_M = 2000.0
-SPARSE_MAX_SECTION_M = 1000.0
 
 
 @dataclass(frozen=True, eq=False)
 class SpeedCodes:
-    """Speed codes per section; decision variables in km/h."""
+    """Speed codes per section; decision variables in km/h.
+
+    With ``coast_points`` the vector is the codes (km/h), then one coasting point (m) per section,
+    bounded by the section: the train heads for the code up to it and coasts after it.
+    """
 
     boundaries_m: np.ndarray
     xl: np.ndarray
     xu: np.ndarray
     integer: bool = False
+    coast_points: bool = False
 
     name = "speed_codes"
     # every run lands on the platform through the braking envelope
@@ -79,10 +89,10 @@ class SpeedCodes:
             bounds = gradient_limit_partition(line)
             neutral_points = [p for row in line.neutral_sections for p in row]
             bounds = np.unique(np.concatenate([bounds, neutral_points]))
-            if max_section_m is None and (bounds[-1] - bounds[0]) / (bounds.shape[0] - 1) > SPARSE_MEAN_SECTION_M:
-                max_section_m = SPARSE_MAX_SECTION_M
+            coast = max_section_m is None and (bounds[-1] - bounds[0]) / (bounds.shape[0] - 1) > SPARSE_MEAN_SECTION_M
             bounds = split_long_sections(bounds, max_section_m)
         elif partition == "equal":
+            coast = False
             bounds = equal_partition(line, n_sections if n_sections is not None else 10)
         else:
             raise ValueError(f"partition = {partition!r} is unknown (known: {', '.join(PARTITIONS)})")
@@ -102,14 +112,34 @@ class SpeedCodes:
                 k = int(np.argmax(xl > xu))
                 raise ValueError(f"floor_kmh = {floor_kmh!r}: section {k} has no whole km/h code "
                                  f"between {xl[k]} and {xu[k]}")
-        return cls(boundaries_m=bounds, xl=xl, xu=xu, integer=bool(integer))
+        if coast:  # coasting point of each section, inside it (fixed at its end where codes are fixed)
+            fixed = xl == xu
+            xl = np.concatenate([xl, np.where(fixed, bounds[1:], bounds[:-1])])
+            xu = np.concatenate([xu, bounds[1:]])
+            if integer:
+                xl, xu = np.ceil(xl - 1e-9), np.floor(xu + 1e-9)
+        return cls(boundaries_m=bounds, xl=xl, xu=xu, integer=bool(integer), coast_points=bool(coast))
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (one speed code per section)."""
         return self.xl.shape[0]
 
+    @property
+    def n_sections(self) -> int:
+        """Number of sections of the partition (one speed code each)."""
+        return self.boundaries_m.shape[0] - 1
+
+    @property
+    def units(self) -> list[str]:
+        """Unit of each decision variable."""
+        return ["km/h"] * self.n_sections + ["m"] * (self.n_var - self.n_sections)
+
     def programs(self, X: np.ndarray) -> np.ndarray:
-        X = np.asarray(X, dtype=float)
+        """Simulator programs of the speed codes ``X`` (km/h, one row per decision vector)."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if self.coast_points:
+            return self._coasting_programs(X)
         negative = np.argwhere(X < 0)
         if negative.size:  # reported in km/h, the unit it was given in
             idx = tuple(int(i) for i in negative[0])
@@ -119,6 +149,21 @@ class SpeedCodes:
             raise ValueError(f"speed_codes{list(idx)} = {float(X[idx])}: integer codes must be whole km/h "
                              "(use pymoo's integer operators or RoundingRepair)")
         return speed_code_programs(self.boundaries_m, X / KMH_PER_MS)
+
+    def _coasting_programs(self, X: np.ndarray) -> np.ndarray:
+        """Two rows per section: head for the code up to the coasting point, then coast."""
+        n = self.n_sections
+        if X.shape[1] != self.n_var:
+            raise ValueError(f"speed codes with coasting points need {self.n_var} values per run, got {X.shape[1]}")
+        codes = speed_code_programs(self.boundaries_m, X[:, :n] / KMH_PER_MS)
+        coast_m = np.clip(X[:, n:], self.boundaries_m[:-1], self.boundaries_m[1:])
+        programs = np.empty((X.shape[0], 2 * n, 3))
+        programs[:, 0::2, 0] = coast_m
+        programs[:, 0::2, 1:] = codes[:, :, 1:]
+        programs[:, 1::2, 0] = self.boundaries_m[1:]
+        programs[:, 1::2, 1] = k.MODE_COAST
+        programs[:, 1::2, 2] = 0.0
+        return programs
 
     def fixed(self) -> np.ndarray:
         """Mask of genes that cannot change (inside neutral sections)."""
@@ -140,6 +185,7 @@ class SwitchingPoints:
 
     @classmethod
     def build(cls, case: Case, regimes: tuple[str, ...] | None = None) -> SwitchingPoints:
+        """The switching-point encoding of ``case`` (default: a traction-hold-coast cycle per limit zone, then brake)."""
         if regimes is None:
             zones = 1
             limits = [row[2] for row in case.line.speed_limits]
@@ -156,12 +202,15 @@ class SwitchingPoints:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (one switching point per regime change)."""
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of the switching points ``X`` (m, one row per decision vector)."""
         return switching_programs(X, self.regimes, self.length_m)
 
     def fixed(self) -> np.ndarray:
+        """Mask of the genes an algorithm must not change (none)."""
         return np.zeros(self.n_var, dtype=bool)
 
 
@@ -239,13 +288,16 @@ class BrakingOnset:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (switching points, braking onset, deceleration)."""
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of ``X`` (switching points and braking onset in m, deceleration last)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         return braking_programs(X[:, :-1], self.regimes, X[:, -1], self.simulator.length_m)
 
     def fixed(self) -> np.ndarray:
+        """Mask of the genes an algorithm must not change (none)."""
         return np.zeros(self.n_var, dtype=bool)
 
     def run_batch(self, programs: np.ndarray) -> np.ndarray:

@@ -32,11 +32,11 @@ import numpy as np
 import pandas as pd
 from numba import njit
 
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.sim.kernel import trace_cell_energies
 from pymoo_rail.sim.physics import KernelModel
 from pymoo_rail.sim.trajectory import Trajectory
 
-J_PER_KWH = 3.6e6
 
 
 @njit(cache=True)
@@ -179,14 +179,17 @@ class ClockedRun:
 
     @property
     def arrival_s(self) -> float:
+        """Arrival time on the common clock (s)."""
         return self.departure_s + float(self.time_s[-1])
 
     @property
     def traction_kwh(self) -> float:
+        """Traction energy of the run (kWh)."""
         return float(self.traction_j.sum() / J_PER_KWH)
 
     @property
     def regen_kwh(self) -> float:
+        """Regenerated energy of the run (kWh)."""
         return float(self.regen_j.sum() / J_PER_KWH)
 
 

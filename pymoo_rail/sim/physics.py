@@ -12,7 +12,9 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
+from pymoo_rail.sim.jit import inlined
 
 
 class KernelModel(NamedTuple):
@@ -66,7 +68,7 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
         brake_breaks_ms=bb, brake_coefs=bc, brake_max_n=bf, brake_max_w=bp,
         regen_max_n=train.regen_max_force_kn * 1000.0 if train.regen_max_force_kn is not None else math.inf,
         regen_max_w=train.regen_max_power_kw * 1000.0 if train.regen_max_power_kw is not None else math.inf,
-        regen_min_speed_ms=train.regen_min_speed_kmh / 3.6,
+        regen_min_speed_ms=train.regen_min_speed_kmh / KMH_PER_MS,
         max_accel_ms2=train.max_accel_ms2 if train.max_accel_ms2 is not None else math.inf,
         max_decel_ms2=train.max_decel_ms2 if train.max_decel_ms2 is not None else math.inf,
         traction_efficiency=train.traction_efficiency, regen_efficiency=train.regen_efficiency,
@@ -79,13 +81,13 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
     )
     envelope = braking_envelope(model)
     if model.initial_speed_ms > envelope[0]:
-        raise InfeasibleCaseError("run.initial_speed_kmh", case.initial_speed_ms * 3.6,
-                                  f"is above the braking envelope at the start ({envelope[0] * 3.6:.3f} km/h): "
+        raise InfeasibleCaseError("run.initial_speed_kmh", case.initial_speed_ms * KMH_PER_MS,
+                                  f"is above the braking envelope at the start ({envelope[0] * KMH_PER_MS:.3f} km/h): "
                                   "no braking meets the limits ahead", case.name)
     return model._replace(envelope_ms=envelope)
 
 
-@njit(cache=True, inline="always")
+@inlined
 def curve_force(v, breaks, coefs, max_n, max_w):
     """Piecewise polynomial force limit at speed v, capped by a force and a power."""
     k = 0
@@ -106,13 +108,13 @@ def curve_force(v, breaks, coefs, max_n, max_w):
     return f
 
 
-@njit(cache=True, inline="always")
+@inlined
 def davis_force(m, v):
     """Basic running resistance W0(v) in N."""
     return m.davis_a_n + (m.davis_b_nsm + m.davis_c_ns2m2 * v) * v
 
 
-@njit(cache=True, inline="always")
+@inlined
 def max_traction(m, v, cell):
     """Largest usable traction force in a cell: the curve, the acceleration cap, neutral sections."""
     if m.neutral[cell] != 0:
@@ -126,7 +128,7 @@ def max_traction(m, v, cell):
     return f
 
 
-@njit(cache=True, inline="always")
+@inlined
 def max_braking(m, v, cell):
     """Largest usable braking force in a cell: the curve and the deceleration cap."""
     f = curve_force(v, m.brake_breaks_ms, m.brake_coefs, m.brake_max_n, m.brake_max_w)
@@ -138,7 +140,7 @@ def max_braking(m, v, cell):
     return f
 
 
-@njit(cache=True, inline="always")
+@inlined
 def electric_braking_capped(m, v, brake_n):
     """The part of a braking force within the motors' regen force and power caps."""
     f = brake_n
@@ -149,24 +151,12 @@ def electric_braking_capped(m, v, brake_n):
     return f
 
 
-@njit(cache=True, inline="always")
-def electric_braking(m, v, brake_n):
-    """The part of a braking force the motors take (and regenerate) at speed v; the rest is friction.
-
-    Zero below the regen cut-off speed. (The simulator credits the share of a cell run above the
-    cut-off instead, so that results do not jump with the grid.)
-    """
-    if v < m.regen_min_speed_ms:
-        return 0.0
-    return electric_braking_capped(m, v, brake_n)
-
-
 # Relative tolerance of a landing: the force it needs may exceed what the train has by this much
 # (rounding of the force-speed curves); the braking envelope itself is built with none.
 LANDING_RTOL = 1e-8
 
 
-@njit(cache=True, inline="always")
+@inlined
 def landing_force(m, v0, v1, cell):
     """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
 
@@ -186,7 +176,7 @@ def landing_force(m, v0, v1, cell):
     return f, w0, feasible
 
 
-@njit(cache=True, inline="always")
+@inlined
 def braking_shortfall(m, v0, v1, cell):
     """Braking force a landing from v0 onto v1 needs beyond the train's maximum (N, <= 0 if it can).
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import GRAVITY_MS2, Case, InfeasibleCaseError, TrackGrid
 
 # below this share of its weight as traction (braking) a train cannot climb (brake on) even 10 permille
@@ -57,7 +58,7 @@ def _descent_cause(case: Case, grid: TrackGrid) -> InfeasibleCaseError | None:
     speeds_kmh = np.linspace(0.0, train.max_speed_kmh, 161)
     margin_n = (train.braking.force_kn(speeds_kmh) + train.resistance.force_kn(speeds_kmh, train.mass_t)) * 1000.0
     worst = np.minimum.accumulate(margin_n)  # weakest hold from 0 up to each speed
-    limit_kmh = grid.limit_ms[:-1] * 3.6
+    limit_kmh = grid.limit_ms[:-1] * KMH_PER_MS
     reach = np.clip(np.searchsorted(speeds_kmh, limit_kmh, side="right") - 1, 0, len(speeds_kmh) - 1)
     short = np.flatnonzero(worst[reach] < pull_n)
     if not short.size:

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.sim import kernel as k
 
 
@@ -44,7 +45,8 @@ class Trajectory:
 
     @property
     def speed_kmh(self) -> np.ndarray:
-        return self.speed_ms * 3.6
+        """Speed at each node (km/h)."""
+        return self.speed_ms * KMH_PER_MS
 
     @property
     def accel_variation_ms2(self) -> float:
@@ -62,6 +64,7 @@ class Trajectory:
 
     @property
     def regime_changes(self) -> int:
+        """Number of changes of driving regime over the run."""
         return int(self.summary["regime_changes"])
 
     @property
@@ -74,7 +77,7 @@ class Trajectory:
         return pd.DataFrame({
             "position_m": self.position_m, "time_s": self.time_s, "speed_kmh": self.speed_kmh,
             "speed_ms": self.speed_ms, "accel_ms2": self.accel_ms2, "force_kn": self.force_n / 1000.0,
-            "regime": [k.REGIME_NAMES[r] for r in self.regime], "limit_kmh": self.limit_ms * 3.6,
+            "regime": [k.REGIME_NAMES[r] for r in self.regime], "limit_kmh": self.limit_ms * KMH_PER_MS,
         })
 
 
@@ -84,5 +87,6 @@ def summary_dict(row: np.ndarray) -> dict:
 
 
 def energy_from_summary(row: np.ndarray) -> EnergyBreakdown:
+    """The energy breakdown of one row of the kernel's summary output."""
     return EnergyBreakdown(traction_kwh=float(row[k.OUT_TRACTION_KWH]), regen_kwh=float(row[k.OUT_REGEN_KWH]),
                            aux_kwh=float(row[k.OUT_AUX_KWH]), net_kwh=float(row[k.OUT_NET_KWH]))

@@ -92,6 +92,7 @@ def ship_fronts(names=None, progress: bool = True, remove_old: bool = True) -> l
 
 
 def best_known_path(name: str = METRO_4OBJ) -> Path:
+    """The file of the shipped best-known front of suite problem ``name``."""
     return FRONTS_DIR / f"{name}-best-known-v{BEST_KNOWN_VERSION}.csv"
 
 

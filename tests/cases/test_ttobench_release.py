@@ -186,19 +186,41 @@ def test_every_track_with_its_train_first_to_last_stop(track, train):
     _solve_line(track, train, n_gen=20)
 
 
-def test_long_sparse_lines_get_one_speed_code_per_km_and_dense_lines_keep_their_partition():
+def test_long_sparse_lines_get_coasting_points_or_1_km_codes_and_dense_lines_keep_their_partition():
     from pymoo_rail.cases import load_case
     from pymoo_rail.problems.encodings import SpeedCodes
     from pymoo_rail.sim import gradient_limit_partition
 
     reference = quietly(from_ttobench, RELEASE / "tracks" / "00_reference.json",
                         RELEASE / "trains" / "NL_Intercity_VIRM6.json", 0, -1, 1600.0)
-    codes = SpeedCodes.build(reference)
-    assert codes.n_var == 49 and np.max(np.diff(codes.boundaries_m)) <= 1000.0  # was 1 variable
+    codes = SpeedCodes.build(reference)  # one 48.5 km section: a code and a coasting point (was 1 variable)
+    assert codes.coast_points and codes.n_var == 2 and codes.units == ["km/h", "m"]
+    assert list(codes.xl) == [10.0, 0.0] and list(codes.xu) == [140.0, 48531.0]
     assert SpeedCodes.build(reference, max_section_m=5000.0).n_var == 10  # an explicit choice wins
+    wind = quietly(from_ttobench, RELEASE / "tracks" / "00_var_speed_limit_wind.json",
+                   RELEASE / "trains" / "NL_Intercity_VIRM6.json", 0, -1, 1000.0)
+    six = SpeedCodes.build(wind)  # six sections averaging 3.3 km
+    assert six.coast_points and six.n_var == 12 and list(six.boundaries_m) == [0, 2000, 9000, 11000, 12000, 18000,
+                                                                                 20000]
     for name in ("wuguang-crh3", "yizhuang"):  # sections average 1.7 km and 280 m: unchanged
         case = load_case(name)
         assert SpeedCodes.build(case).n_var == len(gradient_limit_partition(case.line)) - 1 + (
             len(np.unique(np.concatenate([gradient_limit_partition(case.line),
                                           [p for r in case.line.neutral_sections for p in r]])))
             - len(gradient_limit_partition(case.line)))
+
+
+def test_a_coasting_point_makes_the_train_coast_from_there():
+    from pymoo_rail.sim import kernel
+
+    case = quietly(from_ttobench, RELEASE / "tracks" / "00_reference.json",
+                   RELEASE / "trains" / "NL_Intercity_VIRM6.json", 0, -1, 1700.0)
+    problem = SpeedProfileProblem(case, objectives=("energy",))
+    traj = problem.trajectory(np.array([120.0, 40000.0]))
+    before, after = traj.position_m < 40000.0, traj.position_m >= 40000.0
+    assert np.max(traj.speed_ms[before]) * 3.6 == pytest.approx(120.0, abs=0.01)  # reaches and holds 120
+    braking = traj.regime == kernel.REGIME_BRAKE
+    assert np.all(traj.regime[after & ~braking] == kernel.REGIME_COAST)  # coasts, then brakes at the end
+    assert np.all(np.diff(traj.speed_ms[after]) <= 1e-12) and traj.reached
+    with pytest.raises(Exception, match="variable 1 = 50000.0 m is outside"):
+        problem.evaluate(np.array([[120.0, 50000.0]]))

@@ -122,13 +122,27 @@ def test_a_binding_passing_window_gets_its_own_price_and_is_met():
     assert run.energy_kwh > free_run.energy_kwh  # the window costs energy
 
 
+def test_no_reading_of_the_public_journey_makes_its_last_stretch_reachable():
+    # TTOBench's journey README: times are measured from the start of the journey (s, cumulative),
+    # positions are track coordinates in the track's direction. Read the other way round (positions
+    # from Wil), the last 9556.1 m are the first 9556.1 m of the track run backwards: still too long.
+    assert _limit_time_s(20000.0, 29556.1) == pytest.approx(345.4, abs=0.1)
+    assert _limit_time_s(0.0, 29556.1 - 20000.0) > 250.0
+    # at the head or the tail of a train: the deficit is 95 s, about 2.8 km at 105 km/h
+    assert (_limit_time_s(20000.0, 29556.1) - 250.0) * 105 / 3.6 > 2700.0
+
+
 @pytest.mark.slow
-def test_stgallen_wil_with_a_reachable_window_at_20000_m_is_solved_within_every_window():
+def test_stgallen_wil_as_first_published_is_solved_within_every_window():
+    # TTOBench commit b33a3ff published the journey ending at 25000 m; the review commit 7d62ff9
+    # moved the arrival to the track's end (29556.1 m) and kept its window 1400-1450 s, which made
+    # the last stretch unreachable. With the arrival at 25000 m every window is met (14 s CPU).
     data = json.loads(JOURNEY.read_text())
-    data["timing points"]["values"][4][1:3] = [1040, 1100]  # the public 1200-1250 s cannot be met
+    data["timing points"]["values"][-1][0] = 25000
     run = solve_timed_journey(timed(data))
     assert run.all_met
     assert [c["time_ok"] and c["speed_ok"] for c in run.checks] == [True] * 6
+    assert run.departures_s == (0.0, 800.0)
     for traj in run.trajectories:
         assert traj.reached and traj.speed_ms[-1] == pytest.approx(0.0, abs=1e-9)
 
@@ -171,3 +185,41 @@ def test_toml_journey_reads_like_the_ttobench_file(tmp_path):
     with pytest.raises(CaseError, match="unknown key") as err:
         timed_journey_from_toml(path)
     assert err.value.field == "timing_points[6].when"
+
+
+def _min_speed_journey(min_kmh):
+    # Yizhuang stops 9 -> 10; the free optimum passes 17557 m (1800 m into the section) coasting
+    # at about 47 km/h, so a minimum speed of 60 km/h there binds
+    return timed(_yizhuang_journey([[15757, 0, 0, 0, 0], [17557, None, None, min_kmh, None],
+                                    [18022, 160, 170, 0, 0]]), YIZHUANG, BEIJING)
+
+
+def test_the_exact_solve_enforces_a_binding_minimum_speed():
+    free = solve_timed_journey(_min_speed_journey(None), dx_m=5.0)
+    v_free = float(np.interp(1800.0, free.trajectories[0].position_m, free.trajectories[0].speed_ms)) * 3.6
+    assert v_free < 55.0  # the bound below binds
+    run = solve_timed_journey(_min_speed_journey(60.0), dx_m=5.0)
+    traj = run.trajectories[0]
+    v = float(np.interp(1800.0, traj.position_m, traj.speed_ms)) * 3.6
+    assert 60.0 <= v < 62.0  # held, by at most a speed node more than asked
+    assert run.all_met and traj.running_time_s == pytest.approx(170.0, abs=0.5)
+    assert run.energy_kwh > free.energy_kwh  # the bound costs energy
+    assert np.all(traj.speed_ms * 3.6 <= 80.0 + 1e-6) and traj.speed_ms[-1] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_minimum_speed_above_the_speed_limit_is_refused_naming_the_point():
+    with pytest.raises(TimingError, match="minimum speed 85 km/h.*limit of 80 km/h") as err:
+        solve_timed_journey(_min_speed_journey(85.0), dx_m=5.0)
+    assert err.value.field == "timing point at 17557 m"
+
+
+def test_the_problem_form_makes_a_run_below_a_minimum_speed_infeasible():
+    from pymoo_rail.journeys.timed_problem import TimedSectionProblem
+
+    problem = TimedSectionProblem(_min_speed_journey(60.0), 0)
+    column = problem.n_ieq_constr - 3  # min speed, then the arrival window's latest and earliest
+    slow = np.full(problem.n_var, 30.0)  # speed codes: 30 km/h all the way
+    fast = problem.xu.copy()  # flat out: above 60 km/h at 1800 m
+    G = problem.evaluate(np.vstack([slow, fast]), return_values_of=["G"])
+    assert G[0, column] == pytest.approx(30.0, abs=0.5)  # 60 km/h asked, 30 km/h run
+    assert G[1, column] < 0.0

@@ -8,7 +8,6 @@ from pymoo_rail.sim import Simulator
 from pymoo_rail.sim import cooperation as coop
 from pymoo_rail.sim.pacing import PacedSpeedCodes, solve_pace, split_long_sections
 
-J_PER_KWH = 3.6e6
 
 
 @pytest.fixture(scope="module")
