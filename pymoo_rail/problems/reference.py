@@ -262,9 +262,10 @@ def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = N
 
     Every node is solved twice: in one sweep over the running times (each solve warm-started from
     the last) and alone. The lower run at the requested time is kept, and the node's bound is raised
-    to at least the difference of the two: a warm-started sweep can settle on a worse run than the
-    same solve alone (on yizhuang at 171.6 s: 9.115 against 8.978 kWh, with a solver bound of 0.011
-    kWh), so where they disagree the solver's own bound is not trusted.
+    to at least the difference of the two: a warm-started sweep can settle on a worse run than a
+    solve started elsewhere (yizhuang, 17 nodes: 9.115 kWh at 171.6 s with a solver bound of 0.011
+    kWh, while the solver alone at 171.1 s reached 9.034 kWh), so where they disagree the solver's
+    own bound is not trusted.
     """
     from pymoo_rail.optimal import OptimalSolver, min_running_time, optimal_front
     from pymoo_rail.optimal.solver import DEFAULT_N_SPEEDS
