@@ -43,6 +43,8 @@ def test_speed_ratios():
     theirs = pd.DataFrame([{"case": "a", "solver": "x", "energy_kwh": 100.0, "cpu_s": 8.0, "source": "run here"}])
     r = peers.speed_ratios(ours, theirs).iloc[0]
     assert r["cpu_ratio"] == pytest.approx(4.0) and r["energy_diff_pct"] == pytest.approx(1.0)
+    published = theirs.assign(source="published")
+    assert peers.speed_ratios(ours, published)["cpu_ratio"].isna().all()  # another machine's time
 
 
 @pytest.mark.slow
