@@ -41,6 +41,7 @@ from pymoo_rail.sim.kernel import (
     full_step,
     share_above,
 )
+from pymoo_rail.sim.jit import inlined_internal
 from pymoo_rail.sim.physics import electric_braking_capped, landing_force
 
 INF = math.inf
@@ -115,7 +116,8 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
         u1, f, w0 = br_u, br_f, br_w
     else:
         u1, f, w0 = co_u, co_f, co_w
-    u1, f, w0, _, _ = clamp_to_envelope(m, v0, cell, u1, f, w0, REGIME_COAST)
+    # np.int64(...): a run-time int, not a literal, so the simulator's compiled helpers serve here too
+    u1, f, w0, _, _ = clamp_to_envelope(m, v0, cell, u1, f, w0, np.int64(REGIME_COAST))
     return u1, f, w0
 
 
@@ -164,7 +166,7 @@ def value_position(top_u, u, k_max, bias):
     return node_position(top_u, u, k_max, bias)
 
 
-@njit(cache=True, inline="always")
+@inlined_internal
 def interp_at(v_next, p):
     """Cost-to-go at fractional node index ``p`` (from :func:`value_position`), linear in ``u``."""
     if p < 0.0:
@@ -265,7 +267,7 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
         stride = _n_targets(k_lo, k_hi, max_targets)[1]
         for k in range(k_lo, k_hi + 1, stride):
             target = math.sqrt(node_u(top_u, k, k_max, bias))
-            u1, f, w0 = cell_outcome(m, v0, cell, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+            u1, f, w0 = cell_outcome(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                      br_u, br_f, br_w)
             cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
             if cost < INF:
@@ -281,7 +283,8 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
 def _count_targets(m, n_speeds, max_targets, bias, counts):
     n = m.position_m.shape[0]
     k_max = n_speeds - 1
-    for i in prange(n - 1):
+    for p_cell in prange(n - 1):
+        i = np.int64(p_cell)  # prange counts in uint64: the int64 cell index of every other caller
         top0 = m.envelope_ms[i] ** 2
         top1 = m.envelope_ms[i + 1] ** 2
         for j in range(n_speeds):
@@ -300,7 +303,8 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
     n = m.position_m.shape[0]
     k_max = n_speeds - 1
     aux = m.aux_power_w
-    for i in prange(n - 1):
+    for p_cell in prange(n - 1):
+        i = np.int64(p_cell)  # prange counts in uint64: the int64 cell index of every other caller
         top0 = m.envelope_ms[i] ** 2
         top1 = m.envelope_ms[i + 1] ** 2
         for j in range(n_speeds):
@@ -323,7 +327,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, offsets, fixed_u1, fixed_e
             p = offsets[s]
             for k in range(k_lo, k_hi + 1, stride):
                 target = math.sqrt(node_u(top1, k, k_max, bias))
-                u1, f, w0 = cell_outcome(m, v0, i, MODE_TOWARD, target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+                u1, f, w0 = cell_outcome(m, v0, i, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
                                          br_u, br_f, br_w)
                 e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
                 tgt_u1[p] = value_position(top1, u1, k_max, bias)
