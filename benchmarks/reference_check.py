@@ -39,6 +39,8 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from optimal import markdown  # noqa: E402  (benchmarks/optimal.py: this script's directory is on sys.path)
+
 from pymoo_rail.experiments.scripts import lower_priority  # noqa: E402
 
 REPORTS = ROOT / "benchmarks" / "reports"
@@ -64,6 +66,7 @@ def members() -> pd.DataFrame:
 
 
 def case_objects() -> dict:
+    """The cases the members ran on, by the names :func:`members` gives them."""
     from pymoo_rail.cases import load_case
     from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
     from pymoo_rail.journeys import Journey
@@ -109,15 +112,8 @@ def summary(table: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def markdown(df: pd.DataFrame) -> str:
-    lines = ["| " + " | ".join(df.columns) + " |", "|" + "---|" * len(df.columns)]
-    for row in df.itertuples(index=False):
-        cells = [f"{v:.4f}" if isinstance(v, (float, np.floating)) else str(v) for v in row]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines)
-
-
 def write_report(table: pd.DataFrame, out: Path) -> int:
+    """Write and print ``reference_check.md``; returns how many members lie below the reference."""
     s = summary(table)
     n_below = int(s["below_reference"].sum())
     lines = ["# Committed optimiser results against the exact optimum at their own running time", "",
@@ -134,6 +130,7 @@ def write_report(table: pd.DataFrame, out: Path) -> int:
 
 
 def main(argv=None) -> int:
+    """Check every committed member (or report from the stored CSV); exit status 1 if one is below."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=REPORTS, help="report folder")
     parser.add_argument("--report-only", action="store_true", help="report from the stored reference_check.csv")
