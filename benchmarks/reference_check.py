@@ -39,7 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from optimal import markdown  # noqa: E402  (benchmarks/optimal.py: this script's directory is on sys.path)
+from benchmarks.optimal import markdown  # noqa: E402
 
 from pymoo_rail.experiments.scripts import lower_priority  # noqa: E402
 

@@ -2,25 +2,20 @@
 
 from __future__ import annotations
 
-import importlib.util
 import os
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "peers.py"
 MSEETC = Path(os.environ.get("MSEETC_CHECKOUT", "/tmp/mseetc"))
 MSEETC_PYTHON = os.environ.get("MSEETC_PYTHON", "/work/venv-mseetc/bin/python")
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location("peers", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules.setdefault("peers", module)
-    spec.loader.exec_module(module)
-    return module
+    from benchmarks import peers
+
+    return peers
 
 
 def test_the_last_json_line_is_the_result():

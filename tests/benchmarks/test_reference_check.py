@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import pandas as pd
@@ -12,12 +10,9 @@ SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "reference_check.p
 
 
 def _script():
-    sys.path.insert(0, str(SCRIPT.parent))  # the script imports benchmarks/optimal.py as its neighbour
-    spec = importlib.util.spec_from_file_location("reference_check", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules.setdefault("reference_check", module)
-    spec.loader.exec_module(module)
-    return module
+    from benchmarks import reference_check
+
+    return reference_check
 
 
 def test_every_committed_member_is_read():
