@@ -1,125 +1,87 @@
 """Two trains sharing braking energy (Chen et al. 2017): every offset and the gradient study, with statistics.
 
-Runs through ``pymoo_rail.experiments.run_study``:
+A thin script over ``pymoo_rail.experiments.cooperative`` and ``run_study``:
 
 1. offsets: ``CooperativeTrainsProblem(cooperative-pair, offset_s=x)`` for x in -45, 0, 45, 90, 135 s,
    plain pymoo ``GA(pop_size=60)`` for 6000 evaluations, ``--seeds`` seeds (default 15);
 2. gradients (Chen et al. 2017, fig. 6): the same with every gradient times phi (``--phis``, default
    0.7, 0.4, 0), ``--phi-seeds`` seeds (default 15).
 
-Each run is compared with the exact uncoordinated baseline at its phi (each train's exact optimum
-alone, ``exact_baseline``; stored in ``reports/cooperative_baselines.json`` once computed): median,
-IQR, and a one-sample Wilcoxon signed-rank test (``experiments.stats.signed_rank_vs``). The records
-stay in ``reports/cooperative_study/`` (a second invocation skips finished runs); the report is
-``reports/cooperative.md``.
+Each run is compared with the exact uncoordinated baseline at its phi (``exact_baseline``, each
+train exactly optimal alone, recomputed here: about a CPU second each): median, IQR and a one-sample
+Wilcoxon signed-rank test. The report also shows, from the kernel's traces, how much regenerated
+energy there is to share at each offset. Records: ``--work`` (a second invocation skips finished
+runs); report: ``<--out>/cooperative.md``.
 
 Usage: ``python benchmarks/cooperative.py [--seeds 15] [--phis 0.7,0.4,0] [--phi-seeds 15] [--workers 2]``
+(set ``NUMBA_NUM_THREADS=1`` when the pool has several workers).
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from pymoo_rail.cases import load_case
-from pymoo_rail.experiments import Study, algorithm, load_results, problem, run_study
-from pymoo_rail.experiments.stats import signed_rank_vs
-from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S, scale_gradients
-from pymoo_rail.problems.cooperative_baseline import exact_baseline
+from pymoo_rail.experiments import load_results, run_study
+from pymoo_rail.experiments.cooperative import (
+    exact_baselines,
+    offsets_study,
+    problem_label,
+    savings_table,
+    sharing_potential,
+)
+from pymoo_rail.experiments.scripts import add_study_options, lower_priority
+from pymoo_rail.problems import CooperativeTrainsProblem
+from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S
 
 REPORTS = Path(__file__).parent / "reports"
-# the earlier model (the paper's subsection encoding, DE with the punctuality repair, train-by-train
-# turns and a joint polish; one run per offset) against its heuristic baseline of 25.57 kWh
-EARLIER = {-45.0: 22.45, 0.0: 24.51, 45.0: 25.47, 90.0: 25.39, 135.0: 25.01}
-EARLIER_PHI = {0.7: (26.71, {-45.0: 23.91, 0.0: 25.43, 45.0: 26.74, 90.0: 26.54, 135.0: 25.91}),
-               0.4: (27.86, {-45.0: 24.22, 0.0: 26.14, 45.0: 27.82, 90.0: 27.82, 135.0: 26.70}),
-               0.0: (29.49, {-45.0: 25.64, 0.0: 27.66, 45.0: 29.49, 90.0: 29.49, 135.0: 27.94})}
+# the earlier model (the paper's subsection encoding on its own integrator, DE with the punctuality
+# repair, train-by-train turns and a joint polish; one run per offset) against its heuristic baseline
+EARLIER = {1.0: (25.57, {-45.0: 22.45, 0.0: 24.51, 45.0: 25.47, 90.0: 25.39, 135.0: 25.01}),
+           0.7: (26.71, {-45.0: 23.91, 0.0: 25.43, 45.0: 26.74, 90.0: 26.54, 135.0: 25.91}),
+           0.4: (27.86, {-45.0: 24.22, 0.0: 26.14, 45.0: 27.82, 90.0: 27.82, 135.0: 26.70}),
+           0.0: (29.49, {-45.0: 25.64, 0.0: 27.66, 45.0: 29.49, 90.0: 29.49, 135.0: 27.94})}
 PAPER = {-45.0: "1.3 %", 45.0: "5.8 %", 135.0: "3.8 %"}  # Chen et al. (2017) sections 4.2-4.3
 
 
-def baselines(phis, path: Path) -> dict:
-    """Exact uncoordinated baselines by phi (computed once, stored as JSON)."""
-    stored = json.loads(path.read_text()) if path.exists() else {}
+def savings_lines(table: pd.DataFrame) -> list[str]:
+    lines = ["| phi | x (s) | seeds | exact baseline | shared by chance | median result | best | median saving "
+             "(IQR) | Wilcoxon p | earlier model (one run) | paper |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in table.itertuples():
+        b_old, runs = EARLIER.get(r.phi, (None, {}))
+        earlier = f"{runs[r.offset_s]:.2f} ({100 * (1 - runs[r.offset_s] / b_old):.1f} % vs {b_old:.2f})" if runs else ""
+        paper = PAPER.get(r.offset_s, "") if r.phi == 1.0 else ""
+        lines.append(f"| {r.phi:g} | {r.offset_s:+g} | {r.seeds} | {r.baseline_kwh:.3f} | {r.chance_kwh:.3f} | "
+                     f"{r.median_kwh:.3f} | {r.best_kwh:.3f} | {r.saving_median_pct:.2f} % ({r.saving_q1_pct:.2f}-"
+                     f"{r.saving_q3_pct:.2f}) | {r.p:.2g} {r.verdict} | {earlier} | {paper} |")
+    return lines
+
+
+def potential_lines(results: pd.DataFrame, base) -> list[str]:
+    """Regenerated energy per train and offset, from the traces of the exact runs and of the best GA run."""
     case = load_case("cooperative-pair")
-    for phi in phis:
-        key = f"{phi:g}"
-        if key in stored:
-            continue
-        start = time.process_time()
-        base = exact_baseline(scale_gradients(case, phi) if phi != 1.0 else case)
-        stored[key] = dict(base.to_dict(), cpu_time_s=time.process_time() - start,
-                           shared_by_chance_kwh={f"{x:g}": base.shared_by_chance_kwh(x) for x in SEED_001_OFFSETS_S})
-        path.write_text(json.dumps(stored, indent=1))
-        print(f"exact baseline at phi = {key}: {stored[key]['energy_kwh']:.3f} kWh", flush=True)
-    return stored
-
-
-def study(name: str, phis, seeds: int) -> Study:
-    problems = []
-    for phi in phis:
-        for x in SEED_001_OFFSETS_S:
-            label = f"phi={phi:g} x={x:+g}"
-            if phi == 1.0:
-                problems.append(problem("cooperative_trains", label=label, offset_s=x))
-            else:
-                problems.append(problem("cooperative_trains_scaled", label=label, offset_s=x, phi=phi))
-    return Study(name, problems=problems, algorithms=[algorithm("ga", label="GA", pop_size=60)], seeds=seeds,
-                 budget={"n_eval": 6000})
-
-
-def rows(results, base: dict, phis) -> list[dict]:
-    out = []
-    for phi in phis:
-        b = base[f"{phi:g}"]
-        for x in SEED_001_OFFSETS_S:
-            sel = results[results["problem"] == f"phi={phi:g} x={x:+g}"]
-            if sel.empty:
-                continue
-            f = np.array([float(np.min(F[:, 0])) for F in sel["F"]])
-            saving = 100.0 * (1.0 - f / b["energy_kwh"])
-            q1, med, q3 = np.percentile(saving, [25, 50, 75])
-            p, verdict = signed_rank_vs(f, b["energy_kwh"])
-            out.append(dict(phi=phi, x=x, n=len(f), baseline=b["energy_kwh"],
-                            chance=b["shared_by_chance_kwh"][f"{x:g}"], median_kwh=float(np.median(f)),
-                            best_kwh=float(f.min()), saving_med=med, saving_q1=q1, saving_q3=q3, p=p, verdict=verdict,
-                            feasible=int(sel["feasible"].sum()), cpu_s=float(sel["cpu_time_s"].sum())))
-    return out
-
-
-def report(table: list[dict], base: dict) -> str:
-    lines = ["# Two trains sharing braking energy (Chen et al. 2017): statistics over seeds", "",
-             "Generated by `benchmarks/cooperative.py` from the study records in `cooperative_study/`. "
-             "`CooperativeTrainsProblem(load_case(\"cooperative-pair\"), offset_s=x)` solved by plain pymoo "
-             "`GA(pop_size=60)` with 6000 evaluations per seed, no repair (every decision vector is on time by "
-             "construction). Baseline: each train exactly optimal alone (`exact_baseline`, dynamic programming), "
-             "nothing shared. Energies are traction energy at the wheel (kWh); saving = 1 - result / baseline. "
-             "Test: one-sample Wilcoxon signed-rank of the results against the baseline value "
-             "(`+`: significantly below it, alpha 0.05).", "",
-             "| phi | x (s) | seeds | exact baseline | shared by chance | median result | best | median saving "
-             "(IQR) | Wilcoxon p | earlier model (one run) | paper |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in table:
-        if r["phi"] == 1.0:
-            earlier = f"{EARLIER[r['x']]:.2f} ({100 * (1 - EARLIER[r['x']] / 25.57):.1f} % vs 25.57)"
-        else:
-            b_old, runs = EARLIER_PHI.get(r["phi"], (None, {}))
-            earlier = f"{runs[r['x']]:.2f} ({100 * (1 - runs[r['x']] / b_old):.1f} % vs {b_old:.2f})" if runs else ""
-        paper = PAPER.get(r["x"], "") if r["phi"] == 1.0 else ""
-        lines.append(f"| {r['phi']:g} | {r['x']:+g} | {r['n']} | {r['baseline']:.3f} | {r['chance']:.3f} | "
-                     f"{r['median_kwh']:.3f} | {r['best_kwh']:.3f} | {r['saving_med']:.2f} % "
-                     f"({r['saving_q1']:.2f}-{r['saving_q3']:.2f}) | {r['p']:.2g} {r['verdict']} | {earlier} | "
-                     f"{paper} |")
-    lines += ["", "Exact baselines (kWh, train A + train B): " + "; ".join(
-        f"phi {k}: {' + '.join(f'{e:.3f}' for e in v['energies_kwh'])} = {v['energy_kwh']:.3f}"
-        for k, v in base.items()), "",
-        f"CPU time of the runs: {sum(r['cpu_s'] for r in table):.0f} s. Runs with a feasible result: "
-        f"{sum(r['feasible'] for r in table)} of {sum(r['n'] for r in table)}.", ""]
-    return "\n".join(lines)
+    lines = ["| x (s) | runs | A regenerates (kWh, when on the clock) | of it while B moves | B regenerates | "
+             "of it while A moves | shared |", "|---|---|---|---|---|---|---|"]
+    for x in SEED_001_OFFSETS_S:
+        sel = results[results["problem"] == problem_label(1.0, x)]
+        candidates = [("exact, alone", base.clocked_pair(x))]
+        if not sel.empty:
+            best = sel.iloc[int(np.argmin([float(np.min(F[:, 0])) for F in sel["F"]]))]
+            x_best = np.asarray(best["X"])[int(np.argmin(best["F"][:, 0]))]
+            candidates.append(("best GA", CooperativeTrainsProblem(case, offset_s=x).simulate(x_best[None, :])
+                               ["clocked"][0]))
+        for label, runs in candidates:
+            pot = sharing_potential(runs)
+            a, b = pot.iloc[0], pot.iloc[1]
+            lines.append(f"| {x:+g} | {label} | {a.regen_kwh:.2f} ({a.braking_from_s:.0f}-{a.braking_to_s:.0f} s) | "
+                         f"{a.while_others_move_kwh:.2f} | {b.regen_kwh:.2f} ({b.braking_from_s:.0f}-"
+                         f"{b.braking_to_s:.0f} s) | {b.while_others_move_kwh:.2f} | "
+                         f"{a.others_draw_kwh + b.others_draw_kwh:.2f} |")
+    return lines
 
 
 def main() -> None:
@@ -128,32 +90,46 @@ def main() -> None:
     parser.add_argument("--phis", default="0.7,0.4,0")
     parser.add_argument("--phi-seeds", type=int, default=15)
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--report-only", action="store_true",
-                        help="write the report from the records already stored (after a study was stopped early)")
+    add_study_options(parser, REPORTS / "cooperative_study", REPORTS)
     args = parser.parse_args()
+    lower_priority()
     phis = [float(p) for p in args.phis.split(",") if p.strip()]
 
-    base = baselines([1.0] + phis, REPORTS / "cooperative_baselines.json")
-    directory = REPORTS / "cooperative_study"
-    if not args.report_only:
-        run_study(study("cooperative_offsets", [1.0], args.seeds), directory / "offsets", workers=args.workers,
-                  seed_major=True)
-    frames = [load_results(directory / "offsets")]
+    studies = [(offsets_study("cooperative_offsets", [1.0], args.seeds), args.work / "offsets")]
     if phis and args.phi_seeds > 0:
+        studies.append((offsets_study("cooperative_gradients", phis, args.phi_seeds), args.work / "gradients"))
+    for study, directory in studies:
         if not args.report_only:
-            run_study(study("cooperative_gradients", phis, args.phi_seeds), directory / "gradients",
-                      workers=args.workers, seed_major=True)
-        if (directory / "gradients").exists():
-            frames.append(load_results(directory / "gradients"))
-    results = pd.concat(frames, ignore_index=True)
-    table = rows(results, base, [1.0] + phis)
-    text = report(table, base)
-    (REPORTS / "cooperative.md").write_text(text + "\n" + NOTES)
+            run_study(study, directory, workers=args.workers, seed_major=True)
+    results = pd.concat([load_results(d) for _, d in studies if d.exists()], ignore_index=True)
+    baselines = exact_baselines(load_case("cooperative-pair"), [1.0] + phis)
+    table = savings_table(results, baselines)
+    lines = ["# Two trains sharing braking energy (Chen et al. 2017): statistics over seeds", "",
+             "Generated by `benchmarks/cooperative.py` from the study records in `cooperative_study/`. "
+             "`CooperativeTrainsProblem(load_case(\"cooperative-pair\"), offset_s=x)` (gradients times phi) solved "
+             "by plain pymoo `GA(pop_size=60)` with 6000 evaluations per seed, no repair (every decision vector is "
+             "on time by construction). Baseline: each train exactly optimal alone (`exact_baseline`, dynamic "
+             "programming), nothing shared. Energies are traction energy at the wheel (kWh); saving = 1 - result / "
+             "baseline. Test: one-sample Wilcoxon signed-rank of the results against the baseline value (`+`: "
+             "significantly below it, alpha 0.05).", ""]
+    lines += savings_lines(table)
+    lines += ["", "Exact baselines (kWh, train A + train B): " + "; ".join(
+        f"phi {phi:g}: {' + '.join(f'{e:.3f}' for e in b.energies_kwh)} = {b.energy_kwh:.3f}"
+        for phi, b in baselines.items()), "",
+        f"CPU time of the runs: {table['cpu_s'].sum():.0f} s ({table['cpu_s'].sum() / table['seeds'].sum():.1f} s "
+        f"per run). Runs with a feasible result: {table['feasible'].sum()} of {table['seeds'].sum()}.", "",
+        "## What there is to share (phi = 1)", "",
+        "Regenerated energy (eta = 0.8 included) of each train, when it falls on the common clock, the part of "
+        "it regenerated while the other train is on the move (a standing train draws nothing), and what is "
+        "shared, from the kernel's traces (`experiments.cooperative.sharing_potential`) of the two exact "
+        "single-train optima and of the best GA run at each offset.", ""]
+    lines += potential_lines(results, baselines[1.0])
+    lines += ["", "How these compare with the earlier model and with the paper: `docs/cooperative.md`.",
+              "A row with fewer seeds than asked for comes from a study stopped early (`--report-only`).", ""]
+    text = "\n".join(lines)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "cooperative.md").write_text(text)
     print(text)
-
-
-NOTES = """How these compare with the earlier model and with the paper: `docs/cooperative.md`.
-A row with fewer seeds than asked for comes from a study stopped early (`--report-only`)."""
 
 
 if __name__ == "__main__":

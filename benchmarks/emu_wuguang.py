@@ -16,12 +16,13 @@ run, resumable):
   and on switching points (the best fronts of the encoding study, as a check).
 
 The exact front of ``pymoo_rail.optimal`` at 13 running times from 990 to 1110 s is computed once
-and cached in ``reports/emu_wuguang_optimal.csv`` (``--no-exact`` leaves it out).
+and cached in ``reports/emu_wuguang_optimal.csv`` by ``pymoo_rail.problems.reference.exact_points``
+(``--no-exact`` leaves it out).
 
 Algorithms (seed 003, 4.1: crossover 0.9, mutation 0.01; 2m = 40, Pc_max 0.9, Pm_max 0.1):
 
 * ``NSGA-II``: pymoo NSGA2, SBX(prob 0.9, eta 15), PM(eta 20) with per-variable probability
-  0.01 (the same reading as ``benchmarks/grnsga2_zdt.py``), built by :func:`seed_nsga2`;
+  0.01 (the same reading as ``benchmarks/grnsga2_zdt.py``): ``pymoo_rail.experiments.tang2020_nsga2``;
 * ``GR-NSGA-II``: ``GoldenRatioNSGA2(pop_size=200, local_size=40, pc_max=0.9, pm_max=0.1)``; the
   runner passes the neutral-section genes as ``fixed_genes``.
 
@@ -49,7 +50,6 @@ import argparse
 import csv
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -58,7 +58,8 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS  # noqa: E402
+from pymoo_rail.experiments.fronts import choose_member  # noqa: E402
+from pymoo_rail.sim.checks import check_run  # noqa: E402
 
 CASE = "wuguang-crh3"
 OBJECTIVES = ("energy", "running_time")
@@ -69,9 +70,6 @@ ENCODING_BUDGET = 20_000
 ENCODING_SEEDS = 3
 NSGA2_LABEL = "NSGA-II"
 GR_LABEL = "GR-NSGA-II"
-# the factory of the seed's NSGA-II lives here; workers import it by this name (the script's
-# folder is on sys.path of the driver, and spawned workers inherit sys.path)
-MODULE = Path(__file__).stem
 ENCODINGS = {  # label -> SpeedProfileProblem keyword arguments
     "speed codes": {"encoding": "speed_codes"},
     "speed codes <= 1000 m": {"encoding": "speed_codes", "max_section_m": 1000.0},
@@ -93,25 +91,15 @@ SEED_TABLE5 = {NSGA2_LABEL: (657.13, 1051.5), GR_LABEL: (650.76, 1049.2)}
 # --------------------------------------------------------------------------------- studies
 
 
-def seed_nsga2(pop_size: int = POP_SIZE, crossover_prob: float = 0.9, mutation_prob_var: float = 0.01):
-    """NSGA-II with seed 003's settings (crossover 0.9, per-variable mutation 0.01)."""
-    from pymoo.algorithms.moo.nsga2 import NSGA2
-    from pymoo.operators.crossover.sbx import SBX
-    from pymoo.operators.mutation.pm import PM
-
-    return NSGA2(pop_size=pop_size, crossover=SBX(prob=crossover_prob, eta=15),
-                 mutation=PM(prob=1.0, prob_var=mutation_prob_var, eta=20))
-
-
 def problem_params(case, encoding: str) -> dict:
     return {"case": CASE, "objectives": list(OBJECTIVES), "time_tolerance_s": float(case.time_margin_s),
             **ENCODINGS[encoding]}
 
 
 def algorithm_specs(pop_size: int, local_size: int):
-    from pymoo_rail.experiments import algorithm
+    from pymoo_rail.experiments import algorithm, tang2020_nsga2
 
-    return [algorithm(f"{MODULE}:seed_nsga2", label=NSGA2_LABEL, pop_size=pop_size),
+    return [tang2020_nsga2(label=NSGA2_LABEL, pop_size=pop_size),
             algorithm("grnsga2", label=GR_LABEL, pop_size=pop_size, local_size=local_size, pc_max=0.9,
                       pm_max=0.1)]
 
@@ -137,109 +125,26 @@ EXACT_N_SPEEDS = 800
 
 
 def exact_front(path: Path, times_s=EXACT_TIMES_S, profile_path: Path | None = None, n_speeds: int = EXACT_N_SPEEDS):
-    """The exact solver's front (``pymoo_rail.optimal``) at ``times_s``, cached row by row in ``path``.
-
-    Each finished running time is written at once (a temporary file renamed over ``path``), so an
-    interrupted computation resumes where it stopped; rows of another ``n_speeds`` are recomputed.
-    With ``profile_path``, the optimal run at the planned time is also kept there as a trajectory
-    table (for fig. 12).
-    """
-    import pandas as pd
-
+    """The exact solver's front at ``times_s``, cached row by row in ``path`` (resumable); with
+    ``profile_path``, the optimal run at the planned time is kept there as a trajectory table (fig. 12)."""
+    from pymoo_rail.atomic import atomic_write_text
     from pymoo_rail.cases import load_case
-    from pymoo_rail.optimal import OptimalSolver
+    from pymoo_rail.problems.reference import exact_points
 
     case = load_case(CASE)
-    rows = pd.read_csv(path).to_dict("records") if path.exists() else []
-    rows = [r for r in rows if int(r.get("n_speeds", -1)) == n_speeds]
-    done = {float(r["requested_time_s"]) for r in rows}
-    want = sorted(float(t) for t in times_s)
-    if profile_path is not None and not profile_path.exists():
-        done.discard(case.planned_time_s)
-        want = sorted(set(want) | {case.planned_time_s})
-    solver, guess = None, None
-    for t in want:
-        if t in done:
-            continue
-        if solver is None:
-            solver = OptimalSolver(case, n_speeds=n_speeds)
-        start = time.perf_counter()
-        traj = solver.profile(t, lambda_guess_w=guess)
-        guess = traj.summary["lambda_w"]
-        row = {"requested_time_s": t, "running_time_s": traj.running_time_s, "energy_kwh": traj.energy.net_kwh,
-               "traction_kwh": traj.energy.traction_kwh, "regen_kwh": traj.energy.regen_kwh,
-               "lambda_kwh_per_s": guess / J_PER_KWH, "neutral_traction_j": traj.summary["neutral_traction_j"],
-               "limit_excess_ms": traj.summary["limit_excess_ms"], "stop_error_m": traj.stop_error_m,
-               "n_speeds": n_speeds, "solve_s": time.perf_counter() - start}
-        rows = [r for r in rows if float(r["requested_time_s"]) != t] + [row]
-        rows.sort(key=lambda r: float(r["requested_time_s"]))
-        write_csv(path, rows)
+
+    def keep_profile(t, traj):
         if profile_path is not None and t == case.planned_time_s:
-            tmp = profile_path.with_suffix(".tmp")
-            traj.to_frame().to_csv(tmp, index=False)
-            tmp.replace(profile_path)
-        print(f"exact front: {t:g} s -> {traj.running_time_s:.2f} s, {traj.energy.net_kwh:.2f} kWh "
-              f"({row['solve_s']:.0f} s)", flush=True)
-    frame = pd.DataFrame(rows)
-    return frame[frame["requested_time_s"].isin(times_s)].sort_values("running_time_s").reset_index(drop=True)
+            atomic_write_text(profile_path, traj.to_frame().to_csv(index=False))
+        print(f"exact front: {t:g} s -> {traj.running_time_s:.2f} s, {traj.energy.net_kwh:.2f} kWh", flush=True)
 
-
-
-@dataclass(frozen=True)
-class MemberCheck:
-    """Verification of one front member's trajectory."""
-
-    neutral_traction_j: float  # summary figure of the kernel
-    neutral_max_force_n: float  # largest force over the cells that touch a neutral section
-    limit_excess_ms: float  # summary figure of the kernel (v - limit, max over the run)
-    independent_excess_ms: float  # v - lowest line limit under the train, max over the nodes
-    stop_error_m: float
-    running_time_s: float
-    energy_kwh: float
-
-    @property
-    def ok(self) -> bool:
-        return (self.neutral_traction_j == 0.0 and self.neutral_max_force_n <= 0.0
-                and self.limit_excess_ms <= SPEED_TOLERANCE_MS and self.independent_excess_ms <= SPEED_TOLERANCE_MS
-                and self.stop_error_m <= STOP_TOLERANCE_M)
-
-
-def limit_under_train_ms(position_m: np.ndarray, line, train) -> np.ndarray:
-    """Lowest line limit (m/s) over the train, head at each position, tail ``train.length_m`` behind.
-
-    Computed from ``line.speed_limits`` alone (not the simulator's grid): a limit applies
-    from the moment the head reaches its start until the tail has passed its end.
-    """
-    limit = np.full(position_m.shape, train.max_speed_kmh)
-    for start, end, value in line.speed_limits:
-        under = (position_m >= start) & (position_m - train.length_m < end)
-        limit[under] = np.minimum(limit[under], value)
-    return limit / KMH_PER_MS
-
-
-def check_member(problem, x: np.ndarray) -> MemberCheck:
-    traj = problem.trajectory(x)
-    case = problem.case
-    x_m = traj.position_m
-    cells = x_m[:-1]
-    cell_end = x_m[1:]
-    force = traj.force_n[:-1]
-    touch = np.zeros(cells.shape, dtype=bool)
-    for start, end in case.line.neutral_sections:
-        touch |= (cells < end) & (cell_end > start)
-    excess = traj.speed_ms - limit_under_train_ms(x_m, case.line, case.train)
-    return MemberCheck(
-        neutral_traction_j=float(traj.summary["neutral_traction_j"]),
-        neutral_max_force_n=float(force[touch].max()) if touch.any() else 0.0,
-        limit_excess_ms=float(traj.summary["limit_excess_ms"]),
-        independent_excess_ms=float(excess.max()),
-        stop_error_m=float(traj.stop_error_m),
-        running_time_s=float(traj.running_time_s), energy_kwh=float(traj.energy.net_kwh))
+    redo = [case.planned_time_s] if profile_path is not None and not profile_path.exists() else []
+    return exact_points(case, times_s, path, n_speeds=n_speeds, redo_s=redo, on_run=keep_profile)
 
 
 def most_punctual(F: np.ndarray, planned_time_s: float) -> int:
-    """Index of the member closest to the planned time (ties: the lower energy)."""
-    return int(np.lexsort((F[:, 0], np.abs(F[:, 1] - planned_time_s)))[0])
+    """Index of the (energy, running time) member closest to the planned time (ties: the lower energy)."""
+    return choose_member(F, np.zeros(len(F)), F[:, 1], F[:, 0], planned_time_s, window_s=0.0)
 
 
 def least_energy_within(F: np.ndarray, time_s: float) -> float:
@@ -300,12 +205,12 @@ def analyse(results, problems_by_label: dict, verify: bool = True, exact=None):
                 row.update(gap_to_exact(F, exact))
                 row["punctual_gap_pct"] = 100 * (F[k, 0] / exact_energy_kwh(exact, F[k, 1]) - 1)
         if verify and len(F):
-            member_checks = [check_member(problem, x) for x in X]
+            member_checks = [check_run(problem.trajectory(x), problem.case) for x in X]
             checks[index] = member_checks
             fixed = problem.encoding.fixed()
             fixed_ok = bool(np.all(X[:, fixed] == problem.xl[fixed]))
             row.update(
-                verified=all(c.ok for c in member_checks) and fixed_ok, fixed_genes_ok=fixed_ok,
+                verified=all(c.passes(STOP_TOLERANCE_M, SPEED_TOLERANCE_MS) for c in member_checks) and fixed_ok, fixed_genes_ok=fixed_ok,
                 neutral_traction_j_max=max(c.neutral_traction_j for c in member_checks),
                 neutral_force_n_max=max(c.neutral_max_force_n for c in member_checks),
                 limit_excess_ms_max=max(c.limit_excess_ms for c in member_checks),
@@ -352,13 +257,13 @@ def write_csv(path: Path, rows: list[dict]) -> None:
     keys: list[str] = []
     for row in rows:
         keys += [k for k in row if k not in keys]
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    with open(tmp, "w", newline="") as fh:
+    from pymoo_rail.atomic import atomic_path
+
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=keys)
         writer.writeheader()
         for row in rows:
             writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
-    tmp.replace(path)
 
 
 def rank_sum(rows, problem: str, indicator: str, lower_better: bool):
@@ -533,14 +438,25 @@ TESTED = (("hv_ref", False), ("igd_ref", True), ("gd_ref", True), ("gd_seed", Tr
           ("e_min", True))
 
 
-def table4(rows, enc: str) -> str:
+def pair_values(rows, enc: str, key: str):
+    """(NSGA-II values, GR-NSGA-II values) of ``key`` on encoding ``enc``; None when no run has it."""
     main = [r for r in rows if r["problem"] == enc]
+    if not any(np.isfinite(r.get(key, np.nan)) for r in main):
+        return None
+    return ([r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL],
+            [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL])
+
+
+def measured(rows, enc: str, items, key_of):
+    """``(item, (NSGA-II values, GR-NSGA-II values))`` for the items whose key some run measured."""
+    for item in items:
+        if (pair := pair_values(rows, enc, key_of(item))) is not None:
+            yield item, pair
+
+
+def table4(rows, enc: str) -> str:
     t4 = []
-    for name, key in TABLE4:
-        if not any(np.isfinite(r.get(key, np.nan)) for r in main):
-            continue
-        a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
-        b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
+    for (name, key), (a, b) in measured(rows, enc, TABLE4, lambda item: item[1]):
         sk = SEED_KEYS.get(key)
         t4.append([name, mean_std(a), mean_std(b), fmt(SEED_TABLE4[NSGA2_LABEL][sk]) if sk else "",
                    fmt(SEED_TABLE4[GR_LABEL][sk]) if sk else ""])
@@ -548,13 +464,8 @@ def table4(rows, enc: str) -> str:
 
 
 def tests_table(rows, enc: str) -> str:
-    main = [r for r in rows if r["problem"] == enc]
     st = []
-    for key, lower in TESTED:
-        if not any(np.isfinite(r.get(key, np.nan)) for r in main):
-            continue
-        a = [r.get(key, np.nan) for r in main if r["algorithm"] == NSGA2_LABEL]
-        b = [r.get(key, np.nan) for r in main if r["algorithm"] == GR_LABEL]
+    for (key, lower), (a, b) in measured(rows, enc, TESTED, lambda item: item[0]):
         p, verdict, rel = rank_sum(rows, enc, key, lower)
         st.append([key, "lower" if lower else "higher", mean_std(a), mean_std(b), difference(key, rel), fmt(p, 3),
                    verdict])

@@ -22,7 +22,8 @@ JSON record per finished run in ``--work`` (default ``out/grnsga2_zdt``, not com
 as it finishes, so an interrupted study loses nothing and a re-run starts only the missing runs.
 The report's indicators are computed from the stored final fronts against 500 points of the
 true front (``grnsga2_zdt_runs.csv``, one row per run, is exported from the records).
-``--report-only`` rewrites the report from the stored records.
+``--report-only`` rewrites the report from the stored records or, when there are none (they are not
+committed), from the committed ``grnsga2_zdt_runs.csv`` by the same code.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ ALGORITHMS = ("NSGA-II", "GR-NSGA-II", "GR-NSGA-II no LS", "NSGA-II pm=1/n")
 MAIN_PAIR = ("GR-NSGA-II", "NSGA-II")
 HV_REF = np.array([1.1, 1.1])
 N_PF = 500  # Deb et al. 2002 measured convergence against 500 points of the true front
+RUNS_CSV = "grnsga2_zdt_runs.csv"
 FIELDS = ["problem", "algorithm", "seed", "n_eval", "n_gen", "n_points", "sp", "delta",
           "gd", "gd_vv", "igd", "hv", "n_accepted", "cpu_s"]
 METRICS = ("sp", "delta", "gd", "gd_vv", "igd", "hv")
@@ -62,11 +64,10 @@ SBX_SEED = {"operator": "sbx", "prob": 0.9, "eta": 15}
 
 def algorithm_specs() -> dict:
     """The four algorithms as study specs, by label."""
-    from pymoo_rail.experiments import algorithm
+    from pymoo_rail.experiments import algorithm, tang2020_nsga2
 
     return {
-        "NSGA-II": algorithm("nsga2", label="NSGA-II", pop_size=POP_SIZE, crossover=SBX_SEED,
-                             mutation={"operator": "pm", "prob": 1.0, "prob_var": 0.01, "eta": 20}),
+        "NSGA-II": tang2020_nsga2(label="NSGA-II", pop_size=POP_SIZE),
         "GR-NSGA-II": algorithm("grnsga2", label="GR-NSGA-II", pop_size=POP_SIZE, local_size=40, pc_max=0.9,
                                 pm_max=0.1),
         "GR-NSGA-II no LS": algorithm("grnsga2", label="GR-NSGA-II no LS", pop_size=POP_SIZE, local_size=0,
@@ -120,14 +121,6 @@ def run_row(result) -> dict:
     }
 
 
-def runs_table(results):
-    """One row per stored run with the report's indicators (see :func:`run_row`)."""
-    import pandas as pd
-
-    rows = [run_row(r) for _, r in results.iterrows()]
-    return pd.DataFrame(rows, columns=FIELDS)
-
-
 def write_runs_csv(table, path: Path) -> None:
     table.sort_values(["seed", "problem", "algorithm"], kind="stable").to_csv(path, index=False)
 
@@ -160,13 +153,16 @@ def summarise(rows: list[dict]):
     return df
 
 
-def plot_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
+def plot_median_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
     """Median-IGD run of NSGA-II and GR-NSGA-II per problem; ``fronts[(problem, algorithm, seed)]`` = F."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import plot_fronts, save_figure
 
+    if not fronts:  # report rebuilt from the per-run CSV: the committed figures stay
+        return [name for name in (f"grnsga2_{p}_fronts.png" for p in problems) if (out / name).exists()]
     names = []
     for p in problems:
         pf = reference_front(make_problem(p))
@@ -174,29 +170,23 @@ def plot_fronts(df, fronts: dict, out: Path, problems) -> list[str]:
         for ax, (label, alg) in zip(axes, (("(a) NSGA-II", "NSGA-II"),
                                             ("(b) golden-ratio NSGA-II", "GR-NSGA-II"))):
             sub = df[(df.problem == p) & (df.algorithm == alg)].sort_values(["igd", "seed"])
-            ax.plot(pf[:, 0], pf[:, 1], ".", ms=1.5, color="0.6", label="true Pareto front")
-            if len(sub):
-                row = sub.iloc[(len(sub) - 1) // 2]  # median-IGD run
-                F = fronts.get((p, alg, int(row.seed)))
-                if F is not None:
-                    ax.plot(F[:, 0], F[:, 1], "o", ms=3, mfc="none", color="C0" if alg == "NSGA-II" else "C3",
-                            label=f"obtained (seed {int(row.seed)}, median IGD {row.igd:.2e})")
-            ax.set_title(f"{p.upper()} {label}")
-            ax.set_xlabel("$f_1$")
-            ax.set_ylabel("$f_2$")
-            ax.legend(fontsize=8)
-            ax.grid(alpha=0.3)
+            row = sub.iloc[(len(sub) - 1) // 2] if len(sub) else None  # median-IGD run
+            F = fronts.get((p, alg, int(row.seed))) if row is not None else None
+            if F is None:
+                ax.set_title(f"{p.upper()} {label}: no run")
+                continue
+            plot_fronts({f"obtained (seed {int(row.seed)}, median IGD {row.igd:.2e})": F}, reference=pf,
+                        reference_label="true Pareto front", title=f"{p.upper()} {label}", ax=ax)
         fig.tight_layout()
         name = f"grnsga2_{p}_fronts.png"
-        fig.savefig(out / name, dpi=110)
-        plt.close(fig)
+        save_figure(fig, out / name, dpi=110)
         names.append(name)
     return names
 
 
 def compare(df, problem: str, metric: str, a: str, b: str):
     """(a better?, relative difference of means in %, rank-sum p) of algorithm a vs b."""
-    from scipy.stats import ranksums
+    from pymoo_rail.experiments.stats import rank_sum
 
     x = df[(df.problem == problem) & (df.algorithm == a)][metric].dropna()
     y = df[(df.problem == problem) & (df.algorithm == b)][metric].dropna()
@@ -204,7 +194,7 @@ def compare(df, problem: str, metric: str, a: str, b: str):
         return None
     better = x.mean() > y.mean() if metric == "hv" else x.mean() < y.mean()
     rel = (x.mean() - y.mean()) / abs(y.mean()) * 100 if y.mean() != 0 else float("nan")
-    return bool(better), float(rel), float(ranksums(x, y).pvalue)
+    return bool(better), float(rel), rank_sum(x, y)[1]
 
 
 def pct(rel: float) -> str:
@@ -329,25 +319,29 @@ def pd_mean(frame, column: str) -> float:
 
 
 def write_report(out: Path, results, problems, algorithms) -> None:
-    """The report, the per-run CSV and the front plots from the stored runs (``load_results``)."""
-    from scipy.stats import ranksums
+    """The report, the per-run CSV and the front plots from the stored runs (``load_results``).
 
-    if not len(results):
-        print("no runs to report")
-        return
-    table = runs_table(results)
-    write_runs_csv(table, out / "grnsga2_zdt_runs.csv")
+    Without stored runs the report is rebuilt from the committed ``grnsga2_zdt_runs.csv`` by the
+    same code (the front figures, which need the fronts, are kept as they are).
+    """
+    from pymoo_rail.experiments.scripts import report_runs
+
+    table, fronts, from_records = report_runs(results, run_row, FIELDS, out / RUNS_CSV)
+    if from_records:
+        write_runs_csv(table, out / RUNS_CSV)
     df = summarise(table.to_dict("records"))
     df = df[df.problem.isin(problems) & df.algorithm.isin(algorithms)]
-    fronts = {(r.problem, r.algorithm, int(r.seed)): r.F for r in results.itertuples()}
-    pngs = plot_fronts(df, fronts, out, problems)
+    pngs = plot_median_fronts(df, fronts, out, problems)
     n_runs = df.groupby(["problem", "algorithm"]).size()
 
     L = []
     L.append("# Golden-ratio NSGA-II vs NSGA-II on ZDT1-4 (seed 003, section 4.1)\n")
     L.append("Generated by `benchmarks/grnsga2_zdt.py`: runs by `pymoo_rail.experiments.run_study` "
-             "(study `grnsga2-zdt`, one record per run), indicators computed here from the stored "
-             "final fronts; one row per run in `grnsga2_zdt_runs.csv`.\n")
+             "(study `grnsga2-zdt`, one record per run), indicators computed from the stored "
+             "final fronts; one row per run in `grnsga2_zdt_runs.csv`. "
+             + ("This report was built from the run records." if from_records else
+                "This report was rebuilt from that CSV (the run records are not in git), the front "
+                "figures are those of the last build from the records.") + "\n")
     L.append(f"Runs per problem and algorithm: {n_runs.min()}" +
              (f" to {n_runs.max()}" if n_runs.max() != n_runs.min() else "") +
              " (seeds 1, 2, ...; the same seeds for every algorithm).\n")
@@ -373,8 +367,10 @@ def write_report(out: Path, results, problems, algorithms) -> None:
              "nearest distance to the true front (= Deb's convergence metric Upsilon); "
              "`gd_vv` the seed's eq. 13, sqrt(sum d_i^2) / n; `igd` pymoo IGD; `hv` "
              f"hypervolume with reference point ({HV_REF[0]}, {HV_REF[1]}). Smaller is better except hv.")
-    L.append("- p: two-sided Wilcoxon rank-sum test (`scipy.stats.ranksums`) of "
-             "GR-NSGA-II against NSGA-II (seed settings).\n")
+    L.append("- p: two-sided Wilcoxon rank-sum (Mann-Whitney U) test of GR-NSGA-II against NSGA-II "
+             "(seed settings), `pymoo_rail.experiments.stats.rank_sum`: scipy's `mannwhitneyu`, exact "
+             "when a side has at most 8 runs and there are no ties, otherwise the normal "
+             "approximation with tie and continuity corrections.\n")
 
     L.append("## Seed 003's table 1 is the NSGA-II paper's table\n")
     L.append("Seed 003's NSGA-II column (\"SP\" and \"GD\", 10 runs, population 200, 300 "
@@ -410,14 +406,10 @@ def write_report(out: Path, results, problems, algorithms) -> None:
             for a in algorithms:
                 v = df[(df.problem == p) & (df.algorithm == a)][m].dropna()
                 cells.append(f"{fmt(v.mean())} +- {fmt(v.std())} ({fmt(v.median())})" if len(v) else "-")
-            a_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[0])][m].dropna()
-            b_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[1])][m].dropna()
-            pval = ranksums(a_v, b_v).pvalue if len(a_v) > 1 and len(b_v) > 1 else float("nan")
-            L.append(f"| {m} | " + " | ".join(cells) + f" | {pval:.2e} |")
-            if len(a_v) and len(b_v):
-                better = (a_v.mean() > b_v.mean()) if m == "hv" else (a_v.mean() < b_v.mean())
-                rel = (a_v.mean() - b_v.mean()) / abs(b_v.mean()) * 100 if b_v.mean() != 0 else float("nan")
-                verdict.append((p, m, better, rel, pval))
+            pair = compare(df, p, m, *MAIN_PAIR)
+            L.append(f"| {m} | " + " | ".join(cells) + f" | {pair[2] if pair else float('nan'):.2e} |")
+            if pair:
+                verdict.append((p, m, *pair))
         L.append("")
 
     L.append("### Budget actually used (means per run: evaluations, generations after the initial "

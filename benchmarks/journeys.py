@@ -182,6 +182,7 @@ def main(argv=None) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import save_figure
 
     widest_equal = lo.sum() + len(exact) * (hi - lo).min()
     sweep_t = np.linspace(lo.sum(), min(hi.sum(), widest_equal), 60)
@@ -217,7 +218,7 @@ def main(argv=None) -> None:
     for a in axes:
         a.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(args.out / "journeys.png", dpi=110)
+    save_figure(fig, args.out / "journeys.png", dpi=110)
 
     per_section = best.table[["section", "label", "length_m", "min_time_s", "running_time_s", "supplement_s",
                               "energy_kwh"]].assign(equal_supplement_s=equal.table.supplement_s,

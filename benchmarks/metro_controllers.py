@@ -79,6 +79,7 @@ def main(argv=None) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import save_figure
     import pandas as pd
 
     from pymoo_rail.cases import load_case
@@ -170,7 +171,7 @@ def main(argv=None) -> None:
     ax.grid(True, alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(args.out / "metro_controllers_fig9.png", dpi=120)
+    save_figure(fig, args.out / "metro_controllers_fig9.png", dpi=120)
     L += ["![fig. 9 analogue](metro_controllers_fig9.png)", ""]
     (args.out / "metro_controllers.md").write_text("\n".join(L) + "\n")
     print(f"wrote {args.out / 'metro_controllers.md'}")

@@ -149,7 +149,8 @@ def main() -> None:
     matplotlib.use("Agg")
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import optimal_profile
-    from pymoo_rail.optimal.plots import plot_front, plot_profile
+    from pymoo_rail.optimal.plots import plot_profile
+    from pymoo_rail.plotting import plot_fronts, save_figure
     from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs
 
     case = load_case("yizhuang")
@@ -194,11 +195,14 @@ def main() -> None:
     bounds = gradient_limit_partition(case.line)
     codes = Simulator(case).run(speed_code_programs(bounds, np.full(8, 60 / KMH_PER_MS))[0])
     seeds = pd.DataFrame({"running_time_s": [150.0, 149.89, 149.6], "energy_kwh": [19.68, 19.55, 20.43]})
-    plot_front(front, {"60 km/h speed codes (simulator)": [[codes.running_time_s, codes.energy.net_kwh]],
-                       "seed 000 results (own MATLAB model)": seeds},
-               path=REPORT.parent / "optimal_front.png", title="yizhuang: minimum net energy against running time")
-    plot_profile(planned, {"60 km/h speed codes": codes}, path=REPORT.parent / "optimal_profile.png",
-                 title="yizhuang: optimal profile at 150 s")
+    columns = ["running_time_s", "energy_kwh"]
+    fig = plot_fronts({"60 km/h speed codes (simulator)": np.array([[codes.running_time_s, codes.energy.net_kwh]]),
+                       "seed 000 results (own MATLAB model)": seeds[columns].to_numpy()},
+                      objectives=("running_time", "energy"), reference=front[columns], reference_label="optimum (DP)",
+                      title="yizhuang: minimum net energy against running time")
+    save_figure(fig, REPORT.parent / "optimal_front.png")
+    save_figure(plot_profile(planned, {"60 km/h speed codes": codes}, title="yizhuang: optimal profile at 150 s"),
+                REPORT.parent / "optimal_profile.png")
     out += ["![front](optimal_front.png)", "", "![profile](optimal_profile.png)", ""]
     REPORT.write_text("\n".join(out))
     print(f"written {REPORT}")

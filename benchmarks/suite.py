@@ -1,6 +1,6 @@
 """The rail benchmark suite study: five algorithms on the suite's energy / running-time problems.
 
-Runs ``examples/suite.toml`` (NSGA-II, MOABC, GoldenRatioNSGA2, SMS-EMOA, AGE-MOEA; 20,000
+Runs ``examples/suite.toml`` (NSGA-II, MOABC, GoldenRatioNSGA2, SMS-EMOA, AGE-MOEA; 10,000
 evaluations per run) through ``pymoo_rail.experiments.run_study`` and writes
 ``benchmarks/reports/suite.md`` from the study's records: per problem the median IGD (pymoo's,
 against the certified front), the median HV ratio (HV of the front over HV of the certified
@@ -15,6 +15,9 @@ Usage::
     python benchmarks/suite.py --quick --workers 2                  # 3 problems x 3 seeds
     python benchmarks/suite.py --report-only                        # report from stored records
     python benchmarks/suite.py --fronts                             # fronts, certificates, call times
+    python benchmarks/suite.py --costs                              # CPU per run; the study's budget
+    python benchmarks/suite.py --best-known                         # recompute metro-a-4obj's front
+    python benchmarks/suite.py --sanity                             # NSGA-II vs random, every problem
 
 Records go to ``--work`` (default ``out/suite``, not committed); an interrupted study resumes.
 """
@@ -83,11 +86,44 @@ def plot_problem(results: pd.DataFrame, problem_name: str, out: Path) -> str:
         group = group.sort_values(["igd", "seed"])
         run = group.iloc[(len(group) - 1) // 2]  # the median-IGD run
         fronts[f"{algorithm} (seed {run['seed']})"] = run["F"][run["CV"] <= 0]
+    import matplotlib.pyplot as plt
+
+    _, ax = plt.subplots(figsize=(5.0, 3.4))  # small figures: ten of them sit in the report
     fig = plot_fronts(fronts, problem.objectives, reference=problem.pareto_front(),
-                      reference_label="certified optimal front", title=f"{problem_name}: median-IGD runs")
+                      reference_label="certified optimal front", title=f"{problem_name}: median-IGD runs", ax=ax)
     name = f"suite_{problem_name}.png"
-    save_figure(fig, out / name)
+    save_figure(fig, out / name, dpi=80)
     return name
+
+
+def complete_seeds(results: pd.DataFrame, study) -> tuple[list[int], str]:
+    """The seeds whose runs are all stored, and a sentence saying exactly which runs are missing."""
+    cells = len(study.problems) * len(study.algorithms)
+    done = results.groupby("seed")["run_id"].nunique().reindex(list(study.seeds), fill_value=0)
+    complete = [int(s) for s, n in done.items() if n == cells]
+    partial = {int(s): int(n) for s, n in done.items() if 0 < n < cells}
+    missing = [int(s) for s, n in done.items() if n == 0]
+    if len(complete) == len(study.seeds):
+        return complete, f"All {len(study.runs())} runs are stored."
+    parts = [f"{len(complete)} complete seeds ({_ranges(complete)}, {len(complete) * cells} runs)"]
+    if partial:
+        parts.append("partly run seeds left out so that every cell has the same seeds: "
+                     + ", ".join(f"seed {s} with {n} of {cells} runs" for s, n in partial.items()))
+    if missing:
+        parts.append(f"seeds {_ranges(missing)} not run ({len(missing) * cells} runs)")
+    return complete, f"Not all {len(study.runs())} runs are stored: " + "; ".join(parts) + "."
+
+
+def _ranges(values: list[int]) -> str:
+    """``[1, 2, 3, 7]`` -> ``"1-3, 7"``."""
+    out, start = [], None
+    for k, v in enumerate(values):
+        if start is None:
+            start = v
+        if k + 1 == len(values) or values[k + 1] != v + 1:
+            out.append(f"{start}-{v}" if v != start else f"{v}")
+            start = None
+    return ", ".join(out) or "none"
 
 
 def mean_ranks(results: pd.DataFrame, indicator: str, lower_better: bool) -> pd.Series:
@@ -174,6 +210,41 @@ def front_table() -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def cost_table(study, budgets=(1000, 4000)) -> pd.DataFrame:
+    """CPU seconds of one run per problem and algorithm at two budgets, and the fitted cost model.
+
+    Each (problem, algorithm) runs seed 1 in this process at both budgets (after warm-up runs of
+    every algorithm and problem, so no Numba compile is counted); ``fixed_s + per_eval_ms * n_eval / 1000`` fits
+    the two CPU times (``time.process_time`` around the whole run: building the problem, reading
+    its front, the run, the record). The machine may be loaded.
+    """
+    import time
+
+    from pymoo_rail.experiments.runner import execute_run
+    from pymoo_rail.experiments.spec import Budget, RunSpec
+
+    rows = []
+    for a in study.algorithms:  # compile every kernel (the simulator's, AGE-MOEA's) before timing
+        execute_run(RunSpec(study.problems[0], a, 1, Budget("n_eval", 200)))
+    for p in study.problems:
+        execute_run(RunSpec(p, study.algorithms[0], 1, Budget("n_eval", 200)))  # read the front once
+        for a in study.algorithms:
+            cpu = []
+            for n in budgets:
+                start = time.process_time()
+                execute_run(RunSpec(p, a, 1, Budget("n_eval", n)))
+                cpu.append(time.process_time() - start)
+            per_eval_ms = 1000 * (cpu[1] - cpu[0]) / (budgets[1] - budgets[0])
+            rows.append({"problem": p.display, "algorithm": a.display, **{f"cpu_s_{n}": c for n, c in zip(budgets, cpu)},
+                         "per_eval_ms": per_eval_ms, "fixed_s": cpu[0] - per_eval_ms * budgets[0] / 1000})
+    return pd.DataFrame(rows)
+
+
+def projected_cpu_min(costs: pd.DataFrame, n_eval: int, seeds: int) -> float:
+    """CPU minutes of the whole study at ``n_eval`` evaluations per run, from :func:`cost_table`."""
+    return float(seeds * (costs["fixed_s"] + costs["per_eval_ms"] * n_eval / 1000).sum() / 60)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help=f"{len(QUICK_PROBLEMS)} problems x {QUICK_SEEDS} seeds")
@@ -185,7 +256,51 @@ def main(argv=None) -> int:
     parser.add_argument("--report-only", action="store_true", help="write the report from stored records")
     parser.add_argument("--fronts", action="store_true",
                         help="print each problem's front, certificate and pareto_front() CPU times, and stop")
+    parser.add_argument("--costs", action="store_true",
+                        help="measure the CPU cost of one run per problem and algorithm, project the study's, and stop")
+    parser.add_argument("--best-known", action="store_true",
+                        help="recompute and ship the best-known front of metro-a-4obj, print its size and CPU time, and stop")
+    parser.add_argument("--sanity", action="store_true",
+                        help="NSGA-II (100 x 200 generations) against random sampling on every suite problem, and stop")
     args = parser.parse_args(argv)
+    if args.sanity:
+        from dataclasses import asdict
+
+        from tqdm import tqdm
+
+        from pymoo_rail.experiments.stats import to_markdown
+        from pymoo_rail.suite import list_problems
+        from pymoo_rail.suite.sanity import nsga2_against_random
+
+        names = args.problems or list_problems()
+        rows = [asdict(nsga2_against_random(name)) for name in tqdm(names, desc="sanity", unit="problem")]
+        table = pd.DataFrame(rows)
+        table["passed"] = (np.isfinite(table["igd_nsga2"]) & (table["igd_nsga2"] < table["igd_random"])
+                           & (table["n_below_certificate"] == 0))
+        print(to_markdown(table.round(4)))
+        return 0 if table["passed"].all() else 1
+    if args.best_known:
+        import time
+
+        from pymoo_rail.suite import compute_best_known_front
+        from pymoo_rail.suite.fronts_io import best_known_path
+
+        start = time.process_time()
+        table = compute_best_known_front(write=True)
+        print(f"{best_known_path().name}: {len(table)} points, {time.process_time() - start:.0f} s CPU\n"
+              f"{table.attrs['label']}\n{table.describe().loc[['min', 'max']].to_string()}")
+        return 0
+    if args.costs:
+        from pymoo_rail.experiments.stats import to_markdown
+
+        os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # as in the study's pool workers
+        study = build_study(False, None, args.problems)
+        costs = cost_table(study)
+        print(to_markdown(costs.round(3)))
+        for n_eval in (5000, 8000, 10000, 15000, 20000, study.budget.value):
+            print(f"n_eval = {n_eval}: {projected_cpu_min(costs, n_eval, len(study.seeds)):.0f} CPU min "
+                  f"for {len(study.runs())} runs")
+        return 0
     if args.fronts:
         from pymoo_rail.experiments.stats import to_markdown
 
@@ -202,11 +317,20 @@ def main(argv=None) -> int:
     results = load_results(args.work, study)
     if results.empty:
         raise SystemExit(f"no stored runs in {args.work}")
-    results = scores(results)
-    n_runs = len(study.runs())
-    note = (f"This report covers {len(results)} of the {n_runs} runs of the study as run "
-            f"({len(study.problems)} problems x {len(study.algorithms)} algorithms x {len(study.seeds)} seeds, "
-            f"{study.budget.kind} = {study.budget.value}); the full study file has 10 problems and 30 seeds.")
+    seeds, coverage = complete_seeds(results, study)
+    if not seeds:
+        raise SystemExit(f"no seed has all its runs stored in {args.work}: {coverage}")
+    cpu_min = results["cpu_time_s"].sum() / 60
+    results = scores(results[results["seed"].isin(seeds)].reset_index(drop=True))
+    note = (f"Study: {len(study.problems)} problems x {len(study.algorithms)} algorithms x {len(study.seeds)} seeds, "
+            f"{study.budget.kind} = {study.budget.value:,} per run for every problem and algorithm (NSGA-II: "
+            f"population 100, {study.budget.value // 100} generations). The budget was set from "
+            "`benchmarks/suite.py --costs` (CPU seconds per run at 1,000 and 4,000 evaluations, per problem and "
+            "algorithm, projected to the whole study) so that the study fits about 80 CPU minutes: "
+            "0.04-0.27 ms of CPU per evaluation, the 48.5 km lines and AGE-MOEA the dearest. "
+            f"{coverage} The stored runs took {cpu_min:.1f} CPU minutes (sum of the records' CPU times; the "
+            f"machine was shared with other jobs). Every table below uses the {len(seeds)} complete seeds "
+            f"({len(results)} runs).")
     path = write_report(results, study, Path(args.out), note)
     print(f"wrote {path}")
     return 0

@@ -33,10 +33,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from pymoo.algorithms.soo.nonconvex.de import DE  # noqa: E402
-from pymoo.optimize import minimize  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
 from pymoo_rail.control import PID, FuzzyPID, track  # noqa: E402
+from pymoo_rail.experiments import best_of_seeds  # noqa: E402
+from pymoo_rail.plotting import save_figure  # noqa: E402
 from pymoo_rail.problems import SpeedProfileProblem  # noqa: E402
 from pymoo_rail.sim import Simulator, switching_programs  # noqa: E402
 
@@ -58,14 +59,10 @@ def seed_phase_reference(case, sim):
 
 
 def de_reference(case, sim, gens, seeds=(1, 2)):
-    best = None
-    for seed in seeds:
-        problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=0.5)
-        res = minimize(problem, DE(pop_size=40, CR=0.9), ("n_gen", gens), seed=seed)
-        if res.X is not None and (best is None or res.F[0] < best[0]):
-            best = (float(res.F[0]), res.X, problem)
-    _, x, problem = best
-    return sim.run(problem.encoding.programs(x[None, :])[0])
+    """The least-energy run of DE within 0.5 s of the planned time, best of ``seeds``."""
+    problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=0.5)
+    best = best_of_seeds(problem, lambda: DE(pop_size=40, CR=0.9), ("n_gen", gens), seeds)
+    return sim.run(problem.encoding.programs(best.X[None, :])[0])
 
 
 def heavier(case, factor):
@@ -150,8 +147,7 @@ def main() -> None:
         ax_x.set_title(f"{case.name}, {curve}: control period {period:g} s")
         ax_x.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out_dir / f"{stem}.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, out_dir / f"{stem}.png", dpi=100)
 
     # ---- report
     lines = [f"# PID and adaptive fuzzy PID tracking on {case.name} (seed 002, sections 3.4-3.5)", "",

@@ -29,16 +29,16 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 from pymoo.algorithms.soo.nonconvex.de import DE  # noqa: E402
-from pymoo.optimize import minimize  # noqa: E402
-from scipy.optimize import brentq  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
-from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.constants import KMH_PER_MS  # noqa: E402
 from pymoo_rail.control import Hysteresis, track  # noqa: E402
+from pymoo_rail.experiments import best_of_seeds  # noqa: E402
+from pymoo_rail.optimal.baselines import constant_cruise  # noqa: E402
+from pymoo_rail.plotting import save_figure  # noqa: E402
 from pymoo_rail.problems import SpeedProfileProblem  # noqa: E402
-from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs  # noqa: E402
+from pymoo_rail.sim import Simulator  # noqa: E402
 
 REPORTS = Path(__file__).parent / "reports"
 B_VALUES = (3.0, 4.0, 5.0, 6.0)
@@ -51,23 +51,15 @@ FIELDS = ("reference", "period_s", "a_kmh", "b_kmh", "energy_kwh", "running_time
 
 
 def hold_reference(case, sim):
-    bounds = gradient_limit_partition(case.line)
-
-    def run(v_kmh):
-        return sim.run(speed_code_programs(bounds, np.full(bounds.shape[0] - 1, v_kmh / KMH_PER_MS))[0])
-
-    v = brentq(lambda s: run(s).running_time_s - case.planned_time_s, 40.0, 80.0, xtol=1e-6)
-    return run(v), f"one code, {v:.2f} km/h"
+    """One speed code for every section, running in the planned time (``optimal.baselines.constant_cruise``)."""
+    code, run = constant_cruise(SpeedProfileProblem(case, objectives=("energy",)), tol_s=1e-6)
+    return run, f"one code, {code:.2f} km/h"
 
 
 def de_reference(case, sim, seeds, gens, tracking=None):
-    best = None
-    for seed in seeds:
-        problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=0.5, tracking=tracking)
-        res = minimize(problem, DE(pop_size=50, CR=0.9), ("n_gen", gens), seed=seed)
-        if res.X is not None and (best is None or res.F[0] < best[0]):
-            best = (float(res.F[0]), res.X, problem)
-    f, x, problem = best
+    """The least-energy DE run within 0.5 s of the planned time (of the tracked run with ``tracking``), best of ``seeds``."""
+    problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=0.5, tracking=tracking)
+    x = best_of_seeds(problem, lambda: DE(pop_size=50, CR=0.9), ("n_gen", gens), seeds).X
     ideal = sim.run(problem.encoding.programs(x[None, :])[0])
     return ideal, "codes " + " / ".join(f"{c:.1f}" for c in x) + " km/h"
 
@@ -136,8 +128,7 @@ def main() -> None:
     axes[0, 0].legend(loc="lower center", fontsize=8)
     fig.suptitle("yizhuang: hysteresis tracking of the DE-tracked recommended curve (cf. seed 000 fig. 5-8)")
     fig.tight_layout()
-    fig.savefig(out_dir / "tracking_yizhuang_profiles.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out_dir / "tracking_yizhuang_profiles.png", dpi=110)
 
     fig, (ax_e, ax_t) = plt.subplots(1, 2, figsize=(11, 4))
     for name in references:
@@ -155,8 +146,7 @@ def main() -> None:
     ax_e.grid(alpha=0.3)
     ax_t.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out_dir / "tracking_yizhuang_table.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, out_dir / "tracking_yizhuang_table.png", dpi=110)
 
     # ---- report
     lines = ["# Hysteresis tracking on yizhuang (seed 000, table 5-7)", "",

@@ -25,14 +25,13 @@ finishes; a restart runs only the missing ones). Run it as::
 Outputs: run records in ``--out`` (default ``out/yizhuang_seed000``, not committed), and in
 ``--reports`` (default ``benchmarks/reports``): ``yizhuang_seed000.md``, ``yizhuang_seed000.csv``
 (one row per run: the chosen solution) and ``yizhuang_seed000_*.png``. The energy-level
-variants and the reference optimum are cached in ``--out`` (``variants.json``, ``reference.json``).
+variants and the reference optimum are cached in ``--out`` (``variants.json``, ``reference.csv``).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 from dataclasses import replace
@@ -109,7 +108,10 @@ def load(out: Path, seeds, tolerance_s: float = TOLERANCE_S, n_equal=N_EQUAL) ->
 # ---------------------------------------------------------------------------------------- choice
 def choose(row, planned_s: float, tolerance_s: float) -> dict:
     """The run's recommended solution: least energy with |T - T_plan| <= tolerance among the
-    feasible members of its final set (ABC: its best; MOABC: its archive)."""
+    feasible members of its final set (ABC: its best; MOABC: its archive), by
+    ``pymoo_rail.experiments.punctual_member``."""
+    from pymoo_rail.experiments import punctual_member
+
     F = np.asarray(row["F"], dtype=float)
     X = np.asarray(row["X"], dtype=float)
     CV = np.asarray(row["CV"], dtype=float).reshape(-1)
@@ -118,18 +120,19 @@ def choose(row, planned_s: float, tolerance_s: float) -> dict:
     time_s = np.asarray(ex["running_time_s"], dtype=float)
     stop = np.asarray(ex["stop_error_m"], dtype=float)
     feasible = CV <= 0.0
-    within = feasible & (np.abs(time_s - planned_s) <= tolerance_s + 1e-9)
+    window_s = tolerance_s + 1e-9
     out = {"algorithm": row["algorithm"], "partition": row["problem"], "seed": int(row["seed"]),
            "n_eval": int(row["n_eval"]), "wall_time_s": float(row["wall_time_s"]), "n_front": int(len(F)),
-           "n_feasible": int(feasible.sum()), "n_within": int(within.sum())}
+           "n_feasible": int(feasible.sum()),
+           "n_within": int((feasible & (np.abs(time_s - planned_s) <= window_s)).sum())}
     if F.shape[1] >= 2 and feasible.any():
         err = np.abs(time_s[feasible] - planned_s)
         out["front_time_error_min_s"] = float(err.min())
         out["front_time_error_max_s"] = float(err.max())
         out["front_energy_min_kwh"] = float(energy[feasible].min())
         out["front_energy_max_kwh"] = float(energy[feasible].max())
-    if within.any():
-        i = np.flatnonzero(within)[np.argmin(energy[within])]
+    i = punctual_member(time_s, energy, planned_s, window_s, CV)
+    if i is not None:
         out.update(energy_kwh=float(energy[i]), running_time_s=float(time_s[i]), stop_error_m=float(stop[i]),
                    x=[float(v) for v in X[i]])
     else:
@@ -157,66 +160,11 @@ def make_problem(case, partition: str = NON_EQUAL, tolerance_s: float = TOLERANC
     return SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=tolerance_s, **kwargs)
 
 
-def constant_cruise(problem, target_s: float | None = None, tol_s: float = 1e-3):
-    """The "existing strategy" analogue: one speed code for every section (capped by each
-    section's limit), found by bisection so that the run takes ``target_s`` (default T_plan).
-
-    Returns (code km/h, Trajectory). The running time falls monotonically as the code rises.
-    """
-    target = problem.case.planned_time_s if target_s is None else float(target_s)
-
-    def run(code):
-        return problem.trajectory(np.minimum(np.full(problem.n_var, code), problem.xu))
-
-    lo, hi = float(problem.xl.max()), float(problem.xu.max())
-    if not (run(hi).running_time_s <= target <= run(lo).running_time_s):
-        raise ValueError(f"target_s = {target}: no single code in [{lo}, {hi}] km/h gives that running time")
-    while True:
-        mid = 0.5 * (lo + hi)
-        t = run(mid)
-        if abs(t.running_time_s - target) <= tol_s or hi - lo < 1e-9:
-            return mid, t
-        if t.running_time_s > target:
-            lo = mid
-        else:
-            hi = mid
-
-
-def coast_point(simulator, target_s: float, tol_s: float = 1e-3):
-    """Maximum traction (held at the limits), coasting from one point on, latest braking: the
-    traction-coast-brake practice of seed 000 4.3.1 with the single coasting point found by
-    bisection so that the run takes ``target_s``. Returns (coast position m, Trajectory)."""
-    from pymoo_rail.sim.kernel import MODE_COAST, MODE_TRACTION
-
-    length = simulator.case.line.length_m
-
-    def run(x_m):
-        return simulator.run(np.array([[x_m, MODE_TRACTION, 0.0], [length, MODE_COAST, 0.0]]))
-
-    lo, hi = 0.0, float(length)
-    if not (run(hi).running_time_s <= target_s):
-        raise ValueError(f"target_s = {target_s}: faster than the flat-out run")
-    while True:
-        mid = 0.5 * (lo + hi)
-        t = run(mid)
-        if (t.reached and abs(t.running_time_s - target_s) <= tol_s) or hi - lo < 1e-6:
-            return mid, t
-        if t.running_time_s > target_s or not t.reached:
-            lo = mid
-        else:
-            hi = mid
-
-
 def baselines(case) -> dict:
-    p = make_problem(case)
-    flat = p.simulator.flat_out()
-    code, cruise = constant_cruise(p)
-    x_c, coast = coast_point(p.simulator, case.planned_time_s)
-    return {"flat_out": {"energy_kwh": flat.energy.net_kwh, "running_time_s": flat.running_time_s},
-            "cruise": {"energy_kwh": cruise.energy.net_kwh, "running_time_s": cruise.running_time_s,
-                       "code_kmh": code},
-            "coast": {"energy_kwh": coast.energy.net_kwh, "running_time_s": coast.running_time_s,
-                      "coast_m": x_c}}
+    """Flat-out, constant cruise and coast point at 150 s (``pymoo_rail.optimal.baselines``)."""
+    from pymoo_rail.optimal.baselines import strategy_baselines
+
+    return strategy_baselines(make_problem(case))
 
 
 # ---------------------------------------------------------------------------------------- energy level
@@ -239,24 +187,18 @@ def variant_cases(case) -> dict:
 
 
 def _best_of(problem, seeds=(1, 2, 3, 4, 5)):
-    from pymoo.optimize import minimize
-
+    """(x, trajectory) of the best ABC run over ``seeds`` (``experiments.best_of_seeds``), or None."""
     from pymoo_rail.algorithms import ABC
+    from pymoo_rail.experiments import best_of_seeds
 
-    best = None
-    for seed in seeds:
-        res = minimize(problem, ABC(pop_size=POP, limit=LIMIT), ("n_gen", N_GEN), seed=seed)
-        if res.X is None or res.CV[0] > 0:
-            continue
-        tr = problem.trajectory(res.X)
-        if best is None or tr.energy.net_kwh < best[1].energy.net_kwh:
-            best = (res.X, tr)
-    return best
+    res = best_of_seeds(problem, lambda: ABC(pop_size=POP, limit=LIMIT), ("n_gen", N_GEN), seeds)
+    return None if res is None else (res.X, problem.trajectory(res.X))
 
 
 def energy_level(case, x_best, tolerance_s: float, reopt_seeds=(1, 2, 3, 4, 5)) -> list[dict]:
     """The best ABC profile (its speed codes) under each variant, and the variant re-optimised at 150 s."""
     from pymoo_rail.control import Hysteresis, track
+    from pymoo_rail.optimal.baselines import coast_point, constant_cruise
 
     rows = []
     for label, variant in variant_cases(case).items():
@@ -291,10 +233,10 @@ def cached(path: Path, key: dict, compute):
         data = json.loads(path.read_text())
         if data.get("key") == key:
             return data["value"]
+    from pymoo_rail.atomic import atomic_write_text
+
     value = compute()
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps({"key": key, "value": value}, indent=1, default=float))
-    os.replace(tmp, path)
+    atomic_write_text(path, json.dumps({"key": key, "value": value}, indent=1, default=float))
     return value
 
 
@@ -307,14 +249,15 @@ def reference_available() -> bool:
     return True
 
 
-def reference_front(case, tolerance_s: float) -> dict:
-    """Exact optimum (pymoo_rail.optimal) at running times around T_plan and over the MOABC range."""
-    from pymoo_rail.optimal import optimal_front
+def reference_front(case, tolerance_s: float, path: Path) -> dict:
+    """Exact optimum (pymoo_rail.optimal) at running times around T_plan and over the MOABC range,
+    cached in ``path`` by ``pymoo_rail.problems.reference.exact_points``."""
+    from pymoo_rail.problems.reference import exact_points
 
     planned = case.planned_time_s
     near = np.round(np.arange(planned - tolerance_s - 0.5, planned + tolerance_s + 0.51, 0.25), 6)
     wide = planned + np.array([2.0, 4.0, 7.0, 10.0, 15.0, 20.0, 30.0, 40.0, 50.0])
-    front = optimal_front(case, np.unique(np.concatenate([near, wide])))
+    front = exact_points(case, np.unique(np.concatenate([near, wide])), path)
     return {"running_time_s": front["running_time_s"].tolist(), "energy_kwh": front["energy_kwh"].tolist()}
 
 
@@ -360,13 +303,11 @@ def fmt(v, digits=2):
 
 
 def ranksum(a, b) -> str:
-    from scipy.stats import mannwhitneyu
+    """p of the two-sided rank-sum test (``pymoo_rail.experiments.stats.rank_sum``), '-' when a side has < 2 runs."""
+    from pymoo_rail.experiments.stats import rank_sum
 
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
-    if len(a) < 2 or len(b) < 2:
-        return "-"
-    return f"{mannwhitneyu(a, b, alternative='two-sided').pvalue:.2g}"
+    p = rank_sum(a, b)[1]
+    return f"{p:.2g}" if np.isfinite(p) else "-"
 
 
 def _restyle_comparison_lines(ax) -> None:
@@ -515,13 +456,12 @@ def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, r
     if reference:
         if not reference_available():
             raise SystemExit("--reference: pymoo_rail.optimal is not installed in this checkout (merge main first)")
-        ref = cached(out / "reference.json", {"case": CASE, "tolerance_s": tolerance_s, "v": 1},
-                     lambda: reference_front(case, tolerance_s))
+        ref = reference_front(case, tolerance_s, out / "reference.csv")
         from pymoo_rail.optimal import optimal_profile
 
         ref_traj = optimal_profile(case, planned)
-    elif (out / "reference.json").exists() and reference_available():
-        ref = json.loads((out / "reference.json").read_text())["value"]
+    elif (out / "reference.csv").exists() and reference_available():
+        ref = reference_front(case, tolerance_s, out / "reference.csv")
     summ = summary_rows(ch, base, ref)
 
     L = ["# Seed 000 chapter 5 on the rail problem: ABC and MOABC on yizhuang (tables 5-5, 5-6)", "",

@@ -55,19 +55,21 @@ def test_every_room_has_a_layer():
     assert rooms <= set(LAYERS), f"rooms without a layer in docs/architecture.md: {sorted(rooms - set(LAYERS))}"
 
 
+def _package_imports():
+    """(where, room of the importer, module path parts, imported names) of every package import."""
+    for path in _sources():
+        for line, module, names in _imports(path):
+            yield f"{path.relative_to(PACKAGE.parent)}:{line}", _room(path), module.split("."), names
+
+
 def test_arrows_point_down():
     wrong = []
-    for path in _sources():
-        src = _room(path)
-        for line, module, _ in _imports(path):
-            parts = module.split(".")
-            if len(parts) < 2:
-                continue  # the package root (version)
-            dst = parts[1]
-            if dst == src:
-                continue
-            if src in PYMOO_ONLY or LAYERS.get(dst, 99) > LAYERS[src]:
-                wrong.append(f"{path.relative_to(PACKAGE.parent)}:{line} {src} -> {dst}")
+    for where, src, parts, _ in _package_imports():
+        if len(parts) < 2 or parts[1] == src:
+            continue  # the package root (version), or the room itself
+        dst = parts[1]
+        if src in PYMOO_ONLY or LAYERS.get(dst, 99) > LAYERS[src]:
+            wrong.append(f"{where} {src} -> {dst}")
     assert not wrong, "imports against the layers:\n" + "\n".join(wrong)
 
 
@@ -79,15 +81,12 @@ def test_no_private_name_crosses_a_module():
     # a private module (``algorithms/_bees.py``) serves the modules of its own room only;
     # a private name (``_full_step``) serves its own module only
     wrong = []
-    for path in _sources():
-        room = _room(path)
-        for line, module, names in _imports(path):
-            parts = module.split(".")
-            private = [n for n in names if _private(n)]
-            if len(parts) > 1 and parts[1] != room:
-                private += [p for p in parts if _private(p)]
-            if private:
-                wrong.append(f"{path.relative_to(PACKAGE.parent)}:{line} {module}: {', '.join(private)}")
+    for where, room, parts, names in _package_imports():
+        private = [n for n in names if _private(n)]
+        if len(parts) > 1 and parts[1] != room:
+            private += [p for p in parts if _private(p)]
+        if private:
+            wrong.append(f"{where} {'.'.join(parts)}: {', '.join(private)}")
     assert not wrong, "private names imported across modules:\n" + "\n".join(wrong)
 
 
@@ -99,3 +98,70 @@ def test_the_checks_catch_a_violation(tmp_path, rule):
     found = list(_imports(bad))
     assert ("pymoo_rail.cli", ["main"]) == found[0][1:]
     assert ("pymoo_rail.sim.kernel", ["_x"]) == found[1][1:]
+
+
+def _unit_factor_uses(path: Path) -> list[str]:
+    """Places that define or spell out a unit factor instead of importing it from ``pymoo_rail.constants``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            for t in targets:
+                if isinstance(t, ast.Name) and any(k in t.id for k in ("KMH_PER_MS", "J_PER_KWH", "MS_TO_KMH")):
+                    found.append(f"{path.name}:{node.lineno} defines {t.id}")
+        elif isinstance(node, ast.Constant) and type(node.value) is float and node.value == 3.6e6:
+            found.append(f"{path.name}:{node.lineno} spells out 3.6e6 (J_PER_KWH)")
+        elif isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Mult, ast.Div)):
+            for side in (node.left, node.right):
+                if isinstance(side, ast.Constant) and side.value == 3.6:
+                    other = ast.unparse(node.right if side is node.left else node.left)
+                    if isinstance(node.op, ast.Div) and side is node.right or "_ms" in other or "speed" in other:
+                        found.append(f"{path.name}:{node.lineno} spells out 3.6 (KMH_PER_MS) in {ast.unparse(node)}")
+    return found
+
+
+def test_unit_factors_are_defined_once():
+    wrong = [w for p in _sources() if p != PACKAGE / "constants.py" for w in _unit_factor_uses(p)]
+    assert not wrong, "use pymoo_rail.constants:\n" + "\n".join(wrong)
+
+
+def test_the_unit_factor_check_catches_a_copy(tmp_path):
+    bad = tmp_path / "bad.py"
+    bad.write_text("J_PER_KWH = 3.6e6\nv_kmh = speed_ms * 3.6\nv_ms = 80 / 3.6\nfigsize = (4.6, 3.6 * 2)\n")
+    found = _unit_factor_uses(bad)
+    assert len(found) == 4 and "figsize" not in " ".join(found)  # define + 3.6e6 + two spelled-out 3.6
+
+
+def test_benchmark_scripts_use_only_public_names():
+    # a benchmark is a user's script: what it needs from the package is public API
+    wrong = []
+    for path in sorted((PACKAGE.parent / "benchmarks").glob("*.py")):
+        for line, module, names in _imports(path):
+            private = [n for n in names if _private(n)] + [p for p in module.split(".") if _private(p)]
+            if private:
+                wrong.append(f"benchmarks/{path.name}:{line} {module}: {', '.join(private)}")
+    assert not wrong, "private names used by benchmark scripts:\n" + "\n".join(wrong)
+
+
+def _undocumented(path: Path) -> list[str]:
+    """Public functions, classes and methods of a module without a docstring."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    missing = []
+
+    def visit(body, prefix: str) -> None:
+        for node in body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and not node.name.startswith("_"):
+                if ast.get_docstring(node) is None:
+                    missing.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno} {prefix}{node.name}")
+                if isinstance(node, ast.ClassDef):
+                    visit(node.body, f"{prefix}{node.name}.")
+
+    visit(tree.body, "")
+    return missing
+
+
+def test_every_public_name_has_a_docstring():
+    # private modules (``_bees.py``) and private names are exempt
+    missing = [m for p in _sources() if not p.name.startswith("_") for m in _undocumented(p)]
+    assert not missing, "public names without a docstring:\n" + "\n".join(missing)

@@ -210,6 +210,19 @@ class BeeColony(Algorithm):
     def _observe(self, infills) -> None:
         """Called with every evaluated batch before it is used."""
 
+    def _keep_better(self, infills: Population, off_F, off_CV, pop_F, pop_CV, better) -> None:
+        """Greedy selection of both colonies: candidate ``c`` replaces source ``self._parents[c]`` when
+        ``better(candidate F, CV, source F, CV)``; the source's trial counter restarts or grows.
+        ``pop_F`` / ``pop_CV`` are updated in place, so a later candidate of the same source meets
+        the new one."""
+        for c, i in enumerate(self._parents):
+            if better(off_F[c], off_CV[c], pop_F[i], pop_CV[i]):
+                self.pop[i] = infills[c]
+                pop_F[i], pop_CV[i] = off_F[c], off_CV[c]
+                self.trials[i] = 0
+            else:
+                self.trials[i] += 1
+
     def _start_colony(self, infills, order: np.ndarray) -> None:
         """The first ``n_sources`` of ``order`` (indices of ``infills``) become the food sources."""
         self.pop = infills[np.sort(order[: self.n_sources])]

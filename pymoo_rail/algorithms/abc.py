@@ -153,13 +153,7 @@ class ABC(BeeColony):
         """Replace sources by strictly better candidates, in draw order; count trials."""
         off_F, off_CV = infills.get("F")[:, 0], infills.get("CV")[:, 0]
         pop_F, pop_CV = self.pop.get("F")[:, 0], self.pop.get("CV")[:, 0]
-        for c, i in enumerate(self._parents):
-            if feasibility_first_better(off_F[c], off_CV[c], pop_F[i], pop_CV[i]):
-                self.pop[i] = infills[c]
-                pop_F[i], pop_CV[i] = off_F[c], off_CV[c]
-                self.trials[i] = 0
-            else:
-                self.trials[i] += 1
+        self._keep_better(infills, off_F, off_CV, pop_F, pop_CV, feasibility_first_better)
 
     def _set_optimum(self) -> None:
         # keep the best ever seen: scouts may abandon the current best source

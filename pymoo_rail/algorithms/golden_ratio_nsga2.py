@@ -150,10 +150,12 @@ class GoldenRatioOutput(MultiObjectiveOutput):
         self.n_acc = Column("n_acc", width=6)
 
     def initialize(self, algorithm) -> None:
+        """Add the crossover and mutation probabilities and the accepted local points to the columns."""
         super().initialize(algorithm)
         self.columns += [self.pc, self.pm, self.n_acc]
 
     def update(self, algorithm) -> None:
+        """Fill the columns from the generation just finished (means over the mating pairs)."""
         super().update(algorithm)
         pc, pm = algorithm.last_pc, algorithm.last_pm
         self.pc.set(float(pc.mean()) if len(pc) > 0 else None)

@@ -245,13 +245,7 @@ class MOABC(BeeColony):
         # Python floats: a scalar comparison per pair is cheaper on lists than on array rows
         _, off_F, off_CV = (a.tolist() for a in self._infill_arrays)
         _, pop_F, pop_CV = (a.tolist() for a in population_arrays(self.pop))
-        for c, i in enumerate(self._parents):
-            if constraint_dominates(off_F[c], off_CV[c], pop_F[i], pop_CV[i]):
-                self.pop[i] = infills[c]
-                pop_F[i], pop_CV[i] = off_F[c], off_CV[c]
-                self.trials[i] = 0
-            else:
-                self.trials[i] += 1
+        self._keep_better(infills, off_F, off_CV, pop_F, pop_CV, constraint_dominates)
 
     def _update_archive(self, infills: Population, arrays: tuple) -> None:
         X_new, F_new, CV_new = arrays

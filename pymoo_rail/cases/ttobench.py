@@ -263,6 +263,7 @@ class TTOBenchTrack:
 
     @property
     def length_m(self) -> float:
+        """Length of the track (m): the position of the last stop."""
         return self.stops_m[-1]
 
     def line(self, gradient_model: str = "point_mass", *, curve_model: str = "tang2020",

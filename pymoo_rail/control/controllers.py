@@ -132,12 +132,15 @@ class Hysteresis:
 
     @property
     def name(self) -> str:
+        """A readable name with the band (km/h)."""
         return f"Hysteresis(A={self.a_kmh:g}, B={self.b_kmh:g})"
 
     def code(self) -> int:
+        """The controller's code for the tracking kernel."""
         return CTRL_HYSTERESIS
 
     def params(self) -> np.ndarray:
+        """The parameters as the tracking kernel reads them: A, B, overspeed (km/h), brake fraction."""
         return np.array([self.a_kmh, self.b_kmh, self.overspeed_kmh, self.brake_fraction], dtype=float)
 
 
@@ -171,12 +174,15 @@ class PID:
 
     @property
     def name(self) -> str:
+        """A readable name with the gains."""
         return f"PID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g})"
 
     def code(self) -> int:
+        """The controller's code for the tracking kernel."""
         return CTRL_PID
 
     def params(self) -> np.ndarray:
+        """The parameters as the tracking kernel reads them: kp, ki, kd."""
         return np.array([self.kp, self.ki, self.kd], dtype=float)
 
 
@@ -236,12 +242,17 @@ class FuzzyPID:
 
     @property
     def name(self) -> str:
+        """A readable name with the base gains."""
         return f"FuzzyPID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g})"
 
     def code(self) -> int:
+        """The controller's code for the tracking kernel."""
         return CTRL_FUZZY_PID
 
     def params(self) -> np.ndarray:
+        """The parameters as the tracking kernel reads them: base gains, input ranges, gain steps, then the rule
+        tables.
+        """
         head = [self.kp, self.ki, self.kd, self.e_range_kmh, self.ec_range_kmhs, self.dkp, self.dki, self.dkd]
         return np.concatenate([np.array(head, dtype=float), self.rule_tables().ravel()])
 

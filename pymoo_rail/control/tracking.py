@@ -69,6 +69,7 @@ class Tracker:
 
     @property
     def case(self) -> Case:
+        """The case the tracked train runs on."""
         return self.simulator.case
 
     def run(self, reference: Trajectory, speed_noise_ms: np.ndarray | None = None,

@@ -18,7 +18,13 @@ from pymoo_rail.experiments.registry import (
     build_problem,
     problem_names,
 )
-from pymoo_rail.experiments.fronts import choose_member, distinct_front, distinct_index
+from pymoo_rail.experiments.fronts import (
+    best_of_seeds,
+    choose_member,
+    distinct_front,
+    distinct_index,
+    punctual_member,
+)
 from pymoo_rail.experiments.results import indicator_columns, load_records, load_results, records_frame
 from pymoo_rail.experiments.runner import StudyReport, execute_run, run_study
 from pymoo_rail.experiments.spec import (
@@ -30,6 +36,7 @@ from pymoo_rail.experiments.spec import (
     StudyError,
     algorithm,
     problem,
+    tang2020_nsga2,
 )
 from pymoo_rail.experiments.store import ResultStore
 from pymoo_rail.experiments.study_file import read_study, study_to_toml, write_study
@@ -38,4 +45,4 @@ __all__ = ["Study", "ProblemSpec", "AlgorithmSpec", "Budget", "RunSpec", "StudyE
            "run_study", "execute_run", "StudyReport", "load_results", "load_records", "records_frame",
            "indicator_columns", "read_study", "write_study", "study_to_toml", "ResultStore", "PROBLEMS",
            "ALGORITHMS", "problem_names", "algorithm_names", "build_problem", "build_algorithm", "distinct_front",
-           "distinct_index", "choose_member"]
+           "distinct_index", "choose_member", "punctual_member", "tang2020_nsga2", "best_of_seeds"]

@@ -33,13 +33,25 @@ def spacing_indicator():
 
 
 def true_front(problem) -> np.ndarray | None:
-    """The problem's known Pareto front (dense where pymoo allows), or None."""
+    """The problem's known Pareto front (dense where pymoo allows), or None.
+
+    Parameters
+    ----------
+    problem : pymoo Problem
+        Any problem; one without a known front returns ``None`` from pymoo's ``pareto_front`` or
+        raises ``NotImplementedError`` (a rail problem without a certified front does).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        The front, shape (n, n_obj), or ``None`` when the problem knows none.
+    """
     try:
         try:
             pf = problem.pareto_front(n_pareto_points=1000, use_cache=False)
-        except TypeError:
+        except TypeError:  # a front without a size argument
             pf = problem.pareto_front()
-    except Exception:  # pymoo problems without a front raise all sorts of things
+    except NotImplementedError:  # no known front (pymoo_rail.problems.reference.NoExactFrontError)
         return None
     if pf is None:
         return None
@@ -61,6 +73,9 @@ def normalised_hv(F: np.ndarray, ideal: np.ndarray, nadir: np.ndarray) -> float:
 
 
 def gd_van_veldhuizen(F: np.ndarray, pf: np.ndarray) -> float:
+    """Van Veldhuizen's generational distance ``sqrt(sum d_i^2) / n`` of ``F`` to the front ``pf`` (raw units; Tang
+    et al. (2020) eq. 13).
+    """
     from scipy.spatial.distance import cdist
 
     d = cdist(F, pf).min(axis=1)

@@ -359,10 +359,12 @@ def _import_path(path: str, kind: str) -> Callable[..., Any]:
 
 
 def problem_names() -> list[str]:
+    """Names of the registered problems, sorted."""
     return sorted(PROBLEMS)
 
 
 def algorithm_names() -> list[str]:
+    """Names of the registered algorithms, sorted."""
     return sorted(ALGORITHMS)
 
 
@@ -374,6 +376,9 @@ def check_problem_name(name: str) -> None:
 
 
 def check_algorithm_name(name: str) -> None:
+    """Raise :class:`StudyError` naming the known algorithms when ``name`` is neither one of them nor
+    ``module:factory``.
+    """
     if ":" not in name and canonical_name(name) not in ALGORITHMS:
         raise StudyError("algorithm", name, f"unknown algorithm (built-in: {', '.join(algorithm_names())}; "
                                             "or give 'package.module:factory')")

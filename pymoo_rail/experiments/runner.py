@@ -44,6 +44,7 @@ EXTRA_KEYS = ("energy_kwh", "running_time_s", "stop_error_m")
 
 
 def versions() -> dict[str, str]:
+    """Versions of pymoo-rail, pymoo, numpy and Python, stored with every run record."""
     import pymoo
 
     import pymoo_rail
@@ -240,6 +241,7 @@ class StudyReport:
 
     @property
     def complete(self) -> bool:
+        """True when every run of the study is stored (skipped, finished here or by another process)."""
         return self.n_skipped + self.n_finished + self.n_elsewhere == self.n_runs
 
     def __str__(self) -> str:

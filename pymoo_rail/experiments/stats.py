@@ -346,7 +346,7 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
             part = summary[name].copy()
             part.insert(0, "n", summary[("runs", "n")] if "n" not in part.columns else part.pop("n"))
             sections.append(f"## {name}\n\n" + to_markdown(part, bold_marker=None))
-    emit("summary.md", f"# Summary over seeds (std: sample standard deviation)\n\n" + "\n".join(sections))
+    emit("summary.md", "# Summary over seeds (std: sample standard deviation)\n\n" + "\n".join(sections))
     for name in indicators:
         if results[name].notna().any():
             table = indicator_table(results, name, baseline, alpha)

@@ -95,6 +95,7 @@ class ResultStore:
                         pass
 
     def path(self, run_id: str) -> Path:
+        """The record file of a run."""
         return self.runs_dir / f"{run_id}.json"
 
     def done_ids(self) -> set[str]:
@@ -116,6 +117,7 @@ class ResultStore:
         return path
 
     def write_failure(self, run_id: str, failure: dict) -> Path:
+        """Store the error of a failed run (atomically) and return its file."""
         return atomic_write_text(self.failed_dir / f"{run_id}.json", json.dumps(failure, indent=1))
 
     def set_aside(self, run_id: str, folder: str) -> Path | None:
@@ -188,9 +190,11 @@ class ResultStore:
         return self.check(path)
 
     def read(self, run_id: str) -> dict:
+        """The checked record of a run (:class:`RecordError` when it is corrupt)."""
         return self.check(self.path(run_id))
 
     def failures(self) -> list[dict]:
+        """The stored errors of failed runs, one dict per run."""
         if not self.failed_dir.is_dir():
             return []
         out = []

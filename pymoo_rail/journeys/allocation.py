@@ -239,10 +239,12 @@ class Allocation:
 
     @property
     def running_times_s(self) -> np.ndarray:
+        """Running time of each section (s)."""
         return self.table["running_time_s"].to_numpy(dtype=float)
 
     @property
     def energies_kwh(self) -> np.ndarray:
+        """Net energy of each section (kWh)."""
         return self.table["energy_kwh"].to_numpy(dtype=float)
 
     def marginal_violation(self) -> float:

@@ -119,10 +119,12 @@ class Journey:
 
     @property
     def name(self) -> str:
+        """The journey's name (its case's)."""
         return self.case.name
 
     @property
     def source(self) -> str:
+        """Where the journey's data come from (its case's source)."""
         return self.case.source
 
     @property
@@ -140,26 +142,32 @@ class Journey:
 
     @property
     def train(self) -> Train:
+        """The train (the same in every section)."""
         return self.sections[0].train
 
     @property
     def n_sections(self) -> int:
+        """Number of sections (stop to stop)."""
         return len(self.sections)
 
     @property
     def section_lengths_m(self) -> np.ndarray:
+        """Length of each section (m)."""
         return np.array([c.line.length_m for c in self.sections])
 
     @property
     def length_m(self) -> float:
+        """Length of the whole journey (m)."""
         return float(self.section_lengths_m.sum())
 
     @property
     def total_dwell_s(self) -> float:
+        """Sum of the dwell times at the intermediate stops (s)."""
         return float(sum(self.dwell_s))
 
     @property
     def planned_running_times_s(self) -> np.ndarray:
+        """Planned running time of each section (s)."""
         return np.array([c.planned_time_s for c in self.sections])
 
     def section_label(self, k: int) -> str:

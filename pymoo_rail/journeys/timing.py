@@ -53,13 +53,16 @@ class TimingPoint:
 
     @property
     def is_stop(self) -> bool:
+        """True when the point is a stop (speed window 0-0 km/h)."""
         return self.min_speed_kmh == 0.0 and self.max_speed_kmh == 0.0
 
     def time_ok(self, time_s: float, tol_s: float = 1e-6) -> bool:
+        """True when ``time_s`` is inside the time window (within ``tol_s``)."""
         return (self.earliest_s is None or time_s >= self.earliest_s - tol_s) and \
             (self.latest_s is None or time_s <= self.latest_s + tol_s)
 
     def speed_ok(self, speed_kmh: float, tol_kmh: float = 1e-6) -> bool:
+        """True when ``speed_kmh`` is inside the speed window (within ``tol_kmh``)."""
         return (self.min_speed_kmh is None or speed_kmh >= self.min_speed_kmh - tol_kmh) and \
             (self.max_speed_kmh is None or speed_kmh <= self.max_speed_kmh + tol_kmh)
 
@@ -111,6 +114,7 @@ class TimedJourney:
 
     @property
     def timing_points(self) -> tuple[TimingPoint, ...]:
+        """All timing points of the journey, section by section."""
         out: list[TimingPoint] = []
         for section in self.windows:
             out.extend(section)
@@ -241,10 +245,12 @@ class TimedRun:
 
     @property
     def energy_kwh(self) -> float:
+        """Net energy of the whole journey (kWh)."""
         return float(sum(t.energy.net_kwh for t in self.trajectories))
 
     @property
     def all_met(self) -> bool:
+        """True when every timing point's time and speed windows are met."""
         return all(c["time_ok"] and c["speed_ok"] for c in self.checks)
 
 

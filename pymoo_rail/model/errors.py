@@ -1,15 +1,23 @@
-"""Errors raised for bad case data."""
+"""Errors raised for bad case data (and the field error that study declarations share)."""
 
 from __future__ import annotations
 
 import math
 
 
-class CaseError(ValueError):
-    """A case file or case object holds a value the model cannot use.
+class FieldError(ValueError):
+    """A value a field cannot hold; the message names the source, the field path and the value.
 
-    The message always names the source (file or object), the field and the offending value,
-    so a user can find and fix the entry.
+    Parameters
+    ----------
+    field : str
+        The field path (``"train.mass_t"``, ``"algorithms[0].pop_size"``).
+    value : object
+        The offending value.
+    reason : str
+        What is wrong with it.
+    source : str, optional
+        The file or object it came from.
     """
 
     def __init__(self, field: str, value: object, reason: str, source: str | None = None):
@@ -19,6 +27,14 @@ class CaseError(ValueError):
         self.source = source
         where = f"{source}: " if source else ""
         super().__init__(f"{where}field '{field}' = {value!r}: {reason}")
+
+
+class CaseError(FieldError):
+    """A case file or case object holds a value the model cannot use.
+
+    The message always names the source (file or object), the field and the offending value,
+    so a user can find and fix the entry.
+    """
 
 
 class InfeasibleCaseError(CaseError):

@@ -49,6 +49,7 @@ class TrackGrid:
 
     @property
     def n_nodes(self) -> int:
+        """Number of grid nodes (cells + 1)."""
         return self.position_m.shape[0]
 
     @property

@@ -61,6 +61,7 @@ class Train:
 
     @property
     def mass_kg(self) -> float:
+        """Mass (kg)."""
         return self.mass_t * 1000.0
 
     @property
@@ -70,8 +71,10 @@ class Train:
 
     @property
     def max_speed_ms(self) -> float:
+        """Maximum speed (m/s)."""
         return self.max_speed_kmh / KMH_PER_MS
 
     @property
     def weight_kn(self) -> float:
+        """Weight ``m g`` (kN)."""
         return self.mass_kg * GRAVITY_MS2 / 1000.0

@@ -1,10 +1,8 @@
-"""Plots against the optimum: a front against the optimal front, a profile against the optimal one."""
+"""A speed profile against the optimal one (fronts against the optimal front: ``pymoo_rail.plotting.plot_fronts``)."""
 
 from __future__ import annotations
 
 from pathlib import Path
-
-import numpy as np
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.sim import Trajectory
@@ -17,52 +15,6 @@ def _figure(ax):
         return ax.figure, ax
     fig, ax = plt.subplots(figsize=(7.0, 4.5), constrained_layout=True)
     return fig, ax
-
-
-def _points(front) -> np.ndarray:
-    if hasattr(front, "columns"):
-        return front[["running_time_s", "energy_kwh"]].to_numpy(dtype=float)
-    points = np.asarray(front, dtype=float)
-    if points.ndim != 2 or points.shape[1] != 2:
-        raise ValueError(f"a front has shape {points.shape}: expected (n, 2) rows of (running_time_s, energy_kwh)")
-    return points
-
-
-def plot_front(reference, fronts: dict | None = None, path: str | Path | None = None, ax=None,
-               title: str | None = None):
-    """Energy against running time: the optimal front as a line, other fronts as markers.
-
-    Parameters
-    ----------
-    reference : DataFrame or array (n, 2)
-        The optimal front (``running_time_s``, ``energy_kwh``).
-    fronts : dict of label -> DataFrame or array (n, 2), optional
-        Fronts to compare (e.g. an optimiser's non-dominated set, seed results).
-    path : str or Path, optional
-        Save the figure there (PNG by the suffix).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    fig, ax = _figure(ax)
-    ref = _points(reference)
-    ref = ref[np.argsort(ref[:, 0])]
-    ax.plot(ref[:, 0], ref[:, 1], "-", color="black", lw=1.8, label="optimum (DP)")
-    ax.plot(ref[:, 0], ref[:, 1], "o", color="black", ms=3)
-    markers = "s^vDP*X"
-    for k, (label, front) in enumerate((fronts or {}).items()):
-        pts = _points(front)
-        ax.plot(pts[:, 0], pts[:, 1], markers[k % len(markers)], ms=5, alpha=0.8, label=label)
-    ax.set_xlabel("Running time (s)")
-    ax.set_ylabel("Net energy (kWh)")
-    ax.grid(True, alpha=0.3)
-    ax.legend()
-    if title:
-        ax.set_title(title)
-    if path is not None:
-        fig.savefig(path, dpi=130)
-    return fig
 
 
 def plot_profile(optimal: Trajectory, others: dict[str, Trajectory] | None = None,

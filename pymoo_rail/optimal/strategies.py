@@ -161,10 +161,3 @@ def two_holds_search(case: Case, running_time_s: float, dx_m: float | None = Non
     out = sim.run_batch(progs)[0]
     return StrategyResult("two_holds", float(e1[0]), float(out[OUT_RUNNING_TIME_S]), progs[0],
                           tuple(float(p) for p in best_p))
-
-
-def best_strategy(case: Case, running_time_s: float, dx_m: float | None = None, seed: int = 0) -> StrategyResult:
-    """The better of the two families' searches at one running time."""
-    first = hold_coast_search(case, running_time_s, dx_m)
-    second = two_holds_search(case, running_time_s, dx_m, seed=seed, start=first)
-    return min((first, second), key=lambda r: r.energy_kwh)

@@ -29,33 +29,74 @@ NEUTRAL_COLOR = "gold"
 
 
 def objective_label(name: str | None, index: int) -> str:
+    """Axis label with unit of objective ``name`` (``f1``, ``f2`` ... when unnamed)."""
     if name is None:
         return f"f{index + 1}"
     return OBJECTIVE_LABELS.get(name, name)
 
 
 def objective_labels(names: Sequence[str] | None, n_obj: int) -> list[str]:
+    """Axis labels of ``n_obj`` objectives; ``ValueError`` when ``names`` has another length."""
     if names is not None and len(names) != n_obj:
         raise ValueError(f"objectives = {list(names)!r}: the front has {n_obj} objectives")
     return [objective_label(None if names is None else names[i], i) for i in range(n_obj)]
 
 
 def indicator_label(name: str) -> str:
+    """Axis label of an indicator (its name when unknown)."""
     return INDICATOR_LABELS.get(name, name)
 
 
-def save_figure(fig, path: str | Path, dpi: int = 150, close: bool = True) -> Path:
-    """Save a figure (format from the suffix) through a temporary file, so no half-written image
-    is left behind; closes it by default to free memory in long loops."""
+def save_figure(fig, path: str | Path, dpi: int = 150, close: bool = True, palette: bool = True) -> Path:
+    """Save a figure (format from the suffix) through a temporary file, so no half-written image is left.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or Path
+        Where to write it; the suffix gives the format.
+    dpi : int
+        Resolution of raster formats.
+    close : bool
+        Close the figure afterwards (frees memory in long loops).
+    palette : bool
+        Store a PNG with a 256-colour palette: a plot has few colours, and the file is about a
+        third of the full-colour one (committed report figures have a size limit:
+        ``docs/architecture.md``).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     try:
         with atomic_path(path, suffix=Path(path).suffix) as tmp:
             fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+            if palette and Path(path).suffix.lower() == ".png":
+                to_palette_png(tmp)
     finally:
         if close:
             import matplotlib.pyplot as plt
 
             plt.close(fig)
     return Path(path)
+
+
+def to_palette_png(path: str | Path) -> None:
+    """Rewrite a PNG in place with a 256-colour palette (no dithering: flat plot colours stay flat).
+
+    Parameters
+    ----------
+    path : str or Path
+        A PNG file.
+    """
+    from PIL import Image  # matplotlib's own dependency
+
+    with Image.open(path) as image:
+        quantized = image.convert("RGB").quantize(colors=256, method=Image.Quantize.MEDIANCUT,
+                                                  dither=Image.Dither.NONE)
+    quantized.save(path, format="PNG", optimize=True)
 
 
 def new_figure(nrows: int = 1, ncols: int = 1, figsize=(7.0, 4.5), **kwargs):

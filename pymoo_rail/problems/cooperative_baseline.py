@@ -37,6 +37,7 @@ class ExactBaseline:
 
     @property
     def energies_kwh(self) -> tuple[float, ...]:
+        """Traction energy of each train's exact optimum (kWh)."""
         return tuple(t.energy.traction_kwh for t in self.trajectories)
 
     @property
@@ -49,13 +50,16 @@ class ExactBaseline:
         return {"case": self.case.name, "energies_kwh": list(self.energies_kwh), "energy_kwh": self.energy_kwh,
                 "running_times_s": [t.running_time_s for t in self.trajectories]}
 
+    def clocked_pair(self, offset_s: float) -> list:
+        """The optimal runs of legs 0 and 1 on the common clock, leg 1's leaving ``offset_s`` later."""
+        if len(self.trajectories) != 2:
+            raise ValueError(f"a pair needs two legs, the baseline has {len(self.trajectories)}")
+        return [coop.clocked_run(Simulator(self.case.leg(k)).model, t, dep, self.case.legs[k].start_m)
+                for k, (t, dep) in enumerate(zip(self.trajectories, (0.0, float(offset_s))))]
+
     def shared_by_chance_kwh(self, offset_s: float, time_step_s: float = 0.1) -> float:
         """What the optimal runs of legs 0 and 1 share anyway when leg 1's leaves ``offset_s`` later."""
-        if len(self.trajectories) != 2:
-            raise ValueError(f"shared_by_chance_kwh needs two legs, the baseline has {len(self.trajectories)}")
-        runs = [coop.clocked_run(Simulator(self.case.leg(k)).model, t, dep, self.case.legs[k].start_m)
-                for k, (t, dep) in enumerate(zip(self.trajectories, (0.0, float(offset_s))))]
-        return coop.shared_energy_kwh(runs, 1.0, time_step_s)
+        return coop.shared_energy_kwh(self.clocked_pair(offset_s), 1.0, time_step_s)
 
 
 def exact_baseline(case: Case, **settings) -> ExactBaseline:

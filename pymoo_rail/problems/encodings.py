@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, Line
 from pymoo_rail.sim import (
     Simulator,
@@ -42,7 +43,6 @@ from pymoo_rail.sim import (
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.pacing import split_long_sections
 
-KMH_PER_MS = 3.6
 PARTITIONS = ("gradient_limit", "equal")
 # Long sparse lines: a gradient/limit partition whose sections average more than this keeps its
 # sections and gives each a coasting point, unless max_section_m is given (the 48.5 km TTOBench
@@ -122,10 +122,12 @@ class SpeedCodes:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (one speed code per section)."""
         return self.xl.shape[0]
 
     @property
     def n_sections(self) -> int:
+        """Number of sections of the partition (one speed code each)."""
         return self.boundaries_m.shape[0] - 1
 
     @property
@@ -134,6 +136,7 @@ class SpeedCodes:
         return ["km/h"] * self.n_sections + ["m"] * (self.n_var - self.n_sections)
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of the speed codes ``X`` (km/h, one row per decision vector)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if self.coast_points:
             return self._coasting_programs(X)
@@ -182,6 +185,7 @@ class SwitchingPoints:
 
     @classmethod
     def build(cls, case: Case, regimes: tuple[str, ...] | None = None) -> SwitchingPoints:
+        """The switching-point encoding of ``case`` (default: a traction-hold-coast cycle per limit zone, then brake)."""
         if regimes is None:
             zones = 1
             limits = [row[2] for row in case.line.speed_limits]
@@ -198,12 +202,15 @@ class SwitchingPoints:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (one switching point per regime change)."""
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of the switching points ``X`` (m, one row per decision vector)."""
         return switching_programs(X, self.regimes, self.length_m)
 
     def fixed(self) -> np.ndarray:
+        """Mask of the genes an algorithm must not change (none)."""
         return np.zeros(self.n_var, dtype=bool)
 
 
@@ -281,13 +288,16 @@ class BrakingOnset:
 
     @property
     def n_var(self) -> int:
+        """Number of decision variables (switching points, braking onset, deceleration)."""
         return self.xl.shape[0]
 
     def programs(self, X: np.ndarray) -> np.ndarray:
+        """Simulator programs of ``X`` (switching points and braking onset in m, deceleration last)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
         return braking_programs(X[:, :-1], self.regimes, X[:, -1], self.simulator.length_m)
 
     def fixed(self) -> np.ndarray:
+        """Mask of the genes an algorithm must not change (none)."""
         return np.zeros(self.n_var, dtype=bool)
 
     def run_batch(self, programs: np.ndarray) -> np.ndarray:

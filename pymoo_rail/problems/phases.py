@@ -42,14 +42,13 @@ from typing import Sequence
 import numpy as np
 from pymoo.core.problem import Problem
 
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case
-from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning, canonical_objective
+from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning, canonical_objective, weighted_sum_settings
 
 PHASE_NAMES = ("traction", "cruise", "coast", "brake")
 PHASE_OBJECTIVES = ("energy", "accel_variation", "stop_error", "time_error")  # "jerk": alias of accel_variation
 MENG_ACCELERATIONS_MS2 = (1.0, 0.0, -0.033, -1.1)  # Meng et al. (2017) section 3.2, coasting signed
-_J_PER_KWH = 3.6e6
-_KMH_PER_MS = 3.6
 
 
 @dataclass(frozen=True)
@@ -122,7 +121,7 @@ def phase_runs(lengths_m: np.ndarray, accelerations_ms2: Sequence[float], mass_k
     driven = np.clip(a, 0.0, None)
     return PhaseRuns(length_m=length, speed_end_ms=speed, duration_s=duration,
                      stop_position_m=length.sum(axis=1), running_time_s=duration.sum(axis=1),
-                     peak_speed_ms=speed.max(axis=1), energy_index_kwh=mass_kg * (length @ driven) / _J_PER_KWH,
+                     peak_speed_ms=speed.max(axis=1), energy_index_kwh=mass_kg * (length @ driven) / J_PER_KWH,
                      comfort_ms2=comfort)
 
 
@@ -229,22 +228,13 @@ class KinematicPhasesProblem(Problem):
         self.limits[:, 2] = np.minimum(self.limits[:, 2], case.train.max_speed_kmh)
 
         a = self.accelerations_ms2
-        v_top = self.limits[:, 2].max() / _KMH_PER_MS
+        v_top = self.limits[:, 2].max() / KMH_PER_MS
         self.weights = self.scales = None
         if weights is not None:
-            w = np.asarray(weights, dtype=float)
-            if w.shape != (len(objectives),) or not np.all(np.isfinite(w)) or np.any(w < 0):
-                raise ValueError(f"weights = {list(w)!r}: need {len(objectives)} finite values >= 0, "
-                                 f"one per objective {objectives}")
-            if scales is None:
-                default = {"energy": self.mass_kg * 0.5 * v_top ** 2 / _J_PER_KWH,
-                           "accel_variation": sum(abs(np.diff([0.0, *a, 0.0]))),
-                           "stop_error": 0.25, "time_error": 0.05 * case.planned_time_s}
-                scales = [default[key] for key in self._keys]
-            sc = np.asarray(scales, dtype=float)
-            if sc.shape != w.shape or not np.all(sc > 0):
-                raise ValueError(f"scales = {list(sc)!r}: need {len(objectives)} positive values")
-            self.weights, self.scales = w, sc
+            default = {"energy": self.mass_kg * 0.5 * v_top ** 2 / J_PER_KWH,
+                       "accel_variation": sum(abs(np.diff([0.0, *a, 0.0]))),
+                       "stop_error": 0.25, "time_error": 0.05 * case.planned_time_s}
+            self.weights, self.scales = weighted_sum_settings(weights, scales, objectives, default)
         if "accel_variation" in self._keys and self.min_phase_s > 0:
             warnings.warn(f"objective {objectives[self._keys.index('accel_variation')]} (comfort, sum |a_i - a_(i-1)|) "
                           "is constant in the kinematic phase model: with fixed accelerations and "
@@ -299,7 +289,7 @@ class KinematicPhasesProblem(Problem):
                     inside = (x >= starts[:, i]) & (x <= starts[:, i] + runs.length_m[:, i]) & (runs.length_m[:, i] > 0)
                     v = np.sqrt(np.maximum(v0[:, i] ** 2 + 2.0 * a[i] * d, 0.0))
                     best = np.where(inside, np.maximum(best, v), best)
-            out[:, z] = best - kmh / _KMH_PER_MS
+            out[:, z] = best - kmh / KMH_PER_MS
         return out
 
     def _evaluate(self, x, out, *args, **kwargs):
@@ -313,11 +303,12 @@ class KinematicPhasesProblem(Problem):
         out["phase_lengths_m"] = runs.length_m
         out["running_time_s"] = runs.running_time_s
         out["stop_error_m"] = np.abs(runs.stop_position_m - self.length_m)
-        out["peak_speed_kmh"] = runs.peak_speed_ms * _KMH_PER_MS
+        out["peak_speed_kmh"] = runs.peak_speed_ms * KMH_PER_MS
         out["stop_position_m"] = runs.stop_position_m
         out["energy_index_kwh"] = runs.energy_index_kwh
 
     def describe(self) -> str:
+        """One line naming the case, the form, the coding and the objectives."""
         form = "weighted sum" if self.weights is not None else "Pareto"
         coding = f"{self.n_bits}-bit binary" if self.binary else "real"
         return (f"KinematicPhasesProblem({self.case.name}, {form}: {', '.join(self.objectives)}; "

@@ -33,12 +33,14 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import pandas as pd
 
 from pymoo_rail import __version__
 from pymoo_rail.atomic import atomic_write_text
+from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, case_to_dict
 
 FRONT_VERSION = "3"
@@ -134,6 +136,7 @@ class CertifiedFront:
 
     @property
     def time_range_s(self) -> tuple[float, float]:
+        """Shortest and longest running time of the front's nodes (s)."""
         t = self.table["running_time_s"].to_numpy()
         return float(t[0]), float(t[-1])
 
@@ -175,6 +178,23 @@ class CertifiedFront:
         total = np.where(np.isclose(t, nodes_t[k + 1]), bound[k + 1], total)
         return energy, total
 
+    def below_certificate(self, running_time_s, energy_kwh) -> tuple[np.ndarray, np.ndarray]:
+        """Which runs lie below the front by more than its certificate, among those it covers.
+
+        Returns ``(inside, below)``: boolean masks over the runs, ``inside`` where the running time
+        is in the front's range (and the energy finite), ``below`` where ``E < E*(T) - bound(T)``,
+        which a correct certificate never allows.
+        """
+        t = np.asarray(running_time_s, dtype=float).reshape(-1)
+        e = np.asarray(energy_kwh, dtype=float).reshape(-1)
+        lo, hi = self.time_range_s
+        inside = (t >= lo) & (t <= hi) & np.isfinite(e)
+        below = np.zeros_like(inside)
+        if inside.any():
+            optimum, bound = self.energy_at(t[inside])
+            below[inside] = e[inside] < optimum - bound - 1e-9
+        return inside, below
+
     def dense(self, n_points: int = 100, window_s: tuple[float, float] | None = None) -> pd.DataFrame:
         """The front at ``n_points`` running times (nodes included) in ``window_s``, with each point's bound."""
         lo, hi = self.clip(window_s)
@@ -185,6 +205,7 @@ class CertifiedFront:
 
     # ------------------------------------------------------------------ file format
     def to_csv_text(self) -> str:
+        """The front as a commented CSV (the format of the shipped and cached fronts)."""
         header = [f"# case_hash: {self.case_hash}", f"# case_name: {self.case_name}",
                   f"# planned_time_s: {self.planned_time_s!r}", f"# dx_m: {self.dx_m!r}",
                   f"# certificate: {self.certificate}", f"# version: {self.version}",
@@ -372,6 +393,74 @@ def constrained_optimum(front: CertifiedFront, tolerance_s: float, n_points: int
     return float(energy[k]), float(bound[k]), float(t[k])
 
 
+def exact_points(case: Case, running_times_s: Sequence[float], path: str | Path, *, n_speeds: int | None = None,
+                 redo_s: Sequence[float] = (), on_run: Callable[[float, Any], None] | None = None) -> pd.DataFrame:
+    """The exact solver's runs at chosen running times, cached row by row in a CSV file.
+
+    The resumable form of :func:`~pymoo_rail.optimal.optimal_front` for long lines, where one
+    running time costs minutes: each finished time is written at once (atomically), so an
+    interrupted computation resumes where it stopped. Rows computed with another ``n_speeds`` are
+    recomputed. The times are solved in increasing order, each warm-started from the slope of the
+    one before, as :func:`~pymoo_rail.optimal.optimal_front` does.
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+    running_times_s : sequence of float
+        Requested running times (s).
+    path : str or Path
+        The CSV cache (created when missing).
+    n_speeds : int, optional
+        Speed nodes of the solver (default: the solver's).
+    redo_s : sequence of float
+        Times to solve again even when cached (and to solve when not requested), e.g. to get the
+        run itself through ``on_run``.
+    on_run : callable, optional
+        Called as ``on_run(requested_time_s, trajectory)`` after each solve.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The rows of ``running_times_s``, sorted by running time: ``requested_time_s``,
+        ``running_time_s``, ``energy_kwh`` (net), ``traction_kwh``, ``regen_kwh``,
+        ``lambda_kwh_per_s``, ``neutral_traction_j``, ``limit_excess_ms``, ``stop_error_m``,
+        ``n_speeds`` and ``solve_s`` (wall seconds of the solve).
+    """
+    import time
+
+    from pymoo_rail.optimal import OptimalSolver
+    from pymoo_rail.optimal.solver import DEFAULT_N_SPEEDS
+
+    path = Path(path)
+    n_speeds = DEFAULT_N_SPEEDS if n_speeds is None else int(n_speeds)
+    rows = pd.read_csv(path).to_dict("records") if path.exists() else []
+    rows = [r for r in rows if int(r.get("n_speeds", -1)) == n_speeds]
+    done = {float(r["requested_time_s"]) for r in rows} - {float(t) for t in redo_s}
+    solver, guess = None, None
+    for t in sorted({float(t) for t in running_times_s} | {float(t) for t in redo_s}):
+        if t in done:
+            continue
+        if solver is None:  # built only when a time is missing: the grid and tables cost seconds
+            solver = OptimalSolver(case, n_speeds=n_speeds)
+        start = time.perf_counter()
+        traj = solver.profile(t, lambda_guess_w=guess)
+        guess = traj.summary["lambda_w"]
+        row = {"requested_time_s": t, "running_time_s": traj.running_time_s, "energy_kwh": traj.energy.net_kwh,
+               "traction_kwh": traj.energy.traction_kwh, "regen_kwh": traj.energy.regen_kwh,
+               "lambda_kwh_per_s": guess / J_PER_KWH, "neutral_traction_j": traj.summary["neutral_traction_j"],
+               "limit_excess_ms": traj.summary["limit_excess_ms"], "stop_error_m": traj.stop_error_m,
+               "n_speeds": n_speeds, "solve_s": time.perf_counter() - start}
+        rows = sorted([r for r in rows if float(r["requested_time_s"]) != t] + [row],
+                      key=lambda r: float(r["requested_time_s"]))
+        atomic_write_text(path, pd.DataFrame(rows).to_csv(index=False))
+        if on_run is not None:
+            on_run(t, traj)
+    frame = pd.DataFrame(rows)
+    wanted = frame["requested_time_s"].isin([float(t) for t in running_times_s])
+    return frame[wanted].sort_values("running_time_s").reset_index(drop=True)
+
+
 __all__ = ["CertifiedFront", "NoExactFrontError", "case_hash", "cache_dir", "certified_front", "compute_front",
-           "constrained_optimum", "default_window", "find_front", "forget_fronts", "front_key", "front_times",
+           "constrained_optimum", "default_window", "exact_points", "find_front", "forget_fronts", "front_key", "front_times",
            "mirrored", "FRONT_VERSION"]

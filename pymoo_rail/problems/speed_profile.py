@@ -25,6 +25,43 @@ def canonical_objective(name: str) -> str:
     return OBJECTIVE_ALIASES.get(name, name)
 
 
+def weighted_sum_settings(weights, scales, objectives: Sequence[str],
+                          default_scales: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Checked weights and scales of a weighted-sum form ``sum w_i f_i / s_i``.
+
+    Parameters
+    ----------
+    weights : sequence of float
+        One finite weight >= 0 per objective.
+    scales : sequence of float or None
+        One positive scale per objective; ``None`` takes ``default_scales`` of each objective.
+    objectives : sequence of str
+        The objective names (aliases allowed).
+    default_scales : dict
+        Scale of each canonical objective name (the typical size of its values).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        The weights and the scales.
+
+    Raises
+    ------
+    ValueError
+        Naming the weights or scales when their number or values do not fit.
+    """
+    w = np.asarray(weights, dtype=float)
+    if w.shape != (len(objectives),) or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ValueError(f"weights = {w.tolist()!r}: need {len(objectives)} finite values >= 0, "
+                         f"one per objective {tuple(objectives)}")
+    if scales is None:
+        scales = [default_scales[canonical_objective(name)] for name in objectives]
+    sc = np.asarray(scales, dtype=float)
+    if sc.shape != w.shape or not np.all(sc > 0):
+        raise ValueError(f"scales = {sc.tolist()!r}: need {len(objectives)} positive values")
+    return w, sc
+
+
 DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m", "braking_onset": "m"}
 
 
@@ -223,20 +260,10 @@ class SpeedProfileProblem(Problem):
         self.weights = None
         self.scales = None
         if weights is not None:
-            weights = np.asarray(weights, dtype=float)
-            if weights.shape != (len(objectives),) or not np.all(np.isfinite(weights)) or np.any(weights < 0):
-                raise ValueError(f"weights = {weights.tolist()!r}: need {len(objectives)} finite values >= 0, "
-                                 f"one per objective {objectives}")
-            if scales is None:
-                default = {"energy": fastest.energy.net_kwh, "time_error": 0.05 * case.planned_time_s,
-                           "running_time": case.planned_time_s,
-                           "accel_variation": max(fastest.accel_variation_ms2, 1e-9),
-                           "stop_error": 0.25}
-                scales = [default[canonical_objective(name)] for name in objectives]
-            scales = np.asarray(scales, dtype=float)
-            if scales.shape != weights.shape or not np.all(scales > 0):
-                raise ValueError(f"scales = {scales.tolist()!r}: need {len(objectives)} positive values")
-            self.weights, self.scales = weights, scales
+            default = {"energy": fastest.energy.net_kwh, "time_error": 0.05 * case.planned_time_s,
+                       "running_time": case.planned_time_s, "accel_variation": max(fastest.accel_variation_ms2, 1e-9),
+                       "stop_error": 0.25}
+            self.weights, self.scales = weighted_sum_settings(weights, scales, objectives, default)
 
         n_obj = 1 if self.weights is not None else len(objectives)
         n_ieq = 1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None) + (self.time_window_s is not None)
@@ -367,6 +394,7 @@ class SpeedProfileProblem(Problem):
         return self.encoding if isinstance(self.encoding, BrakingOnset) else self.simulator
 
     def describe(self) -> str:
+        """One line naming the case, the form, the encoding and the objectives."""
         form = "weighted sum" if self.weights is not None else (
             "constrained single-objective" if len(self.objectives) == 1 else "Pareto")
         return (f"SpeedProfileProblem({self.case.name}, {form}: {', '.join(self.objectives)}; "

@@ -179,14 +179,17 @@ class ClockedRun:
 
     @property
     def arrival_s(self) -> float:
+        """Arrival time on the common clock (s)."""
         return self.departure_s + float(self.time_s[-1])
 
     @property
     def traction_kwh(self) -> float:
+        """Traction energy of the run (kWh)."""
         return float(self.traction_j.sum() / J_PER_KWH)
 
     @property
     def regen_kwh(self) -> float:
+        """Regenerated energy of the run (kWh)."""
         return float(self.regen_j.sum() / J_PER_KWH)
 
 

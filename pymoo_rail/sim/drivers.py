@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import CaseError, Line
 from pymoo_rail.sim.kernel import (
     MODE_BRAKE,
@@ -22,7 +21,6 @@ from pymoo_rail.sim.kernel import (
     MODE_DECEL,
     MODE_HOLD,
     MODE_HOLD_BRAKE,
-    MODE_NAMES,
     MODE_TOWARD,
     MODE_TRACTION,
 )
@@ -142,8 +140,3 @@ def braking_programs(positions_m: np.ndarray, regimes: tuple[str, ...], decel_ms
 def flat_out_program(length_m: float) -> np.ndarray:
     """Maximum traction everywhere: the limits and the platform brake it (the fastest run)."""
     return np.array([[length_m, MODE_TRACTION, 0.0]])
-
-
-def describe_program(program: np.ndarray) -> str:
-    """A readable line per program row."""
-    return "\n".join(f"until {r[0]:9.1f} m: {MODE_NAMES[int(r[1])]:8s} {r[2] * KMH_PER_MS:6.1f} km/h" for r in program)

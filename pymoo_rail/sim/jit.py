@@ -15,9 +15,22 @@ import time
 from contextlib import contextmanager
 from typing import Callable, Iterator
 
+from numba import njit
 from numba.core import event
 
 PACKAGE = "pymoo_rail"
+
+# Decorators of the kernels' small helpers (forces, one cell's step and accounting). LLVM inlines
+# them into every caller (``forceinline``: the LLVM attribute ``alwaysinline``), so a cell costs
+# what it cost with Numba's own inlining (``inline="always"``), which re-ran the untyped pipeline
+# of a helper, and of every helper it inlines in turn, at each call site: 66 % of the first run's
+# compile (``benchmarks/compile_profile.py``). No reference counting (they allocate nothing; NRT
+# increfs on the model's arrays were half the cost of a cell where a helper was not inlined).
+inlined = njit(cache=True, forceinline=True, _nrt=False)
+"""For helpers also called from Python (tests, set-up code)."""
+inlined_internal = njit(cache=True, forceinline=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+"""For helpers only kernels call: no Python wrapper to build (its unboxing of the model is most of
+a small helper's own compile)."""
 NOTICE = ("compiling the simulator (first run only: Numba compiles the kernels once and caches them "
           "on disk; this takes a while on a small machine) ...")
 
@@ -52,6 +65,7 @@ class CompileWatch(event.Listener):
         return module.startswith(PACKAGE)
 
     def on_start(self, ev: event.Event) -> None:
+        """Numba's compile-start event: announce the first compile and start the clock at the outermost one."""
         if not self._ours(ev):
             return
         if self._depth == 0:
@@ -61,6 +75,7 @@ class CompileWatch(event.Listener):
         self._depth += 1
 
     def on_end(self, ev: event.Event) -> None:
+        """Numba's compile-end event: count the outermost compile of our kernels and its time."""
         if not self._ours(ev) or self._depth == 0:
             return
         self._depth -= 1
@@ -91,3 +106,109 @@ def compile_notice(say: Callable[[str], None] = _say_stderr, summary: bool = Tru
     if summary and watch.n_compiled:
         say(f"compiled {watch.n_compiled} simulator functions in {watch.compile_s:.0f} s (cached: later runs "
             "start at once)")
+
+
+class CompileProfile(event.Listener):
+    """Where Numba's compile time goes, per function and per stage (exclusive CPU time of the thread).
+
+    Listens to ``numba:compile`` (one dispatcher compiling one signature) and ``numba:run_pass``
+    (one compiler pass of one function). Time is charged to the innermost event open, so nested
+    compilations (a callee compiled during its caller's type inference) are not counted twice.
+    With ``llvm=True`` (:func:`compile_profile`) the LLVM stages of a code library are timed
+    too: ``llvm:function passes``, ``llvm:module passes`` (the optimisation of the linked final
+    module, where LLVM inlines) and ``llvm:machine code``; otherwise they fall inside the
+    ``NativeLowering`` pass.
+
+    Attributes
+    ----------
+    seconds : dict
+        ``(module.qualname of the function, stage) -> seconds``.
+    compiles : dict
+        ``module.qualname -> number of signatures compiled``.
+    signatures : dict
+        ``module.qualname -> [argument types of each compilation]`` (to spot specialisations).
+    """
+
+    def __init__(self) -> None:
+        self.seconds: dict[tuple[str, str], float] = {}
+        self.compiles: dict[str, int] = {}
+        self.signatures: dict[str, list[str]] = {}
+        self._stack: list[list] = []  # [qualname, stage, started, child seconds]
+
+    def _open(self, qualname: str, stage: str) -> None:
+        # the compiling thread's CPU time: not inflated by other processes on a loaded machine
+        self._stack.append([qualname, stage, time.thread_time(), 0.0])
+
+    def _close(self) -> None:
+        qualname, stage, started, children = self._stack.pop()
+        spent = time.thread_time() - started
+        key = (qualname, stage)
+        self.seconds[key] = self.seconds.get(key, 0.0) + spent - children
+        if self._stack:
+            self._stack[-1][3] += spent
+
+    def _owner(self) -> str:
+        return self._stack[-1][0] if self._stack else "?"
+
+    def on_start(self, ev: event.Event) -> None:
+        """A compile or a compiler pass starts: open it (and count the signature of a compile)."""
+        data = ev.data or {}
+        if ev.kind == "numba:compile":
+            dispatcher = data.get("dispatcher")
+            func = getattr(dispatcher, "py_func", None)
+            qualname = f"{getattr(func, '__module__', '?')}.{getattr(func, '__qualname__', '?')}"
+            self.compiles[qualname] = self.compiles.get(qualname, 0) + 1
+            self.signatures.setdefault(qualname, []).append(str(data.get("args", "")))
+            self._open(qualname, "other")
+        else:
+            self._open(f"{data.get('module', '?')}.{data.get('qualname', '?')}", data.get("name", "?").split(" [")[0])
+
+    def on_end(self, ev: event.Event) -> None:
+        """The innermost open compile or pass ends: charge its exclusive time."""
+        self._close()
+
+    def table(self) -> list[tuple[str, float, dict[str, float]]]:
+        """``(function, total s, {stage: s})`` per function, the most expensive first."""
+        per: dict[str, dict[str, float]] = {}
+        for (qualname, stage), s in self.seconds.items():
+            per.setdefault(qualname, {})[stage] = per.setdefault(qualname, {}).get(stage, 0.0) + s
+        rows = [(q, sum(st.values()), st) for q, st in per.items()]
+        return sorted(rows, key=lambda row: -row[1])
+
+
+@contextmanager
+def compile_profile(llvm: bool = True) -> Iterator[CompileProfile]:
+    """Profile every Numba compilation inside the block (see :class:`CompileProfile`).
+
+    With ``llvm`` the LLVM stages of Numba's CPU code libraries are timed by wrapping three of
+    their methods for the duration of the block (restored afterwards).
+    """
+    from numba.core import codegen
+
+    profile = CompileProfile()
+    wrapped = {"_optimize_functions": "llvm:function passes",
+               "_optimize_final_module": "llvm:module passes",
+               "_finalize_specific": "llvm:machine code"}
+    originals = {}
+    if llvm:
+        for cls in (codegen.CPUCodeLibrary, codegen.JITCodeLibrary):
+            for name, stage in wrapped.items():
+                if name in vars(cls):
+                    originals[(cls, name)] = vars(cls)[name]
+                    setattr(cls, name, _timed(profile, vars(cls)[name], stage))
+    try:
+        with event.install_listener("numba:compile", profile), event.install_listener("numba:run_pass", profile):
+            yield profile
+    finally:
+        for (cls, name), method in originals.items():
+            setattr(cls, name, method)
+
+
+def _timed(profile: CompileProfile, method: Callable, stage: str) -> Callable:
+    def timed(self, *args, **kwargs):
+        profile._open(profile._owner(), stage)
+        try:
+            return method(self, *args, **kwargs)
+        finally:
+            profile._close()
+    return timed

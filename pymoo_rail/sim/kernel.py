@@ -6,7 +6,10 @@ acceleration. Forces are recorded at the speeds the scheme used, so the work bal
 (traction - braking - resistance = change of kinetic energy) holds to rounding.
 
 A driving program is an array of rows ``(end_m, mode, target_ms)``: row k applies until the
-cell midpoint passes ``end_m``. Modes:
+cell midpoint passes ``end_m``. A program may carry a fourth column, the traction share
+``gamma`` in (0, 1] a ``MODE_TOWARD`` row accelerates with (the partial traction of Chen et al.
+(2017) table 1; never less than the force that holds the speed); without it every row uses full
+traction. Modes:
 
 - ``MODE_TOWARD``: maximum traction below the target, coasting above it, holding it once reached
   by partial traction (the speed-code connection strategy of Liu (2019) fig. 4-5). It never brakes:
@@ -24,6 +27,9 @@ cell midpoint passes ``end_m``. Modes:
   included) until standstill, the service-brake command of a stopping programme (seed 002's
   braking phase); maximum braking where that is not enough, coasting where the line alone
   decelerates more. Where it stops is the programme's consequence (short of or past the platform).
+- ``MODE_STOP``: brake at the constant deceleration that stops the train exactly at the platform
+  from where it is, ``v^2 / (2 s)`` with ``s`` the distance to go (Chen et al. (2017) type 1,
+  ``v_m^2 / (2 dS)``): recomputed every cell, it stays constant along the run.
 
 Whatever the program says, the train never rises above the braking envelope: it brakes onto every
 lower limit ahead and onto the platform at the latest moment the braking curve allows.
@@ -37,6 +43,7 @@ import numpy as np
 from numba import njit, prange
 
 from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.sim.jit import inlined_internal
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
@@ -46,8 +53,8 @@ from pymoo_rail.sim.physics import (
 )
 
 MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
-MODE_DECEL = 6
-MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake", "decel")
+MODE_DECEL, MODE_STOP = 6, 7
+MODE_NAMES = ("toward", "traction", "hold", "coast", "brake", "hold_brake", "decel", "stop")
 REGIME_TRACTION, REGIME_HOLD, REGIME_COAST, REGIME_BRAKE = 0, 1, 2, 3
 REGIME_CRUISE = REGIME_HOLD  # the older name of the same regime
 # "hold": the speed is held (partial traction or braking); one word in every output and doc
@@ -84,15 +91,35 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
 KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
 
 
-@njit(cache=True, inline="always")
+@inlined_internal
 def full_step(m, v0, cell, kind):
     """Two-stage step over one cell at maximum traction, coasting or maximum braking.
 
     Returns (u1, control force N (+ traction, - braking), W0 N, mean speed m/s).
     """
+    return scaled_step(m, v0, cell, kind, 1.0)
+
+
+@njit(cache=True, forceinline=True, _nrt=False)
+def _traction(m, v, cell, share):
+    """``share`` of the maximum traction, but at least the force that holds the speed (Chen et al.
+    (2017): gamma above the holding ratio); exactly the maximum when ``share`` is 1."""
+    fmax = max_traction(m, v, cell)
+    if share >= 1.0:
+        return fmax
+    f = share * fmax
+    hold = davis_force(m, v) + m.line_force_n[cell]
+    if f < hold:
+        f = hold if hold < fmax else fmax
+    return f
+
+
+@njit(cache=True, forceinline=True, _nrt=False)
+def scaled_step(m, v0, cell, kind, share):
+    """:func:`full_step` with the traction step at ``share`` of the maximum force (see ``_traction``)."""
     wl = m.line_force_n[cell]
     if kind == KIND_TRACTION:
-        f = max_traction(m, v0, cell)
+        f = _traction(m, v0, cell, share)
     elif kind == KIND_BRAKE:
         f = -max_braking(m, v0, cell)
     else:
@@ -101,7 +128,7 @@ def full_step(m, v0, cell, kind):
     u_half = v0 * v0 + (f - davis_force(m, v0) - wl) * gain
     v_half = math.sqrt(u_half) if u_half > 0.0 else 0.5 * v0
     if kind == KIND_TRACTION:
-        f = max_traction(m, v_half, cell)
+        f = _traction(m, v_half, cell, share)
     elif kind == KIND_BRAKE:
         f = -max_braking(m, v_half, cell)
     w0 = davis_force(m, v_half)
@@ -109,7 +136,7 @@ def full_step(m, v0, cell, kind):
     return u1, f, w0, v_half
 
 
-@njit(cache=True, inline="always")
+@inlined_internal
 def _decel_step(m, v0, cell, decel_ms2):
     """One cell braking at the constant deceleration ``decel_ms2`` (MODE_DECEL).
 
@@ -129,8 +156,8 @@ def _decel_step(m, v0, cell, decel_ms2):
     return u1, f, w0, REGIME_BRAKE
 
 
-@njit(cache=True, inline="always")
-def _share_above(v0, v1, v_cut):
+@inlined_internal
+def share_above(v0, v1, v_cut):
     """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
     lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
     if lo >= v_cut:
@@ -152,7 +179,7 @@ TOTAL_PREV_REGIME, TOTAL_REGIME_CHANGES, TOTAL_LIMIT_EXCESS = 11, 12, 13
 N_TOTALS = 14
 
 
-@njit(cache=True)
+@inlined_internal
 def new_totals():
     """Running totals of a run (time, works, comfort and limit figures) as a tuple.
 
@@ -161,7 +188,7 @@ def new_totals():
     return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300)
 
 
-@njit(cache=True, inline="always")
+@inlined_internal
 def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     """Keep a step under the braking envelope and name its regime by the force applied.
 
@@ -192,7 +219,7 @@ def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     return u1, f, w0, regime, clamped
 
 
-@njit(cache=True, inline="always")
+@inlined_internal
 def complete_cell(m, totals, cell, v, u1, f, w0, regime):
     """Finish one cell: standstill inside it, time, energy accounting, comfort.
 
@@ -222,7 +249,7 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
             w_neutral += f * d
     w_brake += brake_n * d
     if brake_n > 0.0:
-        share = _share_above(v, v1, m.regen_min_speed_ms)
+        share = share_above(v, v1, m.regen_min_speed_ms)
         w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
     w_davis += w0 * d
     w_line += m.line_force_n[cell] * d
@@ -257,12 +284,12 @@ def trace_cell_energies(m, x, v, f):
         if f[i] > 0.0:
             trac[i] = f[i] * d / m.traction_efficiency
         elif f[i] < 0.0:
-            share = _share_above(v[i], v[i + 1], m.regen_min_speed_ms)
+            share = share_above(v[i], v[i + 1], m.regen_min_speed_ms)
             regen[i] = m.regen_efficiency * electric_braking_capped(m, 0.5 * (v[i] + v[i + 1]), -f[i]) * d * share
     return trac, regen
 
 
-@njit(cache=True)
+@inlined_internal
 def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime):
     """Write one cell into the trace arrays."""
     tr_x[cell + 1] = x1
@@ -273,7 +300,7 @@ def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, 
     tr_r[cell] = regime
 
 
-@njit(cache=True)
+@inlined_internal
 def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r):
     """Close a run (back to rest) and write its ``OUT_*`` summary."""
     length = m.position_m[m.position_m.shape[0] - 1]
@@ -305,7 +332,7 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
     out[OUT_NEUTRAL_TRACTION_J] = totals[TOTAL_NEUTRAL_TRACTION_J]
 
 
-@njit(cache=True, inline="always")
+@inlined_internal
 def drive_cell(m, program, totals, i, v, row, hold_speed):
     """One cell of a driving program: the program's control, the envelope, the accounting.
 
@@ -320,6 +347,14 @@ def drive_cell(m, program, totals, i, v, row, hold_speed):
         hold_speed = -1.0
     mode = int(program[row, 1])
     target = program[row, 2]
+    if mode == MODE_STOP:  # the constant deceleration onto the platform from here
+        to_go = m.position_m[m.position_m.shape[0] - 1] - m.position_m[i]
+        mode = MODE_DECEL
+        target = v * v / (2.0 * to_go) if to_go > 0.0 else 0.0
+        if to_go <= 1.5 * m.dx_m:
+            # the last cell: aim a hair past the platform, the envelope lands the train on it
+            # (a rounding shortfall would count as stopping short)
+            target *= 1.0 - 1e-9
 
     # what the program asks for
     brake_to_hold = mode == MODE_HOLD_BRAKE
@@ -334,7 +369,8 @@ def drive_cell(m, program, totals, i, v, row, hold_speed):
     if mode == MODE_TOWARD:
         landed = False
         if v < target:
-            u1, f, w0, vm = full_step(m, v, i, KIND_TRACTION)
+            share = program[row, 3] if program.shape[1] > 3 else 1.0
+            u1, f, w0, vm = scaled_step(m, v, i, KIND_TRACTION, share)
             regime = REGIME_TRACTION
             landed = u1 > target * target
         else:
@@ -377,7 +413,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     n = m.position_m.shape[0]
     totals = new_totals()
     v = m.initial_speed_ms
-    row = 0
+    row = n - n  # a run-time 0, not the literal: one compiled drive_cell for both loops
     hold_speed = -1.0
     reached = True
     stop_pos = m.position_m[n - 1]
@@ -415,8 +451,8 @@ def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
     totals_b = new_totals()
     v_a = m.initial_speed_ms
     v_b = m.initial_speed_ms
-    row_a = 0
-    row_b = 0
+    row_a = n - n  # run-time zeros, not literals (see run_program)
+    row_b = n - n
     hold_a = -1.0
     hold_b = -1.0
     moving_a = True
@@ -438,8 +474,9 @@ def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
                 stop_b = x1
         if not (moving_a or moving_b):
             break
-    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, 0, record, empty, empty, empty_r)
-    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, 0, record, empty, empty, empty_r)
+    no_count = n - n  # no trace nodes; a run-time 0: one compiled write_summary for every caller
+    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, no_count, record, empty, empty, empty_r)
+    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, no_count, record, empty, empty, empty_r)
 
 
 @njit(cache=True)
@@ -471,17 +508,23 @@ def simulate_batch(m, programs):
     return out
 
 
-@njit(cache=True)
 def simulate_batch_serial(m, programs):
-    """:func:`simulate_batch` in the calling thread: no thread start-up cost for small batches."""
+    """:func:`simulate_batch` in the calling thread: no thread start-up cost for small batches.
+
+    Plain Python around :func:`simulate_serial`: a compiled wrapper would be one more Numba
+    function (and one more copy of the run loops for LLVM) in the first run's compile.
+    """
     out = np.empty((programs.shape[0], N_OUT))
     simulate_serial(m, programs, out)
     return out
 
 
-@njit(cache=True)
 def simulate_trace(m, program):
-    """One run with its full trace: (summary, x, v, t, a, force, regime), trimmed to the run."""
+    """One run with its full trace: (summary, x, v, t, a, force, regime), trimmed to the run.
+
+    Plain Python around :func:`run_program` (see :func:`simulate_batch_serial`); called from
+    Python, ``record`` is typed ``bool``, so the batch kernels' ``run_program`` serves it too.
+    """
     n = m.position_m.shape[0]
     out = np.empty(N_OUT)
     x = np.empty(n)
@@ -490,6 +533,5 @@ def simulate_trace(m, program):
     a = np.empty(n)
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
-    record = n >= 0  # a run-time True: one compiled run_program for both callers (see simulate_batch)
-    count = run_program(m, program, out, record, x, v, t, a, f, r)
+    count = run_program(m, program, out, True, x, v, t, a, f, r)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]

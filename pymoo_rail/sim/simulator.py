@@ -36,27 +36,28 @@ class Simulator:
 
     @property
     def length_m(self) -> float:
+        """Length of the line (m)."""
         return float(self.case.line.length_m)
 
     def run_batch(self, programs: np.ndarray) -> np.ndarray:
-        """Summaries (N, N_OUT) of programs (N, rows, 3).
+        """Summaries (N, N_OUT) of programs (N, rows, 3) (or 4 columns: a traction share, see ``kernel``).
 
         Evaluated on Numba's threads (``numba.set_num_threads``) when the batch has at least
         :data:`PARALLEL_MIN_CELLS` cells, else in the calling thread; the results are the same.
         """
         programs = np.ascontiguousarray(programs, dtype=float)
-        if programs.ndim != 3 or programs.shape[2] != 3:
-            raise ValueError(f"programs must have shape (N, rows, 3), got {programs.shape}")
+        if programs.ndim != 3 or programs.shape[2] not in (3, 4):
+            raise ValueError(f"programs must have shape (N, rows, 3) or (N, rows, 4), got {programs.shape}")
         n_cells = programs.shape[0] * (self.model.position_m.shape[0] - 1)
         if n_cells < PARALLEL_MIN_CELLS or numba.get_num_threads() == 1:
             return k.simulate_batch_serial(self.model, programs)
         return k.simulate_batch(self.model, programs)
 
     def run(self, program: np.ndarray) -> Trajectory:
-        """The full trajectory of one program (rows, 3)."""
+        """The full trajectory of one program (rows, 3) or (rows, 4)."""
         program = np.ascontiguousarray(program, dtype=float)
-        if program.ndim != 2 or program.shape[1] != 3:
-            raise ValueError(f"a program must have shape (rows, 3), got {program.shape}")
+        if program.ndim != 2 or program.shape[1] not in (3, 4):
+            raise ValueError(f"a program must have shape (rows, 3) or (rows, 4), got {program.shape}")
         out, x, v, t, a, f, r = k.simulate_trace(self.model, program)
         return Trajectory(position_m=x, speed_ms=v, time_s=t, accel_ms2=a, force_n=f, regime=r,
                           limit_ms=self.grid.limit_ms[: x.shape[0]], energy=energy_from_summary(out),

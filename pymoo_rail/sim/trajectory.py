@@ -45,6 +45,7 @@ class Trajectory:
 
     @property
     def speed_kmh(self) -> np.ndarray:
+        """Speed at each node (km/h)."""
         return self.speed_ms * KMH_PER_MS
 
     @property
@@ -63,6 +64,7 @@ class Trajectory:
 
     @property
     def regime_changes(self) -> int:
+        """Number of changes of driving regime over the run."""
         return int(self.summary["regime_changes"])
 
     @property
@@ -85,5 +87,6 @@ def summary_dict(row: np.ndarray) -> dict:
 
 
 def energy_from_summary(row: np.ndarray) -> EnergyBreakdown:
+    """The energy breakdown of one row of the kernel's summary output."""
     return EnergyBreakdown(traction_kwh=float(row[k.OUT_TRACTION_KWH]), regen_kwh=float(row[k.OUT_REGEN_KWH]),
                            aux_kwh=float(row[k.OUT_AUX_KWH]), net_kwh=float(row[k.OUT_NET_KWH]))

@@ -18,7 +18,8 @@ from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.problems import reference
 from pymoo_rail.suite.problems import CASES, METRO_4OBJ, METRO_4OBJ_OBJECTIVES, get_problem
 
-BEST_KNOWN_VERSION = "1"
+BEST_KNOWN_VERSION = "2"
+"""Version of the shipped best-known fronts (2: ``metro-a-4obj`` with ``encoding="braking_onset"``)."""
 FRONTS_DIR = reference.SHIPPED_DIR
 
 
@@ -67,6 +68,7 @@ def verify(names=None, progress: bool = True) -> pd.DataFrame:
 
 
 def best_known_path(name: str = METRO_4OBJ) -> Path:
+    """The file of the shipped best-known front of suite problem ``name``."""
     return FRONTS_DIR / f"{name}-best-known-v{BEST_KNOWN_VERSION}.csv"
 
 
@@ -74,13 +76,21 @@ def best_known_front(name: str = METRO_4OBJ) -> pd.DataFrame:
     """The best-known front of a suite problem without an exact one (labelled, versioned).
 
     Returns a DataFrame with one column per objective; ``attrs`` holds ``label`` ("best-known:
-    non-dominated union of ... runs, not certified"), ``version`` and ``runs``.
+    non-dominated union of ... runs, not certified"), ``version``, ``case_hash`` and ``encoding``.
+    A shipped front computed for other case content or another encoding than the problem's
+    raises ``ValueError`` naming both (recompute it with :func:`compute_best_known_front`).
     """
     path = best_known_path(name)
     if not path.is_file():
         raise FileNotFoundError(f"{name}: no best-known front shipped ({path.name}); "
                                 f"compute one with pymoo_rail.suite.compute_best_known_front({name!r})")
     meta, table = reference.read_commented_csv(path)
+    problem = get_problem(name)
+    current = {"case_hash": reference.case_hash(problem.case), "encoding": problem.encoding.name}
+    for key, value in current.items():
+        if meta.get(key) != value:
+            raise ValueError(f"{path.name}: {key} = {meta.get(key)!r}, but {name} has {key} = {value!r}; "
+                             f"recompute it with pymoo_rail.suite.compute_best_known_front({name!r}, write=True)")
     table.attrs.update(meta)
     return table
 
@@ -113,9 +123,10 @@ def compute_best_known_front(name: str = METRO_4OBJ, seeds=range(1, 6), pop_size
     F = F[find_non_dominated(F)]
     table = pd.DataFrame(F, columns=list(METRO_4OBJ_OBJECTIVES)).sort_values("energy").reset_index(drop=True)
     label = (f"best-known: non-dominated union of the feasible final populations of NSGA-III and NSGA-II "
-             f"(pymoo defaults, population {pop_size}, {n_gen} generations, seeds {seeds[0]}-{seeds[-1]}); "
-             "not certified")
-    table.attrs.update(label=label, version=BEST_KNOWN_VERSION, case_hash=reference.case_hash(problem.case))
+             f"(pymoo defaults, population {pop_size}, {n_gen} generations, seeds {seeds[0]}-{seeds[-1]}, "
+             f"encoding {problem.encoding.name}); not certified")
+    table.attrs.update(label=label, version=BEST_KNOWN_VERSION, case_hash=reference.case_hash(problem.case),
+                       encoding=problem.encoding.name, runs=2 * len(seeds))
     if write:
         header = "".join(f"# {k}: {v}\n" for k, v in table.attrs.items())
         atomic_write_text(best_known_path(name), header + table.to_csv(index=False, float_format="%.9g"))

@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,8 +15,8 @@ from pymoo_rail.algorithms import GoldenRatioNSGA2
 from pymoo_rail.cases import load_case
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.sim import Simulator
+from pymoo_rail.sim.checks import check_run, limit_under_train_ms
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 # seed 003, 4.2: the two neutral sections (m), planned time and margin, table 2 limits
 NEUTRAL_M = ((16177.0, 16819.0), (40079.0, 40705.0))
 PLANNED_S, MARGIN_S = 1050.0, 60.0
@@ -48,15 +46,6 @@ def neutral_cells(position_m: np.ndarray) -> np.ndarray:
     for start, end in NEUTRAL_M:
         touch |= (position_m[:-1] < end) & (position_m[1:] > start)
     return touch
-
-
-def lowest_limit_under_train_ms(position_m: np.ndarray, case) -> np.ndarray:
-    """Lowest line limit over the train (head at each node, tail one train length behind)."""
-    limit_kmh = np.full(position_m.shape, case.train.max_speed_kmh)
-    for start, end, value in case.line.speed_limits:
-        under = (position_m >= start) & (position_m - case.train.length_m < end)
-        limit_kmh[under] = np.minimum(limit_kmh[under], value)
-    return limit_kmh / 3.6
 
 
 @pytest.fixture(scope="module")
@@ -104,8 +93,9 @@ def test_front_coasts_through_neutral_sections_stays_under_limits_and_stops(grns
         assert traj.force_n[:-1][cells].max() <= 0.0  # no traction anywhere in a neutral section
         assert traj.summary["neutral_traction_j"] == 0.0
         assert traj.summary["limit_excess_ms"] <= 0.0
-        excess = traj.speed_ms - lowest_limit_under_train_ms(traj.position_m, wuguang)
+        excess = traj.speed_ms - limit_under_train_ms(traj.position_m, wuguang.line, wuguang.train)
         assert excess.max() <= 1e-9
+        assert check_run(traj, wuguang).passes(STOP_TOLERANCE_M, 1e-9)
         assert traj.stop_error_m <= STOP_TOLERANCE_M
         assert abs(traj.running_time_s - PLANNED_S) <= MARGIN_S
         assert traj.running_time_s == pytest.approx(f[1], abs=1e-9)
@@ -125,16 +115,19 @@ def test_no_traction_in_neutral_sections_even_when_the_program_asks_for_it(wugua
         assert pulled.force_n[:-1][(x[:-1] < end) & (x[1:] > start)].max() > 50e3
     assert coasted.force_n[:-1][neutral_cells(coasted.position_m)].max() <= 0.0
     assert coasted.summary["neutral_traction_j"] == 0.0
+    # the package's run check sees the pull in the sections of the real line
+    assert check_run(pulled, wuguang).neutral_max_force_n > 50e3 and not check_run(pulled, wuguang).passes()
+    assert check_run(coasted, wuguang).neutral_max_force_n <= 0.0
     # the coasted run loses speed in each section and so takes longer
     assert coasted.running_time_s > pulled.running_time_s
 
 
 def test_independent_limit_check_catches_an_overspeed(wuguang):
-    """The independent limit check of the test flags a speed above the 80 km/h exit zone that
+    """The limit check over the train length flags a speed above the 80 km/h exit zone that
     the head has already left but the tail has not."""
     position = np.array([1000.0, 2000.0, 2100.0, 2300.0])
     speed_ms = np.array([80.0, 80.0, 80.5, 81.0]) / 3.6
-    excess = speed_ms - lowest_limit_under_train_ms(position, wuguang)
+    excess = speed_ms - limit_under_train_ms(position, wuguang.line, wuguang.train)
     # at 2100 m the tail (201.4 m behind) is still in the 80 km/h zone; at 2300 m it has left it
     assert excess[2] > 0 and excess[3] < 0
 
@@ -143,19 +136,12 @@ def test_independent_limit_check_catches_an_overspeed(wuguang):
 def test_reduced_study_end_to_end(tmp_path):
     """The benchmark script with a reduced study (3 seeds, 3000 evaluations, population 30) on
     2 worker processes: every front member passes the checks and the report is written."""
-    sys.path.insert(0, str(BENCHMARKS))
-    try:
-        import emu_wuguang
-    finally:
-        sys.path.remove(str(BENCHMARKS))
-    sys.path.insert(0, str(BENCHMARKS))  # the workers import the NSGA-II factory by module name
-    try:
-        code = emu_wuguang.main(["--seeds", "3", "--budget", "3000", "--pop-size", "30", "--local-size", "6",
-                                 "--encoding-seeds", "2", "--encoding-budget", "1000", "--workers", "2",
-                                 "--work", str(tmp_path / "work"), "--out", str(tmp_path / "report"),
-                                 "--no-progress", "--no-exact"])
-    finally:
-        sys.path.remove(str(BENCHMARKS))
+    from benchmarks import emu_wuguang  # every algorithm is a registry name: workers need no sys.path
+
+    code = emu_wuguang.main(["--seeds", "3", "--budget", "3000", "--pop-size", "30", "--local-size", "6",
+                             "--encoding-seeds", "2", "--encoding-budget", "1000", "--workers", "2",
+                             "--work", str(tmp_path / "work"), "--out", str(tmp_path / "report"),
+                             "--no-progress", "--no-exact"])
     assert code == 0  # 0 only when every member of every front passed the verification
     report = (tmp_path / "report" / "emu_wuguang.md").read_text()
     for part in ("Table 4", "table 5", "fig. 12", "rank-sum", "All ", "members pass: yes"):

@@ -1,4 +1,4 @@
-"""Plots against the optimum are written as labelled PNG files."""
+"""The profile against the optimum is written as a labelled PNG file."""
 
 import matplotlib
 
@@ -6,18 +6,8 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 
-from pymoo_rail.optimal.plots import plot_front, plot_profile  # noqa: E402
+from pymoo_rail.optimal.plots import plot_profile  # noqa: E402
 from pymoo_rail.sim import gradient_limit_partition, speed_code_programs  # noqa: E402
-
-
-def test_front_plot(tmp_path):
-    reference = np.array([[130.0, 21.0], [150.0, 12.3], [190.0, 7.0]])
-    fig = plot_front(reference, {"MOABC": np.array([[149.9, 19.55]]), "speed codes": [[154.0, 14.0]]},
-                     path=tmp_path / "front.png")
-    ax = fig.axes[0]
-    assert ax.get_xlabel() == "Running time (s)" and ax.get_ylabel() == "Net energy (kWh)"
-    assert len(ax.get_legend().get_texts()) == 3
-    assert (tmp_path / "front.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_profile_plot(tmp_path, yizhuang, yizhuang_sim, yizhuang_solver):

@@ -186,3 +186,25 @@ def test_history_of_a_pymoo_result():
     x = ax.get_lines()[0].get_xdata()
     np.testing.assert_array_equal(x, [10, 20, 30, 40, 50])
     plt.close(fig)
+
+
+def test_saved_png_figures_use_a_palette_and_are_smaller(tmp_path):
+    from PIL import Image
+
+    def figure():
+        fig, ax = plt.subplots(figsize=(7.0, 4.5))
+        x = np.linspace(0.0, 10.0, 400)
+        for k in range(6):
+            ax.plot(x, np.sin(x + k), label=f"run {k}")
+        ax.legend()
+        ax.grid(True, alpha=0.3)
+        return fig
+
+    small = save_figure(figure(), tmp_path / "palette.png")
+    full = save_figure(figure(), tmp_path / "full.png", palette=False)
+    with Image.open(small) as a, Image.open(full) as b:
+        assert a.mode == "P" and b.mode in ("RGB", "RGBA") and a.size == b.size
+        # the palette keeps the picture: every pixel within a few levels of the full-colour one
+        diff = np.abs(np.asarray(a.convert("RGB"), dtype=int) - np.asarray(b.convert("RGB"), dtype=int))
+    assert np.percentile(diff, 99) <= 16
+    assert small.stat().st_size < 0.6 * full.stat().st_size

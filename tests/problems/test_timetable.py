@@ -74,3 +74,42 @@ def test_bad_input_names_the_field(pair):
         TimetableProblem(pair, 2, 120.0, objectives=("comfort",))
     with pytest.raises(ValueError, match="headway_s = -1"):
         TimetableProblem(pair, 2, -1.0)
+
+
+def test_opposite_direction_mirrors_the_line(pair):
+    from pymoo_rail.problems.timetable import opposite_direction
+
+    down = opposite_direction(pair)
+    L = pair.line.length_m
+    # the -16 permille descent of 950-1650 m is a +16 climb at L - 1650 .. L - 950 the other way
+    assert (L - 1650.0, L - 950.0, 16.0) in down.line.gradients
+    assert [(leg.start_m, leg.end_m, leg.planned_time_s) for leg in down.legs] == [
+        (0.0, 1350.0, 100.0), (1350.0, 3950.0, 190.0)]
+    assert opposite_direction(down).line == pair.line
+
+
+def test_both_directions_alternate_and_share_across(pair):
+    both = TimetableProblem(pair, 2, 120.0, directions=2, dx_m=2.0)
+    assert np.array_equal(both.direction_of, [0, 1]) and len(both.routes) == 2
+    X = both.xl + np.random.default_rng(4).random((3, both.n_var)) * (both.xu - both.xl)
+    out = both.evaluate(X, return_as_dictionary=True)
+    assert np.all(out["G"][:, 1] < 0)  # on time both ways
+    assert np.all(out["G"][:, 0] == -np.inf)  # one train per direction: nobody to follow
+    sim = both.simulate(X[:1])
+    down = sim["journeys"][0][1]
+    assert down.position_m[-1] == pytest.approx(3950.0)
+    # the down train's first leg is the short one (1350 m in 100 s), then a dwell, then 190 s
+    assert down.arrival_s - down.departure_s == pytest.approx(100.0 + both.dwell_s + 190.0, abs=0.05)
+    with pytest.raises(ValueError, match=r"directions = 3"):
+        TimetableProblem(pair, 2, 120.0, directions=3)
+
+
+@pytest.mark.slow
+def test_reference_counts_each_train_in_its_own_direction(pair):
+    from pymoo_rail.problems.cooperative_baseline import exact_baseline
+    from pymoo_rail.problems.timetable import opposite_direction
+
+    both = TimetableProblem(pair, 3, 120.0, directions=2, dx_m=2.0)
+    up, down = (exact_baseline(c, dx_m=2.0).energy_kwh for c in (pair, opposite_direction(pair)))
+    assert up != pytest.approx(down, rel=1e-3)  # descents become climbs
+    assert both.reference_kwh() == pytest.approx(2 * up + down, rel=1e-12)

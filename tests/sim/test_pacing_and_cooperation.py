@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 
 from pymoo_rail.cases import load_case
-from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.sim import Simulator
 from pymoo_rail.sim import cooperation as coop
 from pymoo_rail.sim.pacing import PacedSpeedCodes, solve_pace, split_long_sections

@@ -1,0 +1,37 @@
+"""experiments.cooperative: the offsets study as a Study and the sharing potential of traced runs."""
+
+import numpy as np
+import pytest
+
+from pymoo_rail.experiments.cooperative import offsets_study, problem_label, sharing_potential
+from pymoo_rail.sim.cooperation import ClockedRun
+
+J_PER_KWH = 3.6e6
+
+
+def _run(times_s, traction_j, regen_j, departure_s):
+    t = np.asarray(times_s, dtype=float)
+    return ClockedRun(time_s=t, position_m=10.0 * t, speed_ms=np.full(t.shape, 10.0),
+                      traction_j=np.asarray(traction_j, dtype=float), regen_j=np.asarray(regen_j, dtype=float),
+                      departure_s=departure_s, start_m=0.0)
+
+
+def test_sharing_potential_of_a_stop_over_a_departure():
+    # A draws 20 kJ over [0, 10) s and regenerates 10 kJ over [10, 20) s; B leaves at 15 s and draws
+    # 30 kJ over [15, 25) s: A's regeneration over [15, 20) s (5 kJ) meets B on the move and drawing
+    a = _run([0.0, 10.0, 20.0], [20e3, 0.0], [0.0, 10e3], 0.0)
+    b = _run([0.0, 10.0, 25.0], [30e3, 0.0], [0.0, 0.0], 15.0)
+    pot = sharing_potential([a, b])
+    assert pot.loc[0, "regen_kwh"] == pytest.approx(10e3 / J_PER_KWH)
+    assert pot.loc[0, "while_others_move_kwh"] == pytest.approx(5e3 / J_PER_KWH)
+    assert pot.loc[0, "others_draw_kwh"] == pytest.approx(5e3 / J_PER_KWH)
+    assert pot.loc[0, "braking_from_s"] == pytest.approx(10.05) and pot.loc[0, "braking_to_s"] == pytest.approx(19.95)
+    assert pot.loc[1, "regen_kwh"] == 0.0 and np.isnan(pot.loc[1, "braking_from_s"])
+
+
+def test_offsets_study_names_every_offset_and_gradient_factor():
+    study = offsets_study("s", [1.0, 0.4], 3)
+    labels = [p.label for p in study.problems]
+    assert labels[:2] == [problem_label(1.0, -45.0), problem_label(1.0, 0.0)] and len(labels) == 10
+    assert labels[5] == "phi=0.4 x=-45"
+    assert (study.budget.kind, study.budget.value) == ("n_eval", 6000) and study.seeds == (1, 2, 3)
