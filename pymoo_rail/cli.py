@@ -370,13 +370,6 @@ def _objectives(values: Sequence[str]) -> tuple[str, ...]:
     return tuple(values)
 
 
-def choose_member(*args, **kwargs) -> int:
-    """:func:`pymoo_rail.experiments.fronts.choose_member` (the member ``optimize`` shows)."""
-    from pymoo_rail.experiments.fronts import choose_member as choose
-
-    return choose(*args, **kwargs)
-
-
 class _Progress:
     """pymoo callback that advances a tqdm bar by one per generation."""
 
@@ -545,6 +538,8 @@ def cmd_optimize(args) -> int:
     front["cv"] = CV
     for j in range(X.shape[1]):
         front[f"x{j}_{unit}"] = X[:, j]
+    from pymoo_rail.experiments.fronts import choose_member  # the one member rule (studies use it too)
+
     chosen = choose_member(F, CV, running, energy, case.planned_time_s,
                            time_tolerance_s if time_tolerance_s is not None else DEFAULT_TIME_TOLERANCE_S)
     front.insert(0, "chosen", np.arange(len(front)) == chosen)

@@ -22,6 +22,7 @@ import pandas as pd
 
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, InfeasibleCaseError
+from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.optimal import dp
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim.kernel import (
@@ -76,15 +77,6 @@ class _Solve:
     tie_cost_j: float = 0.0
 
 
-def _check_time(name: str, value: float) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{name} = {value!r}: must be a number of seconds")
-    value = float(value)
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} = {value!r}: must be a finite number of seconds > 0")
-    return value
-
-
 class OptimalSolver:
     """Exact minimum-energy runs of one case on one grid (reused across running times).
 
@@ -137,7 +129,7 @@ class OptimalSolver:
         self.simulator = Simulator(case, dx_m)
         self.n_speeds = int(n_speeds)
         self.max_targets = int(max_targets)
-        self.time_tol_s = _check_time("time_tol_s", time_tol_s)
+        self.time_tol_s = check_number("time_tol_s", time_tol_s, positive=True, error=FieldError)
         self._value = np.empty((self.simulator.grid.n_nodes, self.n_speeds))
         self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
         self._min_time_s: float | None = None
@@ -507,7 +499,7 @@ class OptimalSolver:
 
     def profile(self, running_time_s: float, lambda_guess_w: float | None = None) -> Trajectory:
         """The minimum-energy run taking ``running_time_s`` (see :func:`optimal_profile`)."""
-        running_time_s = _check_time("running_time_s", running_time_s)
+        running_time_s = check_number("running_time_s", running_time_s, positive=True, error=FieldError)
         fastest = self.min_running_time_s()
         if running_time_s < fastest - 1e-9:
             raise InfeasibleCaseError("running_time_s", running_time_s,
@@ -597,7 +589,7 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
     if times.ndim != 1 or times.size == 0:
         raise ValueError(f"running_times has shape {times.shape}: give one or more running times")
     for t in times:
-        _check_time("running_time_s", float(t))
+        check_number("running_time_s", float(t), positive=True, error=FieldError)
     solver = OptimalSolver(case, **settings)
     rows = []
     guess = None

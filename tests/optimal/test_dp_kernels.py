@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+from numba import njit
 
 from pymoo_rail.optimal import dp
 from pymoo_rail.sim import Simulator
@@ -15,6 +16,12 @@ from pymoo_rail.sim.kernel import (
     new_totals,
 )
 from tests.optimal.cases import hilly_case
+
+
+@njit
+def simulator_cell(m, cell, v0, u1, f, w0):
+    """The simulator's own cell (its helpers are kernel-only: no Python entry of their own)."""
+    return complete_cell(m, new_totals(), cell, v0, u1, f, w0, REGIME_COAST)
 
 
 def test_cell_cost_is_the_simulators_accounting_bit_for_bit():
@@ -32,7 +39,7 @@ def test_cell_cost_is_the_simulators_accounting_bit_for_bit():
         w0 = float(rng.uniform(0.0, 5e3))
         price = float(rng.uniform(0.0, 1e6))
         cost, dt = dp.cell_cost(m, v0, u1, f, w0, cell, price)
-        v1, stopped, _, _, totals = complete_cell(m, new_totals(), cell, v0, u1, f, w0, REGIME_COAST)
+        v1, stopped, _, _, totals = simulator_cell(m, cell, v0, u1, f, w0)
         if stopped or v0 + v1 <= 0.0:
             assert cost == math.inf and dt == math.inf
             checked["stopped"] += 1
