@@ -149,8 +149,7 @@ def main() -> None:
     matplotlib.use("Agg")
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import optimal_profile
-    from pymoo_rail.optimal.plots import plot_profile
-    from pymoo_rail.plotting import plot_fronts, save_figure
+    from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
     from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs
 
     case = load_case("yizhuang")
@@ -201,7 +200,10 @@ def main() -> None:
                       objectives=("running_time", "energy"), reference=front[columns], reference_label="optimum (DP)",
                       title="yizhuang: minimum net energy against running time")
     save_figure(fig, REPORT.parent / "optimal_front.png")
-    save_figure(plot_profile(planned, {"60 km/h speed codes": codes}, title="yizhuang: optimal profile at 150 s"),
+    codes_label = f"60 km/h speed codes: {codes.running_time_s:.1f} s, {codes.energy.net_kwh:.2f} kWh"
+    save_figure(plot_speed_profile(planned, case, others=[codes], other_labels=[codes_label],
+                                   title=f"yizhuang: optimal profile at 150 s ({planned.running_time_s:.1f} s, "
+                                         f"{planned.energy.net_kwh:.2f} kWh)"),
                 REPORT.parent / "optimal_profile.png")
     out += ["![front](optimal_front.png)", "", "![profile](optimal_profile.png)", ""]
     REPORT.write_text("\n".join(out))

@@ -31,6 +31,8 @@ import pandas as pd
 from pymoo_rail.constants import J_PER_KWH
 
 HERE = Path(__file__).resolve().parent
+if str(HERE.parent) not in sys.path:  # this checkout's package, not an installed one
+    sys.path.insert(0, str(HERE.parent))
 REPORT = HERE / "reports" / "peers.md"
 CASES = [  # (case, running time s, ms-eetc track id or None)
     (str(HERE / "cases" / "intercity-var-limit-100.toml"), 1541.0, "00_var_speed_limit_100"),
@@ -39,12 +41,14 @@ CASES = [  # (case, running time s, ms-eetc track id or None)
     ("wuguang-crh3", 1050.0, None),
 ]
 GPOPS_II = {"intercity-var-limit-100": (440.14, 7.0)}  # published (ms-eetc paper, fig. 10): kWh, s
-# ms-eetc measured on this machine (2 cores shared by eight jobs, load ~20) on 2026-11-24, casadi 3.8.2:
-# IPOPT process time of one solve (the best of 3); ms-eetc's own "CPU time" is IPOPT's wall time.
+# ms-eetc measured on this machine (2 cores shared by six jobs, load ~14) on 2026-11-24, casadi 3.8.2, in the
+# same run as pymoo-rail's committed figures: IPOPT process time of one solve (the best of 3);
+# ms-eetc's own "CPU time" is IPOPT's wall time.
 MSEETC_RECORDED = {
-    ("intercity-var-limit-100", 300): (441.0839, 3.47), ("intercity-var-limit-100", 1000): (440.3766, 12.45),
-    ("intercity-level-10km", 100): (88.5501, 0.88), ("intercity-level-10km", 300): (88.3277, 3.02),
-    ("intercity-level-10km", 1000): (88.2526, 12.15),
+    ("intercity-var-limit-100", 100): (448.6395, 0.89), ("intercity-var-limit-100", 300): (441.0839, 3.20),
+    ("intercity-var-limit-100", 1000): (440.3766, 11.96),
+    ("intercity-level-10km", 100): (88.5501, 0.75), ("intercity-level-10km", 300): (88.3277, 2.97),
+    ("intercity-level-10km", 1000): (88.2526, 11.28),
 }
 MSEETC_DATE = "2026-11-24"
 
@@ -94,8 +98,22 @@ def run_mseetc(checkout: Path, python: str, track_id: str, trip_s: float, n_inte
         driver.write_text(_DRIVER)
         out = subprocess.run([python, str(driver), track_id, str(trip_s), str(n_intervals), str(tracks)],
                              cwd=checkout, capture_output=True, text=True, check=True)
-    result = json.loads(out.stdout.strip().splitlines()[-1])
-    return result["energy_kwh"], result["cpu_s"]
+    return parse_mseetc_output(out.stdout)
+
+
+def parse_mseetc_output(stdout: str) -> tuple[float, float]:
+    """(energy kWh, CPU s) from the driver's output: its last line is JSON (IPOPT prints above it)."""
+    lines = [line for line in stdout.strip().splitlines() if line.strip()]
+    if not lines:
+        raise ValueError("ms-eetc printed nothing: expected a last line of JSON with energy_kwh and cpu_s")
+    try:
+        result = json.loads(lines[-1])
+        energy, cpu = float(result["energy_kwh"]), float(result["cpu_s"])
+    except (json.JSONDecodeError, KeyError, TypeError) as err:
+        raise ValueError(f"ms-eetc's last line {lines[-1]!r} is not JSON with energy_kwh and cpu_s") from err
+    if not (energy > 0.0 and cpu > 0.0):
+        raise ValueError(f"ms-eetc's last line {lines[-1]!r}: energy_kwh and cpu_s must be > 0")
+    return energy, cpu
 
 
 def pymoo_rail_row(name: str, running_time_s: float) -> dict:
@@ -119,6 +137,17 @@ def pymoo_rail_row(name: str, running_time_s: float) -> dict:
     except ValueError:
         row["closed_form_kwh"] = float("nan")
     return row
+
+
+def speed_ratios(ours: pd.DataFrame, theirs: pd.DataFrame) -> pd.DataFrame:
+    """Per peer row: its CPU time over pymoo-rail's on the same case, and the energy difference (%)."""
+    if len(theirs) == 0:
+        return pd.DataFrame()
+    merged = theirs.merge(ours[["case", "at_request_kwh", "cpu_s"]], on="case", suffixes=("", "_pymoo_rail"))
+    # a published CPU time comes from another machine: no ratio
+    merged["cpu_ratio"] = (merged["cpu_s"] / merged["cpu_s_pymoo_rail"]).where(merged["source"] != "published")
+    merged["energy_diff_pct"] = 100.0 * (merged["at_request_kwh"] / merged["energy_kwh"] - 1.0)
+    return merged[["case", "solver", "source", "cpu_ratio", "energy_diff_pct"]]
 
 
 def main() -> None:
@@ -157,12 +186,18 @@ def main() -> None:
 
     ours = pd.DataFrame(rows)
     theirs = pd.DataFrame(peers)
+    ratios = speed_ratios(ours, theirs)
     text = ["# pymoo-rail's exact solver beside continuous optimal-control solvers", "",
             "Written by `python benchmarks/peers.py`. CPU times are `time.process_time` on a 2-core machine",
             "shared with other jobs (wall times there are meaningless); pymoo-rail's include building the",
             "transition tables, the lambda search, the simulator replay and the certificate.", "",
             "## pymoo-rail", "", markdown(ours), "",
-            "## Peers", "", markdown(theirs) if len(theirs) else "(none)", ""]
+            "## Peers", "", markdown(theirs) if len(theirs) else "(none)", "",
+            "## Side by side", "",
+            "`cpu_ratio` = the peer's CPU time over pymoo-rail's, both measured in this run (> 1: pymoo-rail is"
+            " faster; none for a published time); `energy_diff_pct` ="
+            " pymoo-rail's energy at the requested time over the peer's, minus 1.", "",
+            markdown(ratios) if len(ratios) else "(none)", ""]
     REPORT.write_text("\n".join(text))
     print("\n".join(text))
 

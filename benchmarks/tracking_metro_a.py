@@ -5,7 +5,8 @@ Two target curves (ideal simulator runs):
 - ``seed phases``: seed 002's optimised phases (traction 262.37 m, cruise 169.15 m, coast
   369.69 m), then braking on the braking curve at the latest moment;
 - ``DE 70 s``: the minimum-energy speed-code curve with |T - T_plan| <= 0.5 s found by pymoo's DE
-  through ``SpeedProfileProblem``.
+  through ``SpeedProfileProblem`` (best of seeds 1 and 2; the runs go through
+  ``pymoo_rail.experiments.run_study``, one record per run under ``--work``).
 
 Each is tracked by ``PID(kp, ki, kd)`` and ``FuzzyPID`` with the same base gains, at control
 periods 0.2 s and 1 s, by the nominal train and by a train 15 % heavier than the one the curve
@@ -32,13 +33,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from pymoo.algorithms.soo.nonconvex.de import DE  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
 from pymoo_rail.control import PID, FuzzyPID, track  # noqa: E402
-from pymoo_rail.experiments import best_of_seeds  # noqa: E402
+from pymoo_rail.experiments import (Study, algorithm, best_run, build_problem, load_results, problem,  # noqa: E402
+                                     run_study)
 from pymoo_rail.plotting import save_figure  # noqa: E402
-from pymoo_rail.problems import SpeedProfileProblem  # noqa: E402
 from pymoo_rail.sim import Simulator, switching_programs  # noqa: E402
 
 REPORTS = Path(__file__).parent / "reports"
@@ -58,11 +58,20 @@ def seed_phase_reference(case, sim):
     return sim.run(switching_programs(ends, ("traction", "hold", "coast"), case.line.length_m)[0])
 
 
-def de_reference(case, sim, gens, seeds=(1, 2)):
-    """The least-energy run of DE within 0.5 s of the planned time, best of ``seeds``."""
-    problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=0.5)
-    best = best_of_seeds(problem, lambda: DE(pop_size=40, CR=0.9), ("n_gen", gens), seeds)
-    return sim.run(problem.encoding.programs(best.X[None, :])[0])
+def reference_study(case_name: str, gens: int, seeds=(1, 2)) -> Study:
+    """DE (population 40, CR 0.9) on min energy with |T - T_plan| <= 0.5 s, ``gens`` generations."""
+    return Study("tracking-" + Path(str(case_name)).stem,
+                 problems=[problem("speed_profile", label="DE", case=str(case_name), objectives=["energy"],
+                                   time_tolerance_s=0.5)],
+                 algorithms=[algorithm("de", label="DE", pop_size=40, CR=0.9)], seeds=list(seeds),
+                 budget={"n_gen": gens})
+
+
+def de_reference(sim, study, work: Path, workers: int):
+    """The ideal run of the least-energy DE run of ``study`` (best of its seeds, through the study runner)."""
+    print(run_study(study, work, workers=max(1, min(workers, 2))), flush=True)
+    _, x = best_run(load_results(work, study=study), "DE")
+    return sim.run(build_problem(study.problems[0]).encoding.programs(x[None, :])[0])
 
 
 def heavier(case, factor):
@@ -74,6 +83,9 @@ def main() -> None:
     parser.add_argument("--case", default="metro-a")
     parser.add_argument("--gens", type=int, default=150)
     parser.add_argument("--out", default=str(REPORTS))
+    parser.add_argument("--work", type=Path, default=Path(__file__).resolve().parents[1] / "out",
+                        help="parent of the DE study folder (one record per run, not committed)")
+    parser.add_argument("--workers", type=int, default=2, help="process pool size (at most 2)")
     args = parser.parse_args()
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -83,7 +95,8 @@ def main() -> None:
     case = load_case(args.case)
     sim = Simulator(case)
     curves = {"seed phases": seed_phase_reference(case, sim), "DE 70 s" if args.case == "metro-a" else "DE": None}
-    curves[list(curves)[1]] = de_reference(case, sim, args.gens)
+    study = reference_study(args.case, args.gens)
+    curves[list(curves)[1]] = de_reference(sim, study, args.work / study.name.replace("-", "_"), args.workers)
     trains = {"nominal": case, f"+{100 * (HEAVIER - 1):.0f} % mass": heavier(case, HEAVIER)}
     controllers = {"PID": PID(KP, KI, KD), "fuzzy PID": FuzzyPID(KP, KI, KD)}
     for name, ref in curves.items():

@@ -5,7 +5,8 @@ Three recommended curves, all speed codes on the non-equal partition (seed 000 f
 - ``hold``: one target speed everywhere, chosen so that the ideal run takes 150 s (traction,
   cruise, braking: the "traction-cruise" connection of seed 000 4.3);
 - ``DE ideal``: the constrained single-objective form (min energy, |T - 150| <= 0.5 s) solved by
-  pymoo's DE through ``SpeedProfileProblem``, scored on the ideal run (best of ``--seeds``);
+  pymoo's DE through ``SpeedProfileProblem``, scored on the ideal run (best of ``--seeds``; the
+  DE runs go through ``pymoo_rail.experiments.run_study``, one record per run in ``--work``);
 - ``DE tracked``: the same, scored on the run tracked with A = 2, B = 3
   (``SpeedProfileProblem(..., tracking=Hysteresis(2, 3))``), the procedure of seed 000 (its
   recommended curve is evaluated through the tracking simulation, 5.2).
@@ -29,12 +30,12 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from pymoo.algorithms.soo.nonconvex.de import DE  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
 from pymoo_rail.constants import KMH_PER_MS  # noqa: E402
 from pymoo_rail.control import Hysteresis, track  # noqa: E402
-from pymoo_rail.experiments import best_of_seeds  # noqa: E402
+from pymoo_rail.experiments import (Study, algorithm, best_run, build_problem, load_results, problem,  # noqa: E402
+                                     run_study)
 from pymoo_rail.optimal.baselines import constant_cruise  # noqa: E402
 from pymoo_rail.plotting import save_figure  # noqa: E402
 from pymoo_rail.problems import SpeedProfileProblem  # noqa: E402
@@ -56,10 +57,21 @@ def hold_reference(case, sim):
     return run, f"one code, {code:.2f} km/h"
 
 
-def de_reference(case, sim, seeds, gens, tracking=None):
-    """The least-energy DE run within 0.5 s of the planned time (of the tracked run with ``tracking``), best of ``seeds``."""
-    problem = SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=0.5, tracking=tracking)
-    x = best_of_seeds(problem, lambda: DE(pop_size=50, CR=0.9), ("n_gen", gens), seeds).X
+def reference_study(seeds, gens) -> Study:
+    """DE (population 50, CR 0.9) on min energy with |T - T_plan| <= 0.5 s, scored on the ideal run
+    (``DE ideal``) and on the run tracked with A = 2, B = 3 km/h (``DE tracked``)."""
+    common = dict(case="yizhuang", objectives=["energy"], time_tolerance_s=0.5)
+    tracked = {"controller": "hysteresis", "a_kmh": A_KMH, "b_kmh": 3.0}
+    return Study("tracking-yizhuang", problems=[problem("speed_profile", label="DE ideal", **common),
+                                                problem("speed_profile", label="DE tracked", tracking=tracked, **common)],
+                 algorithms=[algorithm("de", label="DE", pop_size=50, CR=0.9)], seeds=list(seeds),
+                 budget={"n_gen": gens})
+
+
+def de_reference(sim, study, results, label):
+    """The ideal run of the least-energy stored DE run of ``label`` (best of the seeds)."""
+    _, x = best_run(results, label)
+    problem = build_problem(next(p for p in study.problems if p.display == label))
     ideal = sim.run(problem.encoding.programs(x[None, :])[0])
     return ideal, "codes " + " / ".join(f"{c:.1f}" for c in x) + " km/h"
 
@@ -78,6 +90,9 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     parser.add_argument("--period", type=float, default=0.2)
     parser.add_argument("--out", default=str(REPORTS))
+    parser.add_argument("--work", type=Path, default=Path(__file__).resolve().parents[1] / "out" / "tracking_yizhuang",
+                        help="study folder of the DE runs (one record per run, not committed)")
+    parser.add_argument("--workers", type=int, default=2, help="process pool size (at most 2)")
     args = parser.parse_args()
     out_dir = Path(args.out)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -88,8 +103,11 @@ def main() -> None:
     sim = Simulator(case)
     references = {}
     references["hold"] = hold_reference(case, sim)
-    references["DE ideal"] = de_reference(case, sim, args.seeds, args.gens)
-    references["DE tracked"] = de_reference(case, sim, args.seeds, args.gens, tracking=Hysteresis(A_KMH, 3.0))
+    study = reference_study(args.seeds, args.gens)
+    print(run_study(study, args.work, workers=max(1, min(args.workers, 2))), flush=True)
+    results = load_results(args.work, study=study)
+    for label in ("DE ideal", "DE tracked"):
+        references[label] = de_reference(sim, study, results, label)
     for name, (ref, how) in references.items():
         print(f"{name:10s} ideal {ref.energy.net_kwh:.3f} kWh {ref.running_time_s:.2f} s  ({how})", flush=True)
 

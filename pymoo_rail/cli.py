@@ -43,7 +43,7 @@ examples:
   pymoo-rail cases                                  list the built-in cases
   pymoo-rail cases yizhuang                         describe one case
   pymoo-rail optimize yizhuang --out out/           NSGA-II on energy and time error (about 3 s of
-                                                    CPU; the first run compiles, about 140 s more)
+                                                    CPU; the first run compiles, about 18 s more)
   pymoo-rail optimize yizhuang --algorithm moabc --pop-size 40 --n-gen 100 --seed 3 --out out/moabc
   pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
   pymoo-rail reference yizhuang --out out/ref       the exact minimum-energy front
@@ -370,13 +370,6 @@ def _objectives(values: Sequence[str]) -> tuple[str, ...]:
     return tuple(values)
 
 
-def choose_member(*args, **kwargs) -> int:
-    """:func:`pymoo_rail.experiments.fronts.choose_member` (the member ``optimize`` shows)."""
-    from pymoo_rail.experiments.fronts import choose_member as choose
-
-    return choose(*args, **kwargs)
-
-
 class _Progress:
     """pymoo callback that advances a tqdm bar by one per generation."""
 
@@ -545,6 +538,8 @@ def cmd_optimize(args) -> int:
     front["cv"] = CV
     for j in range(X.shape[1]):
         front[f"x{j}_{unit}"] = X[:, j]
+    from pymoo_rail.experiments.fronts import choose_member  # the one member rule (studies use it too)
+
     chosen = choose_member(F, CV, running, energy, case.planned_time_s,
                            time_tolerance_s if time_tolerance_s is not None else DEFAULT_TIME_TOLERANCE_S)
     front.insert(0, "chosen", np.arange(len(front)) == chosen)

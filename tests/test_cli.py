@@ -10,7 +10,8 @@ import pandas as pd
 import pytest
 
 from pymoo_rail.cases import list_cases
-from pymoo_rail.cli import choose_member, main
+from pymoo_rail.cli import main
+from pymoo_rail.experiments import choose_member
 
 
 def run(capsys, *argv):

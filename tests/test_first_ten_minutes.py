@@ -161,3 +161,83 @@ def test_compile_notice_says_once_and_sums_up():
         fast(3.0)  # already compiled: silent
         njit(lambda x: x * 2)(1.0)  # not ours: silent
     assert lines == []
+
+
+def _package_dispatchers():
+    """Every Numba dispatcher defined in a module of the package (imported here)."""
+    import importlib
+    import pkgutil
+
+    import pymoo_rail
+    from numba.core.registry import CPUDispatcher
+
+    found = {}
+    for info in pkgutil.walk_packages(pymoo_rail.__path__, "pymoo_rail."):
+        module = importlib.import_module(info.name)
+        for name, value in vars(module).items():
+            if isinstance(value, CPUDispatcher) and value.py_func.__module__ == info.name:
+                found[f"{info.name}.{name}"] = value
+    return found
+
+
+def test_no_kernel_uses_numba_ir_inlining():
+    # inline="always" re-types a helper's body at every call site, recursively: it was 66 % of the
+    # first run's compile; helpers are inlined by LLVM instead (pymoo_rail.sim.jit.inlined)
+    dispatchers = _package_dispatchers()
+    assert len(dispatchers) > 40
+    assert [name for name, d in dispatchers.items() if d.targetoptions.get("inline") == "always"] == []
+    # every kernel keeps its Python wrapper: without one, a call from Python crashes the interpreter
+    assert [name for name, d in dispatchers.items() if d.targetoptions.get("no_cpython_wrapper")] == []
+    from pymoo_rail.sim import kernel, physics
+
+    for helper in (kernel.full_step, kernel.drive_cell, kernel.complete_cell, kernel.clamp_to_envelope,
+                   physics.max_traction, physics.max_braking, physics.landing_force, physics.curve_force):
+        # inlined by LLVM (a cell's speed) and without reference counting (a call would incref the model)
+        assert helper.targetoptions["forceinline"] and helper.targetoptions["_nrt"] is False
+
+
+def test_compile_profile_charges_each_function_its_own_time():
+    from pymoo_rail.sim.jit import compile_profile
+
+    def inner(x):
+        return x * 2.0
+
+    fast_inner = njit(inner)
+
+    def outer(x):
+        return fast_inner(x) + 1.0
+
+    with compile_profile() as profile:
+        assert njit(outer)(1.0) == 3.0
+    table = {name.split(".")[-1]: (total, stages) for name, total, stages in profile.table()}
+    assert {"inner", "outer"} <= set(table)
+    compiles = {name.split(".")[-1]: n for name, n in profile.compiles.items()}
+    signatures = {name.split(".")[-1]: sigs for name, sigs in profile.signatures.items()}
+    assert compiles["inner"] == 1 and signatures["outer"] == ["(float64,)"]
+    assert "nopython_type_inference" in table["outer"][1] and "llvm:module passes" in table["outer"][1]
+    # exclusive times: the callee's compile (inside the caller's type inference) is not the caller's
+    assert all(s >= 0.0 for _, (_, stages) in table.items() for s in stages.values())
+    from numba.core import codegen
+
+    assert "timed" not in codegen.CPUCodeLibrary._optimize_final_module.__name__  # restored
+
+
+@pytest.mark.slow
+def test_first_run_compiles_each_kernel_once(tmp_path):
+    # a cold compile of the README's main command (about 15-20 s of CPU): no package kernel is
+    # compiled for two signatures (a literal argument, prange's uint64 index) except two tiny
+    # helpers: full_step (its literal kind, which LLVM folds) and the DP's interp_at (float32 and
+    # float64 positions)
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    env = {**__import__("os").environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "MPLBACKEND": "Agg",
+           "PYTHONPATH": str(root)}
+    done = subprocess.run([sys.executable, str(root / "benchmarks" / "compile_profile.py"), "--signatures", "--",
+                           "optimize", "yizhuang", "--algorithm", "nsga2", "-q"],
+                          cwd=root, env=env, capture_output=True, text=True, check=True)
+    twice = done.stdout.split("more than one signature")[1].splitlines()[1:]
+    ours = {line.split(":")[0].strip() for line in twice if line.strip().startswith("pymoo_rail")}
+    assert ours <= {"pymoo_rail.sim.kernel.full_step", "pymoo_rail.optimal.dp.interp_at"}, done.stdout

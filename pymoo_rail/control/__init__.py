@@ -18,6 +18,7 @@ from pymoo_rail.control.controllers import (
     Controller,
     FuzzyPID,
     Hysteresis,
+    make_controller,
     symmetric_rules,
 )
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S, Tracker, track, tracked_summaries
@@ -30,6 +31,6 @@ from pymoo_rail.control.disturbances import (  # noqa: E402 (needs Tracker)
 )
 
 __all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMMETRIC_RULES",
-           "symmetric_rules", "TERMS", "Tracker", "track",
+           "symmetric_rules", "make_controller", "TERMS", "Tracker", "track",
            "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
            "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES"]

@@ -9,10 +9,11 @@ fuzzy universes of Meng et al. (2017)), time in s, and the command is a fraction
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from pymoo_rail.model.errors import FieldError, check_number
 
 CTRL_HYSTERESIS, CTRL_PID, CTRL_FUZZY_PID = 0, 1, 2
 CONTROLLER_NAMES = ("hysteresis", "pid", "fuzzy_pid")
@@ -78,19 +79,8 @@ SYMMETRIC_RULES.setflags(write=False)
 
 
 def _check(name: str, value: object, *, positive: bool = False, upper: float | None = None) -> float:
-    """A finite, non-negative (or positive) float, else ValueError naming the parameter."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{name} = {value!r}: must be a number")
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{name} = {v}: must be finite")
-    if positive and v <= 0.0:
-        raise ValueError(f"{name} = {v}: must be > 0")
-    if v < 0.0:
-        raise ValueError(f"{name} = {v}: must be >= 0")
-    if upper is not None and v > upper:
-        raise ValueError(f"{name} = {v}: must be <= {upper}")
-    return v
+    """A finite, non-negative (or positive) float, else a FieldError (a ValueError) naming the parameter."""
+    return check_number(name, value, positive=positive, nonneg=True, upper=upper, error=FieldError)
 
 
 @dataclass(frozen=True)
@@ -258,6 +248,22 @@ class FuzzyPID:
 
 
 Controller = Hysteresis | PID | FuzzyPID
+
+
+def make_controller(name: str, **params) -> Controller:
+    """A controller by its name in ``CONTROLLER_NAMES`` (``"hysteresis"``, ``"pid"``,
+    ``"fuzzy_pid"``) and its fields, e.g. ``make_controller("hysteresis", a_kmh=2, b_kmh=3)``.
+
+    How a study file, which holds plain data, names a controller. Raises ValueError naming an
+    unknown name or field.
+    """
+    classes = dict(zip(CONTROLLER_NAMES, (Hysteresis, PID, FuzzyPID)))
+    if name not in classes:
+        raise ValueError(f"controller = {name!r}: must be one of {', '.join(CONTROLLER_NAMES)}")
+    try:
+        return classes[name](**params)
+    except TypeError as err:  # an unknown field: say which controller was meant
+        raise ValueError(f"controller = {name!r}: {err}") from None
 
 
 def check_controller(controller: object) -> Controller:

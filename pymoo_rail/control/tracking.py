@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -10,20 +9,12 @@ from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control import kernel as ck
 from pymoo_rail.control.controllers import Controller, check_controller
 from pymoo_rail.model import Case
+from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as sk
 from pymoo_rail.sim.trajectory import energy_from_summary, summary_dict
 
 DEFAULT_CONTROL_PERIOD_S = 0.2  # a usual ATO control cycle (the seeds give none)
-
-
-def _check_period(control_period_s: object) -> float:
-    if isinstance(control_period_s, bool) or not isinstance(control_period_s, (int, float, np.floating, np.integer)):
-        raise ValueError(f"control_period_s = {control_period_s!r}: must be a number")
-    p = float(control_period_s)
-    if not math.isfinite(p) or p <= 0.0:
-        raise ValueError(f"control_period_s = {p}: must be a finite number > 0")
-    return p
 
 
 def _check_reference(reference: Trajectory) -> None:
@@ -62,7 +53,7 @@ class Tracker:
     def __init__(self, case: Case, controller: Controller, control_period_s: float = DEFAULT_CONTROL_PERIOD_S,
                  dx_m: float | None = None):
         self.controller = check_controller(controller)
-        self.control_period_s = _check_period(control_period_s)
+        self.control_period_s = check_number("control_period_s", control_period_s, positive=True, error=FieldError)
         self.simulator = Simulator(case, dx_m)
         self._code = int(controller.code())
         self._params = np.ascontiguousarray(controller.params(), dtype=float)

@@ -20,6 +20,7 @@ from pymoo_rail.experiments.registry import (
 )
 from pymoo_rail.experiments.fronts import (
     best_of_seeds,
+    best_run,
     choose_member,
     distinct_front,
     distinct_index,
@@ -45,4 +46,4 @@ __all__ = ["Study", "ProblemSpec", "AlgorithmSpec", "Budget", "RunSpec", "StudyE
            "run_study", "execute_run", "StudyReport", "load_results", "load_records", "records_frame",
            "indicator_columns", "read_study", "write_study", "study_to_toml", "ResultStore", "PROBLEMS",
            "ALGORITHMS", "problem_names", "algorithm_names", "build_problem", "build_algorithm", "distinct_front",
-           "distinct_index", "choose_member", "punctual_member", "tang2020_nsga2", "best_of_seeds"]
+           "distinct_index", "choose_member", "punctual_member", "tang2020_nsga2", "best_of_seeds", "best_run"]

@@ -143,11 +143,45 @@ def punctual_member(running_time_s: np.ndarray, energy_kwh: np.ndarray, planned_
     return int(candidates[np.argmin(energy_kwh[candidates])])
 
 
+def best_run(results, problem: str | None = None):
+    """The stored single-objective run whose best feasible point has the lowest objective.
+
+    What a study script takes as its one good reference run (e.g. the best of 3 DE runs as the
+    profile a controller then tracks).
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        Stored runs with fronts (``load_results(..., fronts=True)``), one objective.
+    problem : str, optional
+        Only the runs of this problem label (default: every row).
+
+    Returns
+    -------
+    (pandas.Series, numpy.ndarray) or None
+        The run's row and its best feasible decision ``x`` (ties: the lowest seed, then the
+        first member), or ``None`` when no run stored a feasible point.
+    """
+    rows = results if problem is None else results[results["problem"] == problem]
+    best, best_x, best_f = None, None, np.inf
+    for _, row in rows.sort_values("seed", kind="stable").iterrows():
+        F = np.asarray(row["F"], dtype=float)
+        if F.ndim != 2 or F.shape[1] != 1:
+            raise ValueError(f"best_run needs single-objective runs; run {row['run_id']} has F of shape {F.shape}")
+        feasible = np.flatnonzero(np.asarray(row["CV"], dtype=float).reshape(-1) <= 0)
+        if not len(feasible):
+            continue
+        member = int(feasible[np.argmin(F[feasible, 0])])
+        if F[member, 0] < best_f:
+            best, best_x, best_f = row, np.asarray(row["X"], dtype=float)[member], F[member, 0]
+    return None if best is None else (best, best_x)
+
+
 def best_of_seeds(problem, make_algorithm, termination, seeds):
     """The best feasible single-objective result of one algorithm over several seeds.
 
-    What a study script does to get one good reference run (e.g. the best of 3 DE runs as the
-    profile a controller then tracks).
+    For a problem a study spec cannot name (e.g. a case changed in memory); a problem that a
+    spec names goes through the study runner and :func:`best_run` instead.
 
     Parameters
     ----------

@@ -68,11 +68,28 @@ def _tuples(params: dict) -> dict:
     return {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
 
 
-def _speed_profile(case: Any = "yizhuang", load: str | None = None, **params):
+def _controller(spec: Any):
+    """An ATO controller from a table ``{"controller": "hysteresis", "a_kmh": 2, "b_kmh": 3}`` (a
+    study spec holds plain data; the other keys are the controller's fields)."""
+    from pymoo_rail.control.controllers import make_controller
+
+    if not isinstance(spec, dict) or "controller" not in spec:
+        raise StudyError("problem speed_profile tracking", spec,
+                         "must be a table with controller = hysteresis, pid or fuzzy_pid and its fields")
+    try:
+        return make_controller(spec["controller"], **{k: v for k, v in spec.items() if k != "controller"})
+    except ValueError as err:
+        raise StudyError("problem speed_profile tracking", spec, str(err)) from None
+
+
+def _speed_profile(case: Any = "yizhuang", load: str | None = None, tracking: Any = None, **params):
     """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path; ``load``:
-    a passenger load state such as ``"AW3"``)."""
+    a passenger load state such as ``"AW3"``; ``tracking``: a controller as a table,
+    ``{"controller": "hysteresis", "a_kmh": 2, "b_kmh": 3}``)."""
     from pymoo_rail.problems import SpeedProfileProblem
 
+    if tracking is not None:
+        params["tracking"] = _controller(tracking)
     return SpeedProfileProblem(_case(case, load), **_tuples(params))
 
 

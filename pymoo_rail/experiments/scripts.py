@@ -1,9 +1,11 @@
-"""What every study script shares: the standard options and a polite process priority.
+"""What every study script shares: the standard options, a polite process priority and the
+per-run table a report is written from.
 
 The scripts in ``benchmarks/`` are thin calls of :func:`pymoo_rail.experiments.run_study`; they take
 the same three options (where the records go, where the report goes, and whether to only rebuild
 the report from stored records) and run at a lower priority so that a long study leaves an
-interactive machine usable.
+interactive machine usable. Their run records stay out of git; the per-run CSV a report exports
+is committed, so :func:`report_runs` rebuilds a report from that CSV when the records are absent.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import Callable, Mapping, Sequence
 
 
 def add_study_options(parser: argparse.ArgumentParser, work_dir: Path, reports_dir: Path, *,
@@ -61,3 +64,55 @@ def count_range(counts) -> str:
     """
     low, high = int(min(counts)), int(max(counts))
     return f"{low}" if low == high else f"{low} to {high}"
+
+
+def report_runs(results, run_row: Callable[[Mapping], dict], columns: Sequence[str],
+                committed_csv: Path) -> tuple:
+    """The per-run table of a study report and the fronts behind it: from the records, else the CSV.
+
+    With stored records (``results`` of :func:`pymoo_rail.experiments.load_results` not empty),
+    each run becomes one row by ``run_row`` and the fronts are returned for the figures. Without
+    them, the table is read from ``committed_csv``, the per-run CSV the report exported when it
+    was last built from records (every digit of a float survives the round trip), and there are
+    no fronts: the report's numbers are rebuilt, the figures drawn from fronts are not.
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        The stored runs, with fronts (``load_results(..., fronts=True)``); may be empty.
+    run_row : callable
+        One run (a row of ``results``) -> a dict with the ``columns``.
+    columns : sequence of str
+        The table's columns, in the CSV's order.
+    committed_csv : pathlib.Path
+        The per-run CSV next to the report.
+
+    Returns
+    -------
+    (pandas.DataFrame, dict, bool)
+        The table, ``{(problem, algorithm, seed): F}`` (empty without records), and whether the
+        table came from the records (then the caller exports it to ``committed_csv``).
+
+    Raises
+    ------
+    FileNotFoundError
+        Neither records nor ``committed_csv``.
+    ValueError
+        The CSV lacks one of ``columns`` (written by another version of the script).
+    """
+    import pandas as pd
+
+    if len(results):
+        table = pd.DataFrame([run_row(row) for _, row in results.iterrows()], columns=list(columns))
+        fronts = {(r.problem, r.algorithm, int(r.seed)): r.F for r in results.itertuples()}
+        return table, fronts, True
+    committed_csv = Path(committed_csv)
+    if not committed_csv.is_file():
+        raise FileNotFoundError(f"no run records to report and no per-run table {committed_csv}: run the study first")
+    # every digit must come back: pandas >= 3 parses floats round-trip by default (and deprecates the option)
+    exact = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
+    table = pd.read_csv(committed_csv, **exact)
+    missing = [c for c in columns if c not in table.columns]
+    if missing:
+        raise ValueError(f"{committed_csv} lacks the column(s) {', '.join(missing)}: rerun the study to rebuild it")
+    return table[list(columns)], {}, False

@@ -4,16 +4,16 @@ A TTOBench *journey* file lists timing points ``[position, earliest, latest, min
 (times from the journey's start, ``null`` where unset). Two consecutive points at one position with
 both speed bounds 0 are the arrival at and the departure from an intermediate stop; a point with
 both speed bounds 0 is a stopping point, any other a passing point. The stopping points cut the
-journey into stop-to-stop sections (each a :class:`~pymoo_rail.model.Case`), so one model serves:
-a :class:`~pymoo_rail.journeys.Journey` with its timing points.
+journey into stop-to-stop sections: a :class:`~pymoo_rail.journeys.Journey`, i.e. a
+:class:`~pymoo_rail.model.Case` with one leg per section, with its timing points.
 
 :func:`solve_timed_journey` finds the least-energy run meeting every window. Each section's run is
 the exact solver's optimum for a running time: departures are as early as their windows allow
 (a longer dwell never saves energy), the running time as long as the arrival window and the next
-departure window allow (energy falls with running time), and passing-point windows are met by
-bisection on the section's running time: passing points inside a section share the section's
-single price of time. When one price cannot meet them all (a window that needs a faster first
-part and a slower second part), the function raises :class:`TimingError` naming the point.
+departure window allow (energy falls with running time). Passing points split a section into
+stretches, each with its own price of time, and each missed window gets the ratio of the prices
+around its point that puts the run on the window's bound. Minimum speeds are a speed floor of the
+exact solver at their points. When no run meets a point, :class:`TimingError` names it.
 """
 
 from __future__ import annotations

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 
 
 class FieldError(ValueError):
@@ -42,24 +43,48 @@ class InfeasibleCaseError(CaseError):
 
 
 def check_number(field: str, value: object, *, positive: bool = False, nonneg: bool = False,
-                 upper: float | None = None, optional: bool = False, source: str | None = None) -> float | None:
-    """``value`` as a float after checking its type and range; :class:`CaseError` naming ``field``.
+                 upper: float | None = None, optional: bool = False, source: str | None = None,
+                 error: type[FieldError] | None = None) -> float | None:
+    """``value`` as a float after checking its type and range, else an error naming ``field``.
 
+    The one number check of the package: case fields, solver and controller settings.
     Booleans and strings are refused (TOML ``true`` or ``"80"`` are not numbers), as are NaN and
-    infinities: nothing is coerced.
+    infinities: nothing is coerced. Python and numpy numbers are accepted.
+
+    Parameters
+    ----------
+    field : str
+        The field path or parameter name the message names.
+    value : object
+    positive, nonneg : bool
+        Require ``value > 0`` or ``value >= 0``.
+    upper : float, optional
+        Require ``value <= upper``.
+    optional : bool
+        ``None`` is allowed (and returned).
+    source : str, optional
+        The file or object the value came from.
+    error : FieldError subclass, optional
+        The exception raised (default :class:`CaseError`; a setting that is not case data
+        raises :class:`FieldError`).
+
+    Returns
+    -------
+    float or None
     """
+    error = CaseError if error is None else error
     if value is None:
         if optional:
             return None
-        raise CaseError(field, value, "is required", source)
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise CaseError(field, value, f"must be a finite number, not {type(value).__name__}", source)
+        raise error(field, value, "is required", source)
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise error(field, value, f"must be a finite number, not {type(value).__name__}", source)
     if not math.isfinite(value):
-        raise CaseError(field, value, "must be a finite number", source)
+        raise error(field, value, "must be a finite number", source)
     if positive and value <= 0:
-        raise CaseError(field, value, "must be > 0 (positive)", source)
+        raise error(field, value, "must be > 0 (positive)", source)
     if nonneg and value < 0:
-        raise CaseError(field, value, "must be >= 0", source)
+        raise error(field, value, "must be >= 0", source)
     if upper is not None and value > upper:
-        raise CaseError(field, value, f"must be <= {upper}", source)
+        raise error(field, value, f"must be <= {upper}", source)
     return float(value)

@@ -7,8 +7,8 @@ An encoding turns a population of decision vectors into kernel programs. Two fam
   non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``;
   ``"equal"`` cuts ``n_sections`` equal pieces (fig. 4-3). Bounds run from a floor to the highest
   limit in the section; sections inside a neutral section are fixed at the floor (coasting).
-  On long sparse lines (``max_section_m`` not given) sections averaging more than 2 km are cut
-  into 1 km pieces, and where they average more than 5 km each section gets a coasting point (m): the train heads for its code up to that point and coasts
+  On long sparse lines (sections averaging more than 2 km, ``max_section_m`` not given) each
+  section also gets a coasting point (m): the train heads for its code up to that point and coasts
   from there to the section's end, so one section holds the optimal structure of a long stretch
   (reach a speed, hold it, coast into the next limit or the stop) with two variables.
 - ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (Meng et al. (2017) and Tang et al. (2020)),
@@ -44,16 +44,13 @@ from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.pacing import split_long_sections
 
 PARTITIONS = ("gradient_limit", "equal")
-# Long sparse lines, unless max_section_m is given: a gradient/limit partition whose sections
-# average more than SPARSE_MEAN_SECTION_M is cut into pieces of SPARSE_MAX_SECTION_M at most; one
-# whose sections average more than COAST_MEAN_SECTION_M (several coasting distances of an
-# intercity train) instead keeps its sections and gives each a coasting point (the 48.5 km TTOBench
-# reference: 2 variables, not 49). Holding a speed over many 1 km pieces needs many equal codes,
-# which left NSGA2 4-6 % above the optimum on the reference family's limit drops
-# (benchmarks/sparse_encoding.py prints both).
+# Long sparse lines: a gradient/limit partition whose sections average more than this keeps its
+# sections and gives each a coasting point, unless max_section_m is given (the 48.5 km TTOBench
+# reference: a code and a coasting point, where it had one variable: one cruise speed, no
+# coasting). Cutting such sections into 1 km pieces instead (49 codes on the reference) left NSGA2
+# up to 5 % above the optimum on the reference family: holding a speed over many pieces needs many
+# equal codes (benchmarks/sparse_encoding.py prints both).
 SPARSE_MEAN_SECTION_M = 2000.0
-SPARSE_MAX_SECTION_M = 1000.0
-COAST_MEAN_SECTION_M = 5000.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,10 +89,7 @@ class SpeedCodes:
             bounds = gradient_limit_partition(line)
             neutral_points = [p for row in line.neutral_sections for p in row]
             bounds = np.unique(np.concatenate([bounds, neutral_points]))
-            mean_m = (bounds[-1] - bounds[0]) / (bounds.shape[0] - 1)
-            coast = max_section_m is None and mean_m > COAST_MEAN_SECTION_M
-            if max_section_m is None and SPARSE_MEAN_SECTION_M < mean_m <= COAST_MEAN_SECTION_M:
-                max_section_m = SPARSE_MAX_SECTION_M
+            coast = max_section_m is None and (bounds[-1] - bounds[0]) / (bounds.shape[0] - 1) > SPARSE_MEAN_SECTION_M
             bounds = split_long_sections(bounds, max_section_m)
         elif partition == "equal":
             coast = False

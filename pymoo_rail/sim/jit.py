@@ -15,9 +15,20 @@ import time
 from contextlib import contextmanager
 from typing import Callable, Iterator
 
+from numba import njit
 from numba.core import event
 
 PACKAGE = "pymoo_rail"
+
+# Decorator of the kernels' small helpers (forces, one cell's step and accounting). LLVM inlines
+# them into every caller (``forceinline``: the LLVM attribute ``alwaysinline``), so a cell costs
+# what it cost with Numba's own inlining (``inline="always"``), which re-ran the untyped pipeline
+# of a helper, and of every helper it inlines in turn, at each call site: 66 % of the first run's
+# compile (``benchmarks/compile_profile.py``). No reference counting: they allocate nothing, and a
+# called helper with it increfs the model's arrays on every call. They keep their Python wrapper
+# (``no_cpython_wrapper`` would save a little compile, but a call from Python then crashes).
+inlined = njit(cache=True, forceinline=True, _nrt=False)
+"""``njit`` for a kernel helper: inlined by LLVM into every caller, no reference counting."""
 NOTICE = ("compiling the simulator (first run only: Numba compiles the kernels once and caches them "
           "on disk; this takes a while on a small machine) ...")
 
@@ -109,11 +120,11 @@ class CompileProfile(event.Listener):
     Attributes
     ----------
     seconds : dict
-        ``(function qualname, stage) -> seconds``.
+        ``(module.qualname of the function, stage) -> seconds``.
     compiles : dict
-        ``function qualname -> number of signatures compiled``.
+        ``module.qualname -> number of signatures compiled``.
     signatures : dict
-        ``function qualname -> [argument types of each compilation]`` (to spot specialisations).
+        ``module.qualname -> [argument types of each compilation]`` (to spot specialisations).
     """
 
     def __init__(self) -> None:
@@ -142,12 +153,13 @@ class CompileProfile(event.Listener):
         data = ev.data or {}
         if ev.kind == "numba:compile":
             dispatcher = data.get("dispatcher")
-            qualname = getattr(getattr(dispatcher, "py_func", None), "__qualname__", "?")
+            func = getattr(dispatcher, "py_func", None)
+            qualname = f"{getattr(func, '__module__', '?')}.{getattr(func, '__qualname__', '?')}"
             self.compiles[qualname] = self.compiles.get(qualname, 0) + 1
             self.signatures.setdefault(qualname, []).append(str(data.get("args", "")))
             self._open(qualname, "other")
         else:
-            self._open(data.get("qualname", "?"), data.get("name", "?").split(" [")[0])
+            self._open(f"{data.get('module', '?')}.{data.get('qualname', '?')}", data.get("name", "?").split(" [")[0])
 
     def on_end(self, ev: event.Event) -> None:
         """The innermost open compile or pass ends: charge its exclusive time."""

@@ -43,6 +43,7 @@ import numpy as np
 from numba import njit, prange
 
 from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.sim.jit import inlined
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
@@ -90,7 +91,7 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
 KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def full_step(m, v0, cell, kind):
     """Two-stage step over one cell at maximum traction, coasting or maximum braking.
 
@@ -135,7 +136,7 @@ def scaled_step(m, v0, cell, kind, share):
     return u1, f, w0, v_half
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def _decel_step(m, v0, cell, decel_ms2):
     """One cell braking at the constant deceleration ``decel_ms2`` (MODE_DECEL).
 
@@ -155,8 +156,8 @@ def _decel_step(m, v0, cell, decel_ms2):
     return u1, f, w0, REGIME_BRAKE
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
-def _share_above(v0, v1, v_cut):
+@inlined
+def share_above(v0, v1, v_cut):
     """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
     lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
     if lo >= v_cut:
@@ -178,7 +179,7 @@ TOTAL_PREV_REGIME, TOTAL_REGIME_CHANGES, TOTAL_LIMIT_EXCESS = 11, 12, 13
 N_TOTALS = 14
 
 
-@njit(cache=True)
+@inlined
 def new_totals():
     """Running totals of a run (time, works, comfort and limit figures) as a tuple.
 
@@ -187,7 +188,7 @@ def new_totals():
     return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300)
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     """Keep a step under the braking envelope and name its regime by the force applied.
 
@@ -218,7 +219,7 @@ def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     return u1, f, w0, regime, clamped
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def complete_cell(m, totals, cell, v, u1, f, w0, regime):
     """Finish one cell: standstill inside it, time, energy accounting, comfort.
 
@@ -248,7 +249,7 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
             w_neutral += f * d
     w_brake += brake_n * d
     if brake_n > 0.0:
-        share = _share_above(v, v1, m.regen_min_speed_ms)
+        share = share_above(v, v1, m.regen_min_speed_ms)
         w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
     w_davis += w0 * d
     w_line += m.line_force_n[cell] * d
@@ -283,12 +284,12 @@ def trace_cell_energies(m, x, v, f):
         if f[i] > 0.0:
             trac[i] = f[i] * d / m.traction_efficiency
         elif f[i] < 0.0:
-            share = _share_above(v[i], v[i + 1], m.regen_min_speed_ms)
+            share = share_above(v[i], v[i + 1], m.regen_min_speed_ms)
             regen[i] = m.regen_efficiency * electric_braking_capped(m, 0.5 * (v[i] + v[i + 1]), -f[i]) * d * share
     return trac, regen
 
 
-@njit(cache=True)
+@inlined
 def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime):
     """Write one cell into the trace arrays."""
     tr_x[cell + 1] = x1
@@ -299,7 +300,7 @@ def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, 
     tr_r[cell] = regime
 
 
-@njit(cache=True)
+@inlined
 def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r):
     """Close a run (back to rest) and write its ``OUT_*`` summary."""
     length = m.position_m[m.position_m.shape[0] - 1]
@@ -331,7 +332,7 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
     out[OUT_NEUTRAL_TRACTION_J] = totals[TOTAL_NEUTRAL_TRACTION_J]
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def drive_cell(m, program, totals, i, v, row, hold_speed):
     """One cell of a driving program: the program's control, the envelope, the accounting.
 

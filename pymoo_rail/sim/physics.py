@@ -14,6 +14,7 @@ from numba import njit
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
+from pymoo_rail.sim.jit import inlined
 
 
 class KernelModel(NamedTuple):
@@ -86,7 +87,7 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
     return model._replace(envelope_ms=envelope)
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def curve_force(v, breaks, coefs, max_n, max_w):
     """Piecewise polynomial force limit at speed v, capped by a force and a power."""
     k = 0
@@ -107,13 +108,13 @@ def curve_force(v, breaks, coefs, max_n, max_w):
     return f
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def davis_force(m, v):
     """Basic running resistance W0(v) in N."""
     return m.davis_a_n + (m.davis_b_nsm + m.davis_c_ns2m2 * v) * v
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def max_traction(m, v, cell):
     """Largest usable traction force in a cell: the curve, the acceleration cap, neutral sections."""
     if m.neutral[cell] != 0:
@@ -127,7 +128,7 @@ def max_traction(m, v, cell):
     return f
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def max_braking(m, v, cell):
     """Largest usable braking force in a cell: the curve and the deceleration cap."""
     f = curve_force(v, m.brake_breaks_ms, m.brake_coefs, m.brake_max_n, m.brake_max_w)
@@ -139,7 +140,7 @@ def max_braking(m, v, cell):
     return f
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def electric_braking_capped(m, v, brake_n):
     """The part of a braking force within the motors' regen force and power caps."""
     f = brake_n
@@ -155,7 +156,7 @@ def electric_braking_capped(m, v, brake_n):
 LANDING_RTOL = 1e-8
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def landing_force(m, v0, v1, cell):
     """Control force that brings the train from v0 to exactly v1 over one cell, and W0 used.
 
@@ -175,7 +176,7 @@ def landing_force(m, v0, v1, cell):
     return f, w0, feasible
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def braking_shortfall(m, v0, v1, cell):
     """Braking force a landing from v0 onto v1 needs beyond the train's maximum (N, <= 0 if it can).
 

@@ -6,6 +6,7 @@ goes from ``run_study`` to the per-run CSV, the report and the figures."""
 from __future__ import annotations
 
 import importlib.util
+import shutil
 import sys
 from pathlib import Path
 
@@ -73,6 +74,23 @@ def test_grnsga2_reduced_study_gives_runs_report_and_fronts(tmp_path):
     text = (out / "grnsga2_zdt.md").read_text()
     assert "Runs per problem and algorithm: 2" in text and (out / "grnsga2_zdt1_fronts.png").stat().st_size > 0
     assert "Reading (30-run study)" not in text  # the 30-run reading is not shown for other studies
+    _rebuilt_from_csv_alone(out, "grnsga2_zdt_runs.csv", "grnsga2_zdt.md", tmp_path / "none",
+                            lambda o, r: gr.write_report(o, r, ["zdt1"], list(gr.ALGORITHMS)))
+
+
+def _rebuilt_from_csv_alone(out: Path, csv_name: str, report_name: str, no_records: Path, write) -> None:
+    """Without records, the report is rebuilt from the exported CSV alone, with the same numbers."""
+    again = out.parent / "from_csv"
+    shutil.copytree(out, again)  # the committed CSV and figures
+    (again / report_name).unlink()
+    write(again, load_results(no_records))
+    assert (again / csv_name).read_bytes() == (out / csv_name).read_bytes()  # not rewritten
+    first, second = (d / report_name for d in (out, again))
+    differ = [(a, b) for a, b in zip(first.read_text().splitlines(), second.read_text().splitlines()) if a != b]
+    assert len(first.read_text().splitlines()) == len(second.read_text().splitlines())
+    assert len(differ) == 1 and "run records" in differ[0][1], differ  # only the sentence naming the source
+    with pytest.raises(FileNotFoundError, match=csv_name):
+        write(out.parent / "empty", load_results(no_records))
 
 
 def test_moabc_study_cells_and_report(tmp_path):
@@ -102,6 +120,7 @@ def test_moabc_study_cells_and_report(tmp_path):
     assert list(table.algorithm) == ["MOABC-centred", "NSGA2"] and list(table.run) == [0, 0]
     assert (table.IGD > 0).all() and (table.HV >= 0).all() and table.SP.notna().all()
     assert (out / "moabc_zdt_fronts.png").exists() and "## ZDT1" in (out / "moabc_zdt.md").read_text()
+    _rebuilt_from_csv_alone(out, "moabc_zdt.csv", "moabc_zdt.md", tmp_path / "none", mz.report)
 
 
 def test_abc_function_studies_give_equal_budgets_curves_and_report(tmp_path):

@@ -186,7 +186,7 @@ def test_every_track_with_its_train_first_to_last_stop(track, train):
     _solve_line(track, train, n_gen=20)
 
 
-def test_long_sparse_lines_get_coasting_points_or_1_km_codes_and_dense_lines_keep_their_partition():
+def test_long_sparse_lines_get_a_coasting_point_per_section_and_dense_lines_keep_their_partition():
     from pymoo_rail.cases import load_case
     from pymoo_rail.problems.encodings import SpeedCodes
     from pymoo_rail.sim import gradient_limit_partition
@@ -199,8 +199,9 @@ def test_long_sparse_lines_get_coasting_points_or_1_km_codes_and_dense_lines_kee
     assert SpeedCodes.build(reference, max_section_m=5000.0).n_var == 10  # an explicit choice wins
     wind = quietly(from_ttobench, RELEASE / "tracks" / "00_var_speed_limit_wind.json",
                    RELEASE / "trains" / "NL_Intercity_VIRM6.json", 0, -1, 1000.0)
-    pieces = SpeedCodes.build(wind)  # six sections averaging 3.3 km: 1 km pieces
-    assert not pieces.coast_points and pieces.n_var == 20 and np.max(np.diff(pieces.boundaries_m)) <= 1000.0
+    six = SpeedCodes.build(wind)  # six sections averaging 3.3 km
+    assert six.coast_points and six.n_var == 12 and list(six.boundaries_m) == [0, 2000, 9000, 11000, 12000, 18000,
+                                                                                 20000]
     for name in ("wuguang-crh3", "yizhuang"):  # sections average 1.7 km and 280 m: unchanged
         case = load_case(name)
         assert SpeedCodes.build(case).n_var == len(gradient_limit_partition(case.line)) - 1 + (

@@ -128,3 +128,17 @@ def test_controllers_are_frozen_and_hashable():
         c.a_kmh = 1.0
     assert hash(c) == hash(Hysteresis(2.0, 4.0)) and PID() == PID()
     assert FuzzyPID() == FuzzyPID() and hash(FuzzyPID()) == hash(FuzzyPID())
+
+
+def test_make_controller_builds_each_controller_by_name_and_names_bad_input():
+    from pymoo_rail.control import make_controller
+
+    assert make_controller("hysteresis", a_kmh=2, b_kmh=5) == Hysteresis(2.0, 5.0)
+    assert make_controller("pid", kp=0.3) == PID(kp=0.3)
+    assert make_controller("fuzzy_pid").name == FuzzyPID().name
+    with pytest.raises(ValueError, match="controller = 'pi'"):
+        make_controller("pi")
+    with pytest.raises(ValueError, match="controller = 'pid'.*kq"):
+        make_controller("pid", kq=1.0)
+    with pytest.raises(ValueError, match="'b_kmh' = 'x'"):  # the controller's own field check
+        make_controller("hysteresis", b_kmh="x")

@@ -43,7 +43,7 @@ def test_tracked_problem_pickles(yizhuang):
 def test_bad_tracking_option(yizhuang):
     with pytest.raises(ValueError, match="controller"):
         SpeedProfileProblem(yizhuang, tracking="hysteresis")
-    with pytest.raises(ValueError, match="control_period_s = 0.0"):
+    with pytest.raises(ValueError, match="'control_period_s' = 0.0"):
         SpeedProfileProblem(yizhuang, tracking=Hysteresis(2.0, 3.0), control_period_s=0.0)
 
 

@@ -84,3 +84,15 @@ def test_rail_convergence_is_labelled_with_the_objective(rail_results):
     assert fig.axes[0].get_ylabel() == "best energy (kWh)"
     assert fig.axes[0].get_xlabel() == "function evaluations"
     plt.close(fig)
+
+
+def test_a_study_spec_names_the_tracking_controller_as_a_table():
+    from pymoo_rail.control import Hysteresis
+    from pymoo_rail.experiments import StudyError
+
+    tracked = build_problem(problem("speed_profile", case="yizhuang", objectives=["energy"],
+                                    tracking={"controller": "hysteresis", "a_kmh": 2.0, "b_kmh": 3.0}))
+    assert tracked.tracker.controller == Hysteresis(2.0, 3.0)
+    for bad in ({"a_kmh": 2.0}, {"controller": "bang-bang"}, "hysteresis"):
+        with pytest.raises(StudyError, match="tracking"):
+            build_problem(problem("speed_profile", case="yizhuang", objectives=["energy"], tracking=bad))

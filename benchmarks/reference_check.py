@@ -1,0 +1,152 @@
+"""Every optimiser result committed in ``benchmarks/reports`` against the exact optimum at its own time.
+
+For each front member the project's studies committed (their CSVs in ``benchmarks/reports``), the
+exact solver (``pymoo_rail.optimal.solved_energy_gap``, default grid) solves the optimum at the
+member's own running time and gives its certificate ``energy_bound_kwh``. A member that lies below
+the optimum by more than the certificate is a defect of the reference; the script counts them
+(and exits with status 1 if there is one) and writes the exact gaps the study reports quote.
+
+Members read:
+
+- ``yizhuang_seed000.csv``: the best member of each of the 180 ABC / MOABC runs (case ``yizhuang``);
+- ``emu_wuguang_runs.csv``: three members of each of the 58 runs on ``wuguang-crh3`` (its members
+  are not committed, only per-run figures): the fastest (``t_min``, ``e_max``), the slowest
+  (``t_max``, ``e_min``) and the punctual one (``punctual_t``, ``punctual_e``);
+- ``journeys_fronts_simulated.csv``: the strategy-search fronts of the 13 Yizhuang-line sections.
+
+Not read: the cooperative and timetable studies (two trains sharing energy: no single-train
+optimum applies), the metro table-3 runs (the paper's kinematic model, not the simulator's), and the
+tracking and controller runs (no front; disturbed trains).
+
+Usage::
+
+    nice -n 10 python benchmarks/reference_check.py          # about 6 CPU minutes
+    python benchmarks/reference_check.py --report-only       # report from reference_check.csv
+
+Writes ``benchmarks/reports/reference_check.csv`` (one row per member) and ``reference_check.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from benchmarks.optimal import markdown  # noqa: E402
+
+from pymoo_rail.experiments.scripts import lower_priority  # noqa: E402
+
+REPORTS = ROOT / "benchmarks" / "reports"
+
+
+def members() -> pd.DataFrame:
+    """Every committed member: ``source``, ``case``, ``label`` (run / algorithm), time and energy."""
+    rows = []
+    y = pd.read_csv(REPORTS / "yizhuang_seed000.csv")
+    for r in y.itertuples():
+        rows.append(("yizhuang_seed000", "yizhuang", f"{r.algorithm} {r.partition}", r.seed, "best",
+                     r.running_time_s, r.energy_kwh))
+    w = pd.read_csv(REPORTS / "emu_wuguang_runs.csv")
+    for r in w.itertuples():
+        for kind, t, e in (("fastest", r.t_min, r.e_max), ("slowest", r.t_max, r.e_min),
+                           ("punctual", r.punctual_t, r.punctual_e)):
+            rows.append(("emu_wuguang", "wuguang-crh3", f"{r.algorithm} {r.problem}", r.seed, kind, t, e))
+    j = pd.read_csv(REPORTS / "journeys_fronts_simulated.csv")
+    for r in j.itertuples():
+        rows.append(("journeys", f"section {int(r.section)}", r.case, int(r.section), "strategy",
+                     r.running_time_s, r.energy_kwh))
+    return pd.DataFrame(rows, columns=["source", "case", "label", "seed", "member", "running_time_s", "energy_kwh"])
+
+
+def case_objects() -> dict:
+    """The cases the members ran on, by the names :func:`members` gives them."""
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
+    from pymoo_rail.journeys import Journey
+
+    journey = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
+    cases = {"yizhuang": load_case("yizhuang"), "wuguang-crh3": load_case("wuguang-crh3")}
+    cases.update({f"section {k}": c for k, c in enumerate(journey.sections)})
+    return cases
+
+
+def check(table: pd.DataFrame) -> pd.DataFrame:
+    """Add the exact gap columns of ``solved_energy_gap`` (one cached reference per case)."""
+    from tqdm import tqdm
+
+    from pymoo_rail.optimal import ReferenceAtTime, solved_energy_gap
+
+    cases = case_objects()
+    parts = []
+    for name, group in tqdm(list(table.groupby("case", sort=False)), desc="cases", unit="case"):
+        ref = ReferenceAtTime(cases[name])
+        gap = solved_energy_gap(group[["running_time_s", "energy_kwh"]], ref)["points"]
+        cols = ["optimal_kwh", "gap_kwh", "gap_rel", "energy_bound_kwh", "below_reference", "in_range"]
+        parts.append(pd.concat([group.reset_index(drop=True), gap[cols].reset_index(drop=True)], axis=1))
+    return pd.concat(parts, ignore_index=True)
+
+
+def summary(table: pd.DataFrame) -> pd.DataFrame:
+    """Per source and label: members, in range, below the reference beyond the certificate, gaps."""
+    t = table[table["in_range"]].copy()
+    t["margin_kwh"] = t["gap_kwh"] + t["energy_bound_kwh"]  # < 0: below the optimum beyond the certificate
+    g = t.groupby(["source", "label"], sort=False)
+    out = pd.DataFrame({
+        "members": g.size(),
+        "below_reference": g["below_reference"].sum().astype(int),
+        "least margin kWh": g["margin_kwh"].min(),
+        "largest certificate kWh": g["energy_bound_kwh"].max(),
+        "gap best %": 100 * g["gap_rel"].min(),
+        "gap mean %": 100 * g["gap_rel"].mean(),
+        "gap worst %": 100 * g["gap_rel"].max(),
+    }).reset_index()
+    out.insert(3, "out of range", table[~table["in_range"]].groupby(["source", "label"]).size()
+               .reindex(pd.MultiIndex.from_frame(out[["source", "label"]])).fillna(0).astype(int).to_numpy())
+    return out
+
+
+def write_report(table: pd.DataFrame, out: Path) -> int:
+    """Write and print ``reference_check.md``; returns how many members lie below the reference."""
+    s = summary(table)
+    n_below = int(s["below_reference"].sum())
+    lines = ["# Committed optimiser results against the exact optimum at their own running time", "",
+             "Written by `python benchmarks/reference_check.py` (it reads the study CSVs of `benchmarks/reports`, "
+             "see its docstring for which members). Each member is compared with the optimum solved at its own "
+             "running time (`pymoo_rail.optimal.solved_energy_gap`, default grid) and with that solve's certificate "
+             "`energy_bound_kwh`. *margin* = gap + certificate: a negative margin is a member below the optimum by "
+             "more than the certificate, a defect of the reference.", "",
+             f"Members in range: {int(table['in_range'].sum())} of {len(table)}; below the reference beyond the "
+             f"certificate: **{n_below}**.", "", markdown(s), ""]
+    (out / "reference_check.md").write_text("\n".join(lines))
+    print("\n".join(lines))
+    return n_below
+
+
+def main(argv=None) -> int:
+    """Check every committed member (or report from the stored CSV); exit status 1 if one is below."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=REPORTS, help="report folder")
+    parser.add_argument("--report-only", action="store_true", help="report from the stored reference_check.csv")
+    parser.add_argument("--limit", type=int, default=None, help="only the first N members of each case (a quick run)")
+    args = parser.parse_args(argv)
+    csv_path = args.out / "reference_check.csv"
+    if args.report_only:
+        table = pd.read_csv(csv_path)
+    else:
+        lower_priority()
+        table = members()
+        if args.limit is not None:
+            table = table.groupby("case", sort=False).head(args.limit)
+        table = check(table)
+        table.to_csv(csv_path, index=False, float_format="%.10g")  # 10 digits: far below any gap quoted
+    return 1 if write_report(table, args.out) else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
