@@ -1,10 +1,11 @@
 """Every optimiser result committed in ``benchmarks/reports`` against the exact optimum at its own time.
 
 For each front member the project's studies committed (their CSVs in ``benchmarks/reports``), the
-exact solver (``pymoo_rail.optimal.solved_energy_gap``, default grid) solves the optimum at the
-member's own running time and gives its certificate ``energy_bound_kwh``. A member that lies below
-the optimum by more than the certificate is a defect of the reference; the script counts them
-(and exits with status 1 if there is one) and writes the exact gaps the study reports quote.
+exact solver (``pymoo_rail.optimal.solved_energy_gap``, default grid, the lower of its two
+speed-node placements) solves the optimum at the member's own running time and gives its
+certificate ``energy_bound_kwh``. A member that lies below the optimum by more than the
+certificate is a defect of the reference; the script counts them (and exits with status 1 if
+there is one) and writes the exact gaps the study reports quote.
 
 Members read:
 
@@ -20,7 +21,7 @@ tracking and controller runs (no front; disturbed trains).
 
 Usage::
 
-    nice -n 10 python benchmarks/reference_check.py          # about 6 CPU minutes
+    nice -n 10 python benchmarks/reference_check.py          # about 70 CPU seconds
     python benchmarks/reference_check.py --report-only       # report from reference_check.csv
 
 Writes ``benchmarks/reports/reference_check.csv`` (one row per member) and ``reference_check.md``.
@@ -118,7 +119,8 @@ def write_report(table: pd.DataFrame, out: Path) -> int:
     lines = ["# Committed optimiser results against the exact optimum at their own running time", "",
              "Written by `python benchmarks/reference_check.py` (it reads the study CSVs of `benchmarks/reports`, "
              "see its docstring for which members). Each member is compared with the optimum solved at its own "
-             "running time (`pymoo_rail.optimal.solved_energy_gap`, default grid) and with that solve's certificate "
+             "running time (`pymoo_rail.optimal.solved_energy_gap`, default grid; the lower of the two speed-node "
+             "placements it solves, packed towards the envelope and uniform in v^2) and with that solve's certificate "
              "`energy_bound_kwh`. *margin* = gap + certificate: a negative margin is a member below the optimum by "
              "more than the certificate, a defect of the reference.", "",
              f"Members in range: {int(table['in_range'].sum())} of {len(table)}; below the reference beyond the "
