@@ -136,7 +136,11 @@ def main() -> None:
                   "`GA(pop_size=60)` and 6000 evaluations, against the same exact baseline.", ""]
         lines += savings_lines(paper_table)
         lines += ["", f"CPU time of these runs: {paper_table['cpu_s'].sum():.0f} s."]
-    lines += ["", "How these compare with the earlier model and with the paper: `docs/cooperative.md`.",
+    lines += ["", "The offsets study's records are in `cooperative_study/offsets/`; those of the gradient and "
+              "paper-encoding studies are not kept in the repository (the size budget of `benchmarks/reports`): "
+              "`python benchmarks/cooperative.py --paper-seeds 5` recomputes them, seeded, with the same results "
+              "(about 20 CPU minutes).",
+              "How these compare with the earlier model and with the paper: `docs/cooperative.md`.",
               "A row with fewer seeds than asked for comes from a study stopped early (`--report-only`).", ""]
     text = "\n".join(lines)
     args.out.mkdir(parents=True, exist_ok=True)
