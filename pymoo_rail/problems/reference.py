@@ -12,8 +12,10 @@ This module turns the solver's runs into a front with a certificate and keeps it
   running time. When the solver reports this bound (column ``energy_bound_kwh`` of
   :func:`~pymoo_rail.optimal.optimal_front`) it is used (``certificate = "solver"``).
   Otherwise it is the two-grid estimate (``certificate = "two-grid"``): the difference between
-  the default grid and one with half the speed nodes at the same requested time. Either is
-  raised to at least :data:`BOUND_FLOOR_REL` of the energy. The coarse grid errs more than the
+  the default grid and one with half the speed nodes at the same requested time. Each node is
+  solved twice, in a warm-started sweep over the times and alone; the lower run is kept and the
+  bound raised to at least their difference. Either is also raised to at least
+  :data:`BOUND_FLOOR_REL` of the energy. The coarse grid errs more than the
   default one (``docs/optimal.md``), so the difference over-estimates the default grid's error;
   it is an estimate, not a proof.
 - **Between nodes.** The front is convex and decreasing in time, so the chord between two nodes
@@ -43,12 +45,15 @@ from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, case_to_dict
 
-FRONT_VERSION = "3"
-"""Version of the front computation; bump it when the solver or the node choice changes."""
+FRONT_VERSION = "4"
+"""Version of the front computation; bump it when the solver or the node choice changes
+(4: every node solved in the sweep and alone, the lower kept, the bound at least their difference)."""
 FRONT_SPAN = 1.3
 """Fronts cover running times from the minimum to ``FRONT_SPAN`` x the planned time."""
-DEFAULT_N_TIMES = 17
-"""Nodes of a front on lines up to :data:`LONG_LINE_M`; longer lines get :data:`LONG_LINE_N_TIMES` (DP cost)."""
+DEFAULT_N_TIMES = 33
+"""Nodes of a front on lines up to :data:`LONG_LINE_M`; longer lines get :data:`LONG_LINE_N_TIMES` (DP cost).
+Each node's solve warm-starts the next one's: 33 nodes (not 17) keep the warm start close enough that the
+yizhuang front no longer lies above members of the suite study by more than its bound."""
 LONG_LINE_M = 10_000.0
 LONG_LINE_N_TIMES = 9
 BOUND_FLOOR_REL = 5.0e-4
@@ -253,13 +258,25 @@ def n_times_for(case: Case) -> int:
 
 
 def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = None) -> CertifiedFront:
-    """Compute a case's certified front with the exact solver (no cache; see :func:`certified_front`)."""
+    """Compute a case's certified front with the exact solver (no cache; see :func:`certified_front`).
+
+    Every node is solved twice: in one sweep over the running times (each solve warm-started from
+    the last) and alone. The lower run at the requested time is kept, and the node's bound is raised
+    to at least the difference of the two: a warm-started sweep can settle on a worse run than the
+    same solve alone (on yizhuang at 171.6 s: 9.115 against 8.978 kWh, with a solver bound of 0.011
+    kWh), so where they disagree the solver's own bound is not trusted.
+    """
     from pymoo_rail.optimal import OptimalSolver, min_running_time, optimal_front
     from pymoo_rail.optimal.solver import DEFAULT_N_SPEEDS
 
     t_min = min_running_time(case, dx_m)
     times = front_times(t_min, case.planned_time_s, n_times or n_times_for(case))
-    fine = optimal_front(case, times, dx_m=dx_m)
+    sweep = optimal_front(case, times, dx_m=dx_m)
+    alone = pd.concat([optimal_front(case, [t], dx_m=dx_m) for t in sweep["requested_time_s"]], ignore_index=True)
+    use_alone = (alone["energy_at_request_kwh"] < sweep["energy_at_request_kwh"]).to_numpy()
+    fine = sweep.copy()
+    fine.loc[use_alone] = alone.loc[use_alone]
+    spread = np.abs(sweep["energy_at_request_kwh"] - alone["energy_at_request_kwh"]).to_numpy()
     if "energy_bound_kwh" in fine.columns and fine["energy_bound_kwh"].notna().all():
         bound = fine["energy_bound_kwh"].to_numpy(dtype=float)
         certificate = "solver"
@@ -267,11 +284,12 @@ def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = N
         coarse = optimal_front(case, times, dx_m=dx_m, n_speeds=DEFAULT_N_SPEEDS // COARSE_FACTOR)
         bound = np.abs(fine["energy_at_request_kwh"].to_numpy() - coarse["energy_at_request_kwh"].to_numpy())
         certificate = "two-grid"
-    bound = np.maximum(bound, BOUND_FLOOR_REL * np.abs(fine["energy_kwh"].to_numpy()))
+    bound = np.maximum.reduce([bound, spread, BOUND_FLOOR_REL * np.abs(fine["energy_kwh"].to_numpy())])
     table = pd.DataFrame({"requested_time_s": fine["requested_time_s"], "running_time_s": fine["running_time_s"],
                           "energy_kwh": fine["energy_kwh"], "lambda_kwh_per_s": fine["lambda_kwh_per_s"],
                           "energy_bound_kwh": bound})
-    table = table.sort_values("running_time_s", kind="stable").reset_index(drop=True)
+    # two requested times close to the minimum can land on the same run: keep it once
+    table = table.sort_values("running_time_s", kind="stable").drop_duplicates("running_time_s").reset_index(drop=True)
     step = OptimalSolver(case, dx_m).dx_m if dx_m is None else float(dx_m)
     return CertifiedFront(table, case_hash(case), case.name, float(case.planned_time_s), float(step), certificate,
                           f"pymoo_rail {__version__} / front {FRONT_VERSION}")

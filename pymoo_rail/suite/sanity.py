@@ -75,12 +75,13 @@ def _igd(pf: np.ndarray, F: np.ndarray, CV: np.ndarray) -> tuple[float, float, i
     from pymoo.util.nds.non_dominated_sorting import find_non_dominated
 
     F = F[CV <= 0.0]
-    if len(F) == 0:
+    n_feasible = len(F)
+    if n_feasible == 0:
         return float("inf"), float("inf"), 0
     F = F[find_non_dominated(F)]
     spread = np.ptp(pf, axis=0).min() > 0  # a single optimum cannot be normalised
     normalised = float(IGD(pf, zero_to_one=True)(F)) if spread else float("nan")
-    return float(IGD(pf)(F)), normalised, len(F)
+    return float(IGD(pf)(F)), normalised, n_feasible
 
 
 def nsga2_against_random(name: str, pop_size: int = 100, n_gen: int = 200, seed: int = 1) -> SanityResult:
