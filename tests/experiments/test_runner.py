@@ -16,7 +16,7 @@ import pytest
 from pymoo_rail.experiments import ResultStore, Study, algorithm, execute_run, load_results, problem, run_study
 from pymoo_rail.experiments.stats import write_tables
 from pymoo_rail.experiments.store import RECORD_FORMAT
-from tests.experiments.studies import small_study
+from tests.experiments.studies import parallel_spheres, small_study
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -246,3 +246,17 @@ def test_scheduler_local_starts_its_own_cluster(pool_study_dir, tmp_path):
     report = run_study(small_study(), tmp_path, workers=2, scheduler="local", progress=False)
     assert report.n_finished == 45
     _fronts_equal(load_results(pool_study_dir), load_results(tmp_path))
+
+
+def test_pool_workers_compile_after_running_a_cached_parallel_kernel(tmp_path, monkeypatch):
+    """A worker that first runs a kernel from Numba's disk cache on Numba's threads and then has to
+    compile must not fail: the worker's thread count is set without touching NUMBA_NUM_THREADS,
+    which Numba re-reads at every compile (before, every such run failed with "Cannot set
+    NUMBA_NUM_THREADS to a different value once the threads have been launched")."""
+    monkeypatch.delenv("NUMBA_NUM_THREADS", raising=False)
+    parallel_spheres(np.zeros((2, 3)))  # the kernel is on disk before the workers start
+    study = Study("jitted", problems=[problem("tests.experiments.studies:jitted_sphere")],
+                  algorithms=[algorithm("nsga2", pop_size=8)], seeds=[1, 2], budget={"n_gen": 3})
+    report = run_study(study, tmp_path, workers=2, progress=False, check=False)
+    assert report.failures == []
+    assert report.n_finished == 2
