@@ -100,7 +100,7 @@ def full_step(m, v0, cell, kind):
     return scaled_step(m, v0, cell, kind, 1.0)
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def _traction(m, v, cell, share):
     """``share`` of the maximum traction, but at least the force that holds the speed (Chen et al.
     (2017): gamma above the holding ratio); exactly the maximum when ``share`` is 1."""
@@ -114,7 +114,7 @@ def _traction(m, v, cell, share):
     return f
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def scaled_step(m, v0, cell, kind, share):
     """:func:`full_step` with the traction step at ``share`` of the maximum force (see ``_traction``)."""
     wl = m.line_force_n[cell]
