@@ -58,13 +58,15 @@ class ReferenceAtTime:
         The DP's run lands within the solver's time tolerance of the request; its energy is moved to
         the request along the front's slope (``lambda``), and the bound grows by the second-order
         remainder of that move, bounded by ``lambda x |time difference|``. With ``uniform_too``, the
-        lower of the two placements' answers, with that answer's own bound. NaNs below the minimum
-        running time.
+        lower of the two placements' answers, with that answer's own bound; ``first_kwh`` and
+        ``first_bound_kwh`` are the first placement's (``top_bias`` of the settings) alone. NaNs
+        below the minimum running time.
         """
         key = round(float(running_time_s), self.decimals)
         if key in self._cache:
             return self._cache[key]
         out = {"optimal_kwh": math.nan, "energy_bound_kwh": math.nan, "lambda_kwh_per_s": math.nan}
+        first = (math.nan, math.nan)
         for k, solver in enumerate(self.solvers):
             try:
                 tr = solver.profile(key, lambda_guess_w=self._last_lambda_w[k])
@@ -75,9 +77,12 @@ class ReferenceAtTime:
             shift_kwh = lam * (tr.running_time_s - key) / J_PER_KWH
             bound = tr.summary.get("energy_bound_kwh", math.nan)
             energy_kwh = tr.energy.net_kwh + shift_kwh
+            if k == 0:
+                first = (energy_kwh, bound + abs(shift_kwh))
             if not energy_kwh >= out["optimal_kwh"]:  # also replaces the NaN of no answer yet
                 out = {"optimal_kwh": energy_kwh, "energy_bound_kwh": bound + abs(shift_kwh),
                        "lambda_kwh_per_s": lam / J_PER_KWH}
+        out = {**out, "first_kwh": first[0], "first_bound_kwh": first[1]}
         self._cache[key] = out
         return out
 
@@ -98,7 +103,8 @@ def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> d
         ``points``: DataFrame with ``running_time_s``, ``energy_kwh``, ``optimal_kwh``, ``gap_kwh``,
         ``gap_rel``, ``energy_bound_kwh`` (the reference's certificate), ``below_reference`` (the
         point lies below the optimum by more than the certificate: a defect of the reference) and
-        ``in_range`` (False below the minimum running time); ``mean_gap_rel``, ``max_gap_rel``,
+        ``in_range`` (False below the minimum running time), ``first_kwh`` and ``first_bound_kwh``
+        (the first speed-node placement alone, see :meth:`ReferenceAtTime.at`); ``mean_gap_rel``, ``max_gap_rel``,
         ``min_gap_rel`` over the points in range, ``n_out_of_range`` and ``n_below_reference``.
     """
     ref = reference if isinstance(reference, ReferenceAtTime) else ReferenceAtTime(reference, **settings)
@@ -108,11 +114,14 @@ def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> d
     for k in order:
         rows[k] = ref.at(points[k, 0])
     t, e = points[:, 0], points[:, 1]
+    first = np.array([r["first_kwh"] for r in rows])
+    first_bound = np.array([r["first_bound_kwh"] for r in rows])
     optimal = np.array([r["optimal_kwh"] for r in rows])
     bound = np.array([r["energy_bound_kwh"] for r in rows])
     gap = e - optimal
     in_range = np.isfinite(optimal)
     table = pd.DataFrame({TIME_COLUMN: t, ENERGY_COLUMN: e, "optimal_kwh": optimal, "gap_kwh": gap,
                           "gap_rel": gap / optimal, "energy_bound_kwh": bound,
-                          "below_reference": in_range & (gap < -bound), "in_range": in_range})
+                          "below_reference": in_range & (gap < -bound), "in_range": in_range,
+                          "first_kwh": first, "first_bound_kwh": first_bound})
     return {**gap_summary(table), "n_below_reference": int(table["below_reference"].sum())}

@@ -56,4 +56,5 @@ def test_the_reference_keeps_the_lower_of_the_two_node_placements(yizhuang):
     assert at["optimal_kwh"] == pytest.approx(min(a["optimal_kwh"] for a in alone), abs=1e-9)
     kept = min(alone, key=lambda a: a["optimal_kwh"])
     assert at["energy_bound_kwh"] == pytest.approx(kept["energy_bound_kwh"], abs=1e-9)
+    assert at["first_kwh"] == pytest.approx(alone[0]["optimal_kwh"], abs=1e-9)  # the packed placement alone
     assert len(ReferenceAtTime(yizhuang, n_speeds=100, top_bias=0.0).solvers) == 1
