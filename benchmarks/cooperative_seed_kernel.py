@@ -104,7 +104,8 @@ def main() -> None:
                 valid = s["force_excess_ms2"] <= 1e-3 and s["decode_excess_ms"] <= 1e-9
                 if valid:
                     diffs.append((rel, tr_new.running_time_s - tr_old.running_time_s, dv))
-                verdict = "yes" if valid else f"no (force {s['force_excess_ms2']:.2g} m/s2 over)"
+                verdict = "yes" if valid else (f"no: forces {s['force_excess_ms2']:.2g} m/s2 beyond the limits, exit "
+                                               f"speeds {s['decode_excess_ms']:.2g} m/s out of reach")
                 print(f"| {label} | {name} | {verdict} | {run.traction_kwh:.3f} / {tr_new.energy.traction_kwh:.3f} | "
                       f"{run.regen_kwh:.3f} / {tr_new.energy.regen_kwh:.3f} | {tr_old.running_time_s:.2f} / "
                       f"{tr_new.running_time_s:.2f} | {dv:.2f} |")

@@ -19,3 +19,11 @@ def test_timetable_command_writes_a_front(tmp_path, capsys):
 def test_timetable_command_rejects_one_train(tmp_path, capsys):
     assert main(["timetable", "cooperative-pair", "--trains", "1", "--out", str(tmp_path)]) == 2
     assert "--trains" in capsys.readouterr().err
+
+
+def test_timetable_command_runs_both_directions(tmp_path, capsys):
+    code = main(["timetable", "cooperative-pair", "--trains", "2", "--directions", "2", "--pop-size", "4",
+                 "--n-eval", "8", "--out", str(tmp_path)])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "2 direction(s)" in out and "regular timetable wait 120.0 s" in out

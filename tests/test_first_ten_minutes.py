@@ -186,6 +186,8 @@ def test_no_kernel_uses_numba_ir_inlining():
     dispatchers = _package_dispatchers()
     assert len(dispatchers) > 40
     assert [name for name, d in dispatchers.items() if d.targetoptions.get("inline") == "always"] == []
+    # every kernel keeps its Python wrapper: without one, a call from Python crashes the interpreter
+    assert [name for name, d in dispatchers.items() if d.targetoptions.get("no_cpython_wrapper")] == []
     from pymoo_rail.sim import kernel, physics
 
     for helper in (kernel.full_step, kernel.drive_cell, kernel.complete_cell, kernel.clamp_to_envelope,

@@ -74,6 +74,13 @@ def test_docs_slow_python_snippets_run(page, tmp_path, monkeypatch):
     assert run_page(page, with_slow=True) == len(snippets(page))
 
 
+def test_every_docs_snippet_compiles():
+    # the slow ones too: a syntax error shows without running them
+    for page in PAGES:
+        for _, line, code in snippets(page):
+            compile("\n" * (line - 1) + code, str(page.relative_to(ROOT)), "exec")
+
+
 def test_snippet_marks_are_known():
     marks = {(page.name, mark) for page in PAGES for lang in ("python", "bash")
              for mark, _, _ in snippets(page, lang) if mark is not None}

@@ -29,13 +29,19 @@ def problem_label(phi: float, offset_s: float) -> str:
 
 
 def offsets_study(name: str, phis: Sequence[float], seeds: int, offsets_s: Sequence[float] = SEED_001_OFFSETS_S,
-                  pop_size: int = 60, n_eval: int = 6000) -> Study:
-    """``CooperativeTrainsProblem`` at every offset and gradient factor, plain pymoo GA, ``seeds`` seeds."""
+                  pop_size: int = 60, n_eval: int = 6000, paper_encoding: bool = False) -> Study:
+    """``CooperativeTrainsProblem`` at every offset and gradient factor, plain pymoo GA, ``seeds`` seeds.
+
+    ``paper_encoding``: ``CooperativeSeedProblem`` instead (phi 1 only)."""
     problems = []
     for phi in phis:
         for x in offsets_s:
             label = problem_label(phi, x)
-            if phi == 1.0:
+            if paper_encoding:
+                if phi != 1.0:
+                    raise ValueError(f"phi = {phi!r}: the paper-encoding study runs the case as it is (phi 1)")
+                problems.append(problem("cooperative_seed", label=label, offset_s=x))
+            elif phi == 1.0:
                 problems.append(problem("cooperative_trains", label=label, offset_s=x))
             else:
                 problems.append(problem("cooperative_trains_scaled", label=label, offset_s=x, phi=phi))

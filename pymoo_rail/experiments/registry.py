@@ -108,6 +108,13 @@ def _cooperative_scaled(case: Any = "cooperative-pair", phi: float = 1.0, **para
     return CooperativeTrainsProblem(scale_gradients(_case(case), phi), **_tuples(params))
 
 
+def _cooperative_seed(case: Any = "cooperative-pair", **params):
+    """``pymoo_rail.problems.cooperative_seed.CooperativeSeedProblem`` (the paper's encoding on the kernel)."""
+    from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem
+
+    return CooperativeSeedProblem(_case(case), **_tuples(params))
+
+
 def _timetable(case: Any = "cooperative-pair", **params):
     """``pymoo_rail.problems.TimetableProblem``: several trains sharing braking energy."""
     from pymoo_rail.problems import TimetableProblem
@@ -152,6 +159,7 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "rail_suite": _rail_suite,
     "cooperative_trains_scaled": _cooperative_scaled,
     "timetable": _timetable,
+    "cooperative_seed": _cooperative_seed,
 }
 
 # ------------------------------------------------------------------------------- algorithms

@@ -207,9 +207,12 @@ def _watch_parent(parent_pid: int) -> None:
 
 
 def _worker_init(parent_pid: int | None = None) -> None:
-    # one numba thread per worker process: the pool already uses every core
-    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    # One Numba thread per worker process: the pool already uses every core. Numba re-reads
+    # NUMBA_NUM_THREADS at every compile and refuses a change once its threads run, so the
+    # environment is left alone and the count is set on the worker's thread instead.
+    import numba
+
+    numba.set_num_threads(1)
     if parent_pid is not None:
         # a pool worker outlives a killed driver (waiting on its queue forever): exit instead
         threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True, name="parent-watch").start()

@@ -11,8 +11,7 @@ from typing import Sequence
 import numpy as np
 
 from pymoo_rail.cases import ttobench
-from pymoo_rail.model import Case, CaseError, Line, Train
-from pymoo_rail.model.case import Leg
+from pymoo_rail.model import Case, CaseError, Leg, Line, Train
 from pymoo_rail.sim import Simulator
 
 

@@ -41,7 +41,7 @@ from pymoo_rail.sim.kernel import (
     full_step,
     share_above,
 )
-from pymoo_rail.sim.jit import inlined_internal
+from pymoo_rail.sim.jit import inlined
 from pymoo_rail.sim.physics import electric_braking_capped, landing_force
 
 INF = math.inf
@@ -166,7 +166,7 @@ def value_position(top_u, u, k_max, bias):
     return node_position(top_u, u, k_max, bias)
 
 
-@inlined_internal
+@inlined
 def interp_at(v_next, p):
     """Cost-to-go at fractional node index ``p`` (from :func:`value_position`), linear in ``u``."""
     if p < 0.0:

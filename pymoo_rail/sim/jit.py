@@ -20,17 +20,15 @@ from numba.core import event
 
 PACKAGE = "pymoo_rail"
 
-# Decorators of the kernels' small helpers (forces, one cell's step and accounting). LLVM inlines
+# Decorator of the kernels' small helpers (forces, one cell's step and accounting). LLVM inlines
 # them into every caller (``forceinline``: the LLVM attribute ``alwaysinline``), so a cell costs
 # what it cost with Numba's own inlining (``inline="always"``), which re-ran the untyped pipeline
 # of a helper, and of every helper it inlines in turn, at each call site: 66 % of the first run's
-# compile (``benchmarks/compile_profile.py``). No reference counting (they allocate nothing; NRT
-# increfs on the model's arrays were half the cost of a cell where a helper was not inlined).
+# compile (``benchmarks/compile_profile.py``). No reference counting: they allocate nothing, and a
+# called helper with it increfs the model's arrays on every call. They keep their Python wrapper
+# (``no_cpython_wrapper`` would save a little compile, but a call from Python then crashes).
 inlined = njit(cache=True, forceinline=True, _nrt=False)
-"""For helpers also called from Python (tests, set-up code)."""
-inlined_internal = njit(cache=True, forceinline=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-"""For helpers only kernels call: no Python wrapper to build (its unboxing of the model is most of
-a small helper's own compile)."""
+"""``njit`` for a kernel helper: inlined by LLVM into every caller, no reference counting."""
 NOTICE = ("compiling the simulator (first run only: Numba compiles the kernels once and caches them "
           "on disk; this takes a while on a small machine) ...")
 

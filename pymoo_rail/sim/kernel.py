@@ -43,7 +43,7 @@ import numpy as np
 from numba import njit, prange
 
 from pymoo_rail.constants import J_PER_KWH
-from pymoo_rail.sim.jit import inlined_internal
+from pymoo_rail.sim.jit import inlined
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
@@ -91,7 +91,7 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
 KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
 
 
-@inlined_internal
+@inlined
 def full_step(m, v0, cell, kind):
     """Two-stage step over one cell at maximum traction, coasting or maximum braking.
 
@@ -100,7 +100,7 @@ def full_step(m, v0, cell, kind):
     return scaled_step(m, v0, cell, kind, 1.0)
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def _traction(m, v, cell, share):
     """``share`` of the maximum traction, but at least the force that holds the speed (Chen et al.
     (2017): gamma above the holding ratio); exactly the maximum when ``share`` is 1."""
@@ -114,7 +114,7 @@ def _traction(m, v, cell, share):
     return f
 
 
-@njit(cache=True, forceinline=True, _nrt=False)
+@inlined
 def scaled_step(m, v0, cell, kind, share):
     """:func:`full_step` with the traction step at ``share`` of the maximum force (see ``_traction``)."""
     wl = m.line_force_n[cell]
@@ -136,7 +136,7 @@ def scaled_step(m, v0, cell, kind, share):
     return u1, f, w0, v_half
 
 
-@inlined_internal
+@inlined
 def _decel_step(m, v0, cell, decel_ms2):
     """One cell braking at the constant deceleration ``decel_ms2`` (MODE_DECEL).
 
@@ -156,7 +156,7 @@ def _decel_step(m, v0, cell, decel_ms2):
     return u1, f, w0, REGIME_BRAKE
 
 
-@inlined_internal
+@inlined
 def share_above(v0, v1, v_cut):
     """Share of a cell run above the speed v_cut (v^2 is linear in distance within a cell)."""
     lo, hi = (v0, v1) if v0 < v1 else (v1, v0)
@@ -179,7 +179,7 @@ TOTAL_PREV_REGIME, TOTAL_REGIME_CHANGES, TOTAL_LIMIT_EXCESS = 11, 12, 13
 N_TOTALS = 14
 
 
-@inlined_internal
+@inlined
 def new_totals():
     """Running totals of a run (time, works, comfort and limit figures) as a tuple.
 
@@ -188,7 +188,7 @@ def new_totals():
     return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300)
 
 
-@inlined_internal
+@inlined
 def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     """Keep a step under the braking envelope and name its regime by the force applied.
 
@@ -219,7 +219,7 @@ def clamp_to_envelope(m, v, cell, u1, f, w0, regime):
     return u1, f, w0, regime, clamped
 
 
-@inlined_internal
+@inlined
 def complete_cell(m, totals, cell, v, u1, f, w0, regime):
     """Finish one cell: standstill inside it, time, energy accounting, comfort.
 
@@ -289,7 +289,7 @@ def trace_cell_energies(m, x, v, f):
     return trac, regen
 
 
-@inlined_internal
+@inlined
 def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime):
     """Write one cell into the trace arrays."""
     tr_x[cell + 1] = x1
@@ -300,7 +300,7 @@ def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, 
     tr_r[cell] = regime
 
 
-@inlined_internal
+@inlined
 def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r):
     """Close a run (back to rest) and write its ``OUT_*`` summary."""
     length = m.position_m[m.position_m.shape[0] - 1]
@@ -332,7 +332,7 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
     out[OUT_NEUTRAL_TRACTION_J] = totals[TOTAL_NEUTRAL_TRACTION_J]
 
 
-@inlined_internal
+@inlined
 def drive_cell(m, program, totals, i, v, row, hold_speed):
     """One cell of a driving program: the program's control, the envelope, the accounting.
 

@@ -186,7 +186,7 @@ def test_every_track_with_its_train_first_to_last_stop(track, train):
     _solve_line(track, train, n_gen=20)
 
 
-def test_long_sparse_lines_get_coasting_points_or_1_km_codes_and_dense_lines_keep_their_partition():
+def test_long_sparse_lines_get_a_coasting_point_per_section_and_dense_lines_keep_their_partition():
     from pymoo_rail.cases import load_case
     from pymoo_rail.problems.encodings import SpeedCodes
     from pymoo_rail.sim import gradient_limit_partition

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import numpy as np
+from numba import njit, prange
+
 from pymoo_rail.experiments import Study, algorithm, problem
 
 
@@ -55,3 +58,33 @@ def case_sphere(case: str, n_var: int = 3):
             out["F"] = np.column_stack([np.sum((x - centre) ** 2, axis=1), np.sum((x + centre) ** 2, axis=1)])
 
     return CaseSphere()
+
+
+
+@njit(parallel=True, cache=True)
+def parallel_spheres(x):
+    """The two sphere objectives of each row of ``x``, on Numba's threads (cached on disk)."""
+    out = np.empty((x.shape[0], 2))
+    for i in prange(x.shape[0]):
+        out[i, 0] = np.sum((x[i] - 0.5) ** 2)
+        out[i, 1] = np.sum((x[i] + 0.5) ** 2)
+    return out
+
+
+def jitted_sphere(n_var: int = 3):
+    """A two-objective sphere as a study worker meets Numba: a kernel loaded from the disk cache runs
+    on Numba's threads first, then a function is compiled in the worker (no cache)."""
+    from pymoo.core.problem import Problem
+
+    @njit(cache=False)
+    def doubled(f):
+        return 2.0 * f
+
+    class JittedSphere(Problem):
+        def __init__(self):
+            super().__init__(n_var=n_var, n_obj=2, xl=-1.0, xu=1.0)
+
+        def _evaluate(self, x, out, *args, **kwargs):
+            out["F"] = 0.5 * doubled(parallel_spheres(x))
+
+    return JittedSphere()

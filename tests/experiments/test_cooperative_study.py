@@ -35,3 +35,12 @@ def test_offsets_study_names_every_offset_and_gradient_factor():
     assert labels[:2] == [problem_label(1.0, -45.0), problem_label(1.0, 0.0)] and len(labels) == 10
     assert labels[5] == "phi=0.4 x=-45"
     assert (study.budget.kind, study.budget.value) == ("n_eval", 6000) and study.seeds == (1, 2, 3)
+
+
+def test_paper_encoding_study_uses_the_seed_problem():
+    from pymoo_rail.experiments.registry import PROBLEMS
+
+    study = offsets_study("p", [1.0], 2, paper_encoding=True)
+    assert {p.name for p in study.problems} == {"cooperative_seed"} and "cooperative_seed" in PROBLEMS
+    with pytest.raises(ValueError, match=r"phi = 0.4"):
+        offsets_study("p", [0.4], 2, paper_encoding=True)

@@ -16,7 +16,7 @@ import pytest
 from pymoo_rail.experiments import ResultStore, Study, algorithm, execute_run, load_results, problem, run_study
 from pymoo_rail.experiments.stats import write_tables
 from pymoo_rail.experiments.store import RECORD_FORMAT
-from tests.experiments.studies import small_study
+from tests.experiments.studies import parallel_spheres, small_study
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -246,3 +246,32 @@ def test_scheduler_local_starts_its_own_cluster(pool_study_dir, tmp_path):
     report = run_study(small_study(), tmp_path, workers=2, scheduler="local", progress=False)
     assert report.n_finished == 45
     _fronts_equal(load_results(pool_study_dir), load_results(tmp_path))
+
+
+
+def test_pool_workers_compile_after_running_a_cached_parallel_kernel(tmp_path):
+    """A worker that first runs a kernel from Numba's disk cache on Numba's threads and then has to
+    compile must not fail: the worker's thread count is set without touching NUMBA_NUM_THREADS,
+    which Numba re-reads at every compile (before, every such run failed with "Cannot set
+    NUMBA_NUM_THREADS to a different value once the threads have been launched"). A script of its
+    own, as a user runs a study: the driver has run the kernel before the pool starts."""
+    script = (
+        "import sys\n"
+        f"sys.path.insert(0, {str(REPO)!r})\n"
+        "import numpy as np\n"
+        "from tests.experiments.studies import parallel_spheres\n"
+        "from pymoo_rail.experiments import Study, algorithm, problem, run_study\n"
+        "if __name__ == '__main__':\n"
+        "    parallel_spheres(np.zeros((2, 3)))\n"
+        "    study = Study('jitted', problems=[problem('tests.experiments.studies:jitted_sphere')],\n"
+        "                  algorithms=[algorithm('nsga2', pop_size=8)], seeds=[1, 2], budget={'n_gen': 3})\n"
+        f"    report = run_study(study, {str(tmp_path / 'study')!r}, workers=2, progress=False, check=False)\n"
+        "    print(report.n_finished, report.failures)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_NUM_THREADS"}
+    env["PYTHONPATH"] = os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])
+    path = tmp_path / "study.py"  # a file: the pool's fresh interpreters import it, and Numba with it
+    path.write_text(script)
+    done = subprocess.run([sys.executable, str(path)], env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == "2 []", done.stdout[-2000:]

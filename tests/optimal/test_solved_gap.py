@@ -43,3 +43,18 @@ def test_the_solved_optimum_lies_on_or_below_the_interpolated_front(yizhuang, re
     a, b, mid = reference.at(140.0), reference.at(180.0), reference.at(160.0)
     chord = 0.5 * (a["optimal_kwh"] + b["optimal_kwh"])
     assert mid["optimal_kwh"] <= chord + mid["energy_bound_kwh"]
+
+
+def test_the_reference_keeps_the_lower_of_the_two_node_placements(yizhuang):
+    # each placement alone is a simulator run at the requested time: the kept answer is the lower one,
+    # with that answer's own certificate (fresh references: a solve depends on the earlier ones)
+    reference = ReferenceAtTime(yizhuang, n_speeds=100)
+    at = reference.at(160.0)
+    alone = [ReferenceAtTime(yizhuang, uniform_too=False, n_speeds=100, top_bias=bias).at(160.0)
+             for bias in (reference.solver.top_bias, 0.0)]
+    assert len(reference.solvers) == 2
+    assert at["optimal_kwh"] == pytest.approx(min(a["optimal_kwh"] for a in alone), abs=1e-9)
+    kept = min(alone, key=lambda a: a["optimal_kwh"])
+    assert at["energy_bound_kwh"] == pytest.approx(kept["energy_bound_kwh"], abs=1e-9)
+    assert at["first_kwh"] == pytest.approx(alone[0]["optimal_kwh"], abs=1e-9)  # the packed placement alone
+    assert len(ReferenceAtTime(yizhuang, n_speeds=100, top_bias=0.0).solvers) == 1
