@@ -158,37 +158,38 @@ def main() -> None:
     out = [f"# Exact solver benchmark (`benchmarks/optimal.py{' --quick' if args.quick else ''}`)", "",
            f"{cores} cores, load average {load:.1f} at the start (the machine is shared: times are wall clock).", ""]
 
+
+    def emit(text: str) -> None:
+        """Print one report section now and keep it for the report file."""
+        print(text, flush=True)
+        out.extend([text, ""])
+
     front, elapsed, warm_up, fastest = timing(case)
     text = (f"## 1. `optimal_front(yizhuang)`, 10 running times from {fastest:.2f} s to {1.5 * fastest:.2f} s\n\n"
             f"{elapsed:.1f} s wall clock (default grid: 1 m x 200 speed nodes), after a {warm_up:.1f} s warm-up "
             "that loads or compiles the Numba kernels.\n\n" + markdown(front))
-    print(text, flush=True)
-    out += [text, ""]
+    emit(text)
 
     planned = optimal_profile(case, case.planned_time_s)
     text = (f"Optimum at the planned 150 s: {planned.energy.net_kwh:.3f} kWh at {planned.running_time_s:.2f} s "
             f"({_at(planned, 150.0):.3f} kWh at exactly 150 s); the flat-out run: "
             f"{Simulator(case).flat_out().energy.net_kwh:.2f} kWh at {fastest:.2f} s.")
-    print(text, flush=True)
-    out += [text, ""]
+    emit(text)
 
     table = refinement(case, args.quick)
     text = ("## 2. Grid refinement (energy moved to exactly the requested time along the slope lambda)\n\n"
             + markdown(table))
-    print(text, flush=True)
-    out += [text, ""]
+    emit(text)
 
     table = level_track()
     text = ("## 3. Level track (5 km, Davis resistance): Pontryagin's closed form against the DP\n\n"
             + markdown(table))
-    print(text, flush=True)
-    out += [text, ""]
+    emit(text)
 
     table = direct_search(case, args.quick)
     text = ("## 4. Direct search over traction-hold-coast-brake strategies on yizhuang\n\n"
             + markdown(table))
-    print(text, flush=True)
-    out += [text, ""]
+    emit(text)
 
     REPORT.parent.mkdir(parents=True, exist_ok=True)
     bounds = gradient_limit_partition(case.line)

@@ -38,6 +38,7 @@ from pymoo_rail.sim.kernel import (
     new_totals,
     record_cell,
     run_program,
+    trace_arrays,
     write_summary,
 )
 from pymoo_rail.sim.physics import davis_force, max_braking, max_traction
@@ -309,12 +310,7 @@ def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms,
     """One tracked run with its trace: (summary, x, v, t, a, force, regime, command), trimmed."""
     n = m.position_m.shape[0]
     out = np.empty(N_OUT)
-    x = np.empty(n)
-    v = np.empty(n)
-    t = np.empty(n)
-    a = np.empty(n)
-    f = np.empty(n)
-    r = np.empty(n, dtype=np.int8)
+    x, v, t, a, f, r = trace_arrays(n)
     u = np.empty(n)
     record = n >= 0  # run-time booleans, not literals: one compiled track_run / run_program each
     count = track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record, x, v, t, a, f, r, u,
@@ -339,12 +335,8 @@ def track_programs(m, programs, code, params, period_s):
     record, no_record = n >= 0, n < 0
     for j in prange(n_runs):
         ref_out = np.empty(N_OUT)
-        x = np.empty(n)
-        v = np.zeros(n)
-        t = np.empty(n)
-        a = np.empty(n)
-        f = np.empty(n)
-        r = np.empty(n, dtype=np.int8)
+        x, v, t, a, f, r = trace_arrays(n)
+        v[:] = 0.0
         count = run_program(m, programs[j], ref_out, record, x, v, t, a, f, r)
         v[count:] = 0.0
         x_start, x_stop = reference_phases(x, r, count)

@@ -519,19 +519,28 @@ def simulate_batch_serial(m, programs):
     return out
 
 
-def simulate_trace(m, program):
-    """One run with its full trace: (summary, x, v, t, a, force, regime), trimmed to the run.
+@njit(cache=True)
+def trace_arrays(n):
+    """Uninitialised trace buffers for ``n`` nodes: (x, v, t, a, force, regime); regime is int8.
 
-    Plain Python around :func:`run_program` (see :func:`simulate_batch_serial`); called from
-    Python, ``record`` is typed ``bool``, so the batch kernels' ``run_program`` serves it too.
+    Plain ``njit`` (not ``inlined``): it returns new arrays, which needs Numba's runtime.
     """
-    n = m.position_m.shape[0]
-    out = np.empty(N_OUT)
     x = np.empty(n)
     v = np.empty(n)
     t = np.empty(n)
     a = np.empty(n)
     f = np.empty(n)
     r = np.empty(n, dtype=np.int8)
+    return x, v, t, a, f, r
+
+
+def simulate_trace(m, program):
+    """One run with its full trace: (summary, x, v, t, a, force, regime), trimmed to the run.
+
+    Plain Python around :func:`run_program` (see :func:`simulate_batch_serial`); called from
+    Python, ``record`` is typed ``bool``, so the batch kernels' ``run_program`` serves it too.
+    """
+    out = np.empty(N_OUT)
+    x, v, t, a, f, r = trace_arrays(m.position_m.shape[0])
     count = run_program(m, program, out, True, x, v, t, a, f, r)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count]

@@ -115,12 +115,8 @@ def davis_force(m, v):
 
 
 @inlined
-def max_traction(m, v, cell):
-    """Largest usable traction force in a cell: the curve, the acceleration cap, neutral sections."""
-    if m.neutral[cell] != 0:
-        return 0.0
-    f = curve_force(v, m.traction_breaks_ms, m.traction_coefs, m.traction_max_n, m.traction_max_w)
-    cap = m.effective_mass_kg * m.max_accel_ms2 + davis_force(m, v) + m.line_force_n[cell]
+def capped_force(f, cap):
+    """Force ``f`` (N) limited to ``cap`` (N) and never below zero (a cap below zero gives zero)."""
     if cap < f:
         f = cap
     if f < 0.0:
@@ -129,15 +125,21 @@ def max_traction(m, v, cell):
 
 
 @inlined
+def max_traction(m, v, cell):
+    """Largest usable traction force in a cell: the curve, the acceleration cap, neutral sections."""
+    if m.neutral[cell] != 0:
+        return 0.0
+    f = curve_force(v, m.traction_breaks_ms, m.traction_coefs, m.traction_max_n, m.traction_max_w)
+    cap = m.effective_mass_kg * m.max_accel_ms2 + davis_force(m, v) + m.line_force_n[cell]
+    return capped_force(f, cap)
+
+
+@inlined
 def max_braking(m, v, cell):
     """Largest usable braking force in a cell: the curve and the deceleration cap."""
     f = curve_force(v, m.brake_breaks_ms, m.brake_coefs, m.brake_max_n, m.brake_max_w)
     cap = m.effective_mass_kg * m.max_decel_ms2 - davis_force(m, v) - m.line_force_n[cell]
-    if cap < f:
-        f = cap
-    if f < 0.0:
-        f = 0.0
-    return f
+    return capped_force(f, cap)
 
 
 @inlined
