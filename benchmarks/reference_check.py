@@ -153,10 +153,10 @@ DERIVED = ("gap_rel", "below_reference")
 
 def with_derived_columns(table: pd.DataFrame) -> pd.DataFrame:
     """The stored table with ``gap_rel`` and ``below_reference`` as ``solved_energy_gap`` defines them."""
-    table = table.copy()
-    table["gap_rel"] = table["gap_kwh"] / table["optimal_kwh"]
-    table["below_reference"] = table["in_range"] & (table["gap_kwh"] < -table["energy_bound_kwh"])
-    return table
+    from pymoo_rail.optimal.gap import gap_columns
+
+    gaps = gap_columns(table["gap_kwh"], table["optimal_kwh"], table["energy_bound_kwh"], table["in_range"])
+    return table.assign(gap_rel=gaps["gap_rel"], below_reference=gaps["below_reference"])
 
 
 def main(argv=None) -> int:

@@ -855,6 +855,8 @@ def cmd_warmup(args) -> int:
 
 
 COMPILING_COMMANDS = ("optimize", "optimise", "reference", "warmup", "plot", "suite", "journey")
+
+
 def _add_suite_parser(sub) -> None:
     p = sub.add_parser(
         "suite", help="the benchmark suite: list its problems, verify its shipped fronts", formatter_class=_Formatter,

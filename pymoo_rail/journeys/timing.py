@@ -18,11 +18,10 @@ exact solver at their points. When no run meets a point, :class:`TimingError` na
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 

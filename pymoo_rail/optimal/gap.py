@@ -87,6 +87,28 @@ class ReferenceAtTime:
         return out
 
 
+def gap_columns(gap_kwh, optimal_kwh, energy_bound_kwh, in_range) -> dict:
+    """The relative gap of points to the optimum at their running time, and whether each lies below it.
+
+    Parameters
+    ----------
+    gap_kwh, optimal_kwh, energy_bound_kwh : array_like
+        The points' energies minus the optimum at their running times, that optimum and its
+        certificate (kWh).
+    in_range : array_like of bool
+        False where no run exists at that time (below the minimum running time).
+
+    Returns
+    -------
+    dict
+        ``gap_rel`` (gap / optimum) and ``below_reference`` (in range and below the optimum by more
+        than the certificate: a defect of the reference).
+    """
+    gap = np.asarray(gap_kwh)
+    return {"gap_rel": gap / np.asarray(optimal_kwh),
+            "below_reference": np.asarray(in_range) & (gap < -np.asarray(energy_bound_kwh))}
+
+
 def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> dict:
     """Energy of each front point above the optimum solved at its own running time.
 
@@ -120,8 +142,9 @@ def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> d
     bound = np.array([r["energy_bound_kwh"] for r in rows])
     gap = e - optimal
     in_range = np.isfinite(optimal)
+    gaps = gap_columns(gap, optimal, bound, in_range)
     table = pd.DataFrame({TIME_COLUMN: t, ENERGY_COLUMN: e, "optimal_kwh": optimal, "gap_kwh": gap,
-                          "gap_rel": gap / optimal, "energy_bound_kwh": bound,
-                          "below_reference": in_range & (gap < -bound), "in_range": in_range,
+                          "gap_rel": gaps["gap_rel"], "energy_bound_kwh": bound,
+                          "below_reference": gaps["below_reference"], "in_range": in_range,
                           "first_kwh": first, "first_bound_kwh": first_bound})
     return {**gap_summary(table), "n_below_reference": int(table["below_reference"].sum())}

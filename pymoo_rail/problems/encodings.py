@@ -99,19 +99,19 @@ class SpeedCodes:
         if not (np.isfinite(floor_kmh) and floor_kmh >= 0):
             raise ValueError(f"floor_kmh = {floor_kmh!r} must be a number >= 0")
         xu = np.empty(bounds.shape[0] - 1)
-        for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
-            xu[k] = max(v for s, e, v in line.speed_limits if s < b and e > a)
+        for j, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
+            xu[j] = max(v for s, e, v in line.speed_limits if s < b and e > a)
         xu = np.minimum(xu, case.train.max_speed_kmh)
         xl = np.minimum(np.full_like(xu, floor_kmh), xu)
-        for k, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
+        for j, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
             if any(s <= a and b <= e for s, e in line.neutral_sections):
-                xu[k] = xl[k]  # no traction there: the gene cannot matter, so it is fixed
+                xu[j] = xl[j]  # no traction there: the gene cannot matter, so it is fixed
         if integer:
             xl, xu = np.ceil(xl - 1e-9), np.floor(xu + 1e-9)
             if np.any(xl > xu):
-                k = int(np.argmax(xl > xu))
-                raise ValueError(f"floor_kmh = {floor_kmh!r}: section {k} has no whole km/h code "
-                                 f"between {xl[k]} and {xu[k]}")
+                j = int(np.argmax(xl > xu))
+                raise ValueError(f"floor_kmh = {floor_kmh!r}: section {j} has no whole km/h code "
+                                 f"between {xl[j]} and {xu[j]}")
         if coast:  # coasting point of each section, inside it (fixed at its end where codes are fixed)
             fixed = xl == xu
             xl = np.concatenate([xl, np.where(fixed, bounds[1:], bounds[:-1])])

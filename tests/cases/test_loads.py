@@ -1,13 +1,12 @@
 """Load states of the built-in cases (Liu 2019 table 5-2) and whole-km/h speed codes."""
 
-import warnings
 
 import numpy as np
 import pytest
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.model import CaseError
-from pymoo_rail.problems import ConstantObjectiveWarning, SpeedProfileProblem
+from pymoo_rail.problems import SpeedProfileProblem
 
 
 @pytest.mark.parametrize("load, mass_t", [("AW0", 194.295), ("AW2", 282.375), ("AW3", 307.095)])

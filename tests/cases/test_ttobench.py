@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import copy
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +22,6 @@ from pymoo_rail.cases.ttobench import (
 )
 from pymoo_rail.model import CaseError
 from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs
-from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.physics import build_kernel_model, electric_braking_capped, max_braking
 from tests.conftest import make_case
 

@@ -7,7 +7,6 @@ and tunnel physics, and two lines end to end. ``-m slow``: every track x its sui
 from __future__ import annotations
 
 import json
-import math
 import warnings
 from pathlib import Path
 
@@ -19,7 +18,6 @@ from pymoo.optimize import minimize
 from pymoo_rail.cases.ttobench import (
     CLOTHOID_PIECE_M,
     TTOBenchWarning,
-    case_between,
     from_ttobench,
     read_track,
     read_train,

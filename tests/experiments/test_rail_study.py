@@ -3,8 +3,6 @@ the optional energy gap, and the wiring of GoldenRatioNSGA2's fixed genes."""
 
 from __future__ import annotations
 
-import sys
-import types
 
 import numpy as np
 import pandas as pd

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 import subprocess
@@ -16,7 +15,7 @@ import pytest
 from pymoo_rail.experiments import ResultStore, Study, algorithm, execute_run, load_results, problem, run_study
 from pymoo_rail.experiments.stats import write_tables
 from pymoo_rail.experiments.store import RECORD_FORMAT
-from tests.experiments.studies import parallel_spheres, small_study
+from tests.experiments.studies import small_study
 
 REPO = Path(__file__).resolve().parents[2]
 

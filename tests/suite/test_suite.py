@@ -5,7 +5,7 @@ import pytest
 from pymoo.util.nds.non_dominated_sorting import find_non_dominated
 
 from pymoo_rail.problems import reference as ref
-from pymoo_rail.suite import CASES, NoExactFrontError, best_known_front, get_problem, list_problems, suite_case
+from pymoo_rail.suite import CASES, NoExactFrontError, best_known_front, get_problem, list_problems
 from pymoo_rail.suite.problems import tolerance_s
 from pymoo_rail.suite.sanity import nsga2_against_random
 
