@@ -2,6 +2,7 @@
 (a coasting point per section where sections average more than 2 km) against 1 km pieces.
 
 Usage: python benchmarks/sparse_encoding.py [--gen 200] [--seeds 1 2 3] [--only ID ...] [--form F]
+       [--encodings default "1 km pieces"]
 Prints, per track of the 48.5 km reference family (and the 20 km "wind" variant) with the Dutch
 VIRM6 at 1.15 x its minimum running time, the gap (%) to the exact optimum of NSGA2's best member
 within 2 s of the planned time (pop 40), for each seed, with the number of variables and the CPU
@@ -31,6 +32,7 @@ from pymoo_rail.problems import SpeedProfileProblem
 
 ROOT = Path(__file__).resolve().parents[1] / "tests" / "data" / "ttobench"
 TIME_TOL_S = 2.0
+ENCODINGS = {"default": {}, "1 km pieces": {"max_section_m": 1000.0}}
 
 
 def main() -> None:
@@ -39,6 +41,7 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="*", default=[1, 2, 3])
     parser.add_argument("--only", nargs="*")
     parser.add_argument("--form", choices=("front", "punctual"), default="front")
+    parser.add_argument("--encodings", nargs="*", choices=tuple(ENCODINGS), default=tuple(ENCODINGS))
     args = parser.parse_args()
     form = ({"objectives": ("energy", "time_error")} if args.form == "front"
             else {"objectives": ("energy",), "time_tolerance_s": TIME_TOL_S})
@@ -52,7 +55,8 @@ def main() -> None:
             case = from_ttobench(track, train, 0, -1, 1.0)
         case = case.with_planned_time(1.15 * min_running_time(case))
         optimum = optimal_profile(case, case.planned_time_s, certify=False).energy.net_kwh
-        for label, settings in (("default", {}), ("1 km pieces", {"max_section_m": 1000.0})):
+        for label in args.encodings:
+            settings = ENCODINGS[label]
             t0 = time.process_time()
             gaps = []
             for seed in args.seeds:

@@ -209,3 +209,4 @@ def test_journey_command_reports_an_unreachable_window(capsys, tmp_path):
     code, _, err = run(capsys, "journey", root / "journeys" / "CH_StGallen_Wil_Journey_01.json", "--train",
                        root / "trains" / "CH_Stadler_KISS_SBB.json", "--out", tmp_path)
     assert code == 1 and "timing point at 29556.1 m" in err and "345.4 s" in err
+    assert "before 1545.4 s (latest allowed 1450 s)" in err and "Traceback" not in err

@@ -316,7 +316,8 @@ def check_windows_reachable(timed: TimedJourney) -> None:
                                       f"cannot be met: after the earliest time {p.earliest_s:g} s at "
                                       f"{p.position_m} m, {q.position_m - p.position_m:.1f} m take at least "
                                       f"{need:.1f} s at the speed limits, but the windows leave "
-                                      f"{q.latest_s - p.earliest_s:.1f} s")
+                                      f"{q.latest_s - p.earliest_s:.1f} s: no train passes {q.position_m} m "
+                                      f"before {p.earliest_s + need:.1f} s (latest allowed {q.latest_s:g} s)")
 
 
 def speed_floor_ms(nodes_m: np.ndarray, passing: Sequence[TimingPoint], start_m: float) -> np.ndarray | None:

@@ -10,7 +10,8 @@ An encoding turns a population of decision vectors into kernel programs. Two fam
   On long sparse lines (sections averaging more than 2 km, ``max_section_m`` not given) each
   section also gets a coasting point (m): the train heads for its code up to that point and coasts
   from there to the section's end, so one section holds the optimal structure of a long stretch
-  (reach a speed, hold it, coast into the next limit or the stop) with two variables.
+  (reach a speed, hold it, coast into the next limit or the stop) with two variables. There the
+  codes start at the planned mean speed (:func:`sparse_code_floor_kmh`), not at ``floor_kmh``.
 - ``SwitchingPoints``: positions (m) where a fixed regime sequence switches (Meng et al. (2017) and Tang et al. (2020)),
   by default ``traction, hold, coast`` per speed-limit zone and a final ``brake``.
 - ``BrakingOnset``: the phases of Meng et al. (2017) (traction, cruise, coast) with the braking
@@ -51,6 +52,23 @@ PARTITIONS = ("gradient_limit", "equal")
 # up to 5 % above the optimum on the reference family: holding a speed over many pieces needs many
 # equal codes (benchmarks/sparse_encoding.py prints both).
 SPARSE_MEAN_SECTION_M = 2000.0
+
+
+def sparse_code_floor_kmh(case: Case, section_max_kmh: np.ndarray) -> np.ndarray:
+    """Lowest speed code of each section of a long sparse line: the planned mean speed
+    ``L / T_plan`` (km/h), or the section's highest code where that is lower.
+
+    The energy-optimal run of a stretch reaches a speed, holds it and coasts: on level track it
+    is nowhere faster than its hold speed (outside limits lower than that), so the hold speed is
+    at least the run's mean speed. A code below it can only hold a run that is slower than
+    planned, and on a long section a code below the entry speed coasts for kilometres without
+    reaching it: a plateau where neither the code nor the coasting point changes the run. The
+    coasting point expresses coasting, so the codes start at the mean speed, and random initial
+    runs reach the planned time by coasting earlier (the high-cruise family of the optimum)
+    rather than by holding slower.
+    """
+    mean_kmh = float(case.line.length_m) / float(case.planned_time_s) * KMH_PER_MS
+    return np.minimum(section_max_kmh, mean_kmh)
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,18 +121,22 @@ class SpeedCodes:
             xu[j] = max(v for s, e, v in line.speed_limits if s < b and e > a)
         xu = np.minimum(xu, case.train.max_speed_kmh)
         xl = np.minimum(np.full_like(xu, floor_kmh), xu)
+        if coast:
+            sparse_floor = sparse_code_floor_kmh(case, xu)
+            xl = np.maximum(xl, np.floor(sparse_floor + 1e-9) if integer else sparse_floor)
+        neutral = np.zeros(xu.shape[0], dtype=bool)
         for j, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
             if any(s <= a and b <= e for s, e in line.neutral_sections):
                 xu[j] = xl[j]  # no traction there: the gene cannot matter, so it is fixed
+                neutral[j] = True
         if integer:
             xl, xu = np.ceil(xl - 1e-9), np.floor(xu + 1e-9)
             if np.any(xl > xu):
                 j = int(np.argmax(xl > xu))
                 raise ValueError(f"floor_kmh = {floor_kmh!r}: section {j} has no whole km/h code "
                                  f"between {xl[j]} and {xu[j]}")
-        if coast:  # coasting point of each section, inside it (fixed at its end where codes are fixed)
-            fixed = xl == xu
-            xl = np.concatenate([xl, np.where(fixed, bounds[1:], bounds[:-1])])
+        if coast:  # coasting point of each section, inside it (fixed at its end in neutral sections)
+            xl = np.concatenate([xl, np.where(neutral, bounds[1:], bounds[:-1])])
             xu = np.concatenate([xu, bounds[1:]])
             if integer:
                 xl, xu = np.ceil(xl - 1e-9), np.floor(xu + 1e-9)

@@ -193,13 +193,21 @@ def test_long_sparse_lines_get_a_coasting_point_per_section_and_dense_lines_keep
                         RELEASE / "trains" / "NL_Intercity_VIRM6.json", 0, -1, 1600.0)
     codes = SpeedCodes.build(reference)  # one 48.5 km section: a code and a coasting point (was 1 variable)
     assert codes.coast_points and codes.n_var == 2 and codes.units == ["km/h", "m"]
-    assert list(codes.xl) == [10.0, 0.0] and list(codes.xu) == [140.0, 48531.0]
+    # codes start at the planned mean speed (48 531 m in 1600 s: 109.2 km/h), coasting points anywhere
+    assert codes.xl[0] == pytest.approx(48531.0 / 1600.0 * 3.6) and codes.xl[1] == 0.0
+    assert list(codes.xu) == [140.0, 48531.0]
     assert SpeedCodes.build(reference, max_section_m=5000.0).n_var == 10  # an explicit choice wins
     wind = quietly(from_ttobench, RELEASE / "tracks" / "00_var_speed_limit_wind.json",
                    RELEASE / "trains" / "NL_Intercity_VIRM6.json", 0, -1, 1000.0)
     six = SpeedCodes.build(wind)  # six sections averaging 3.3 km
     assert six.coast_points and six.n_var == 12 and list(six.boundaries_m) == [0, 2000, 9000, 11000, 12000, 18000,
                                                                                  20000]
+    # 72 km/h planned mean speed: the 60, 70 and 50 km/h zones hold their limit, their coasting points stay free
+    assert list(six.xl[:6]) == pytest.approx([60.0, 72.0, 72.0, 70.0, 72.0, 50.0])
+    assert list(six.xu[:6]) == [60.0, 120.0, 100.0, 70.0, 120.0, 50.0]
+    assert list(six.xl[6:]) == [0, 2000, 9000, 11000, 12000, 18000] and list(six.fixed()[6:]) == [False] * 6
+    integer = SpeedCodes.build(wind, integer=True)  # whole km/h: the mean speed rounds down
+    assert list(integer.xl[:6]) == [60.0, 72.0, 72.0, 70.0, 72.0, 50.0]
     for name in ("wuguang-crh3", "yizhuang"):  # sections average 1.7 km and 280 m: unchanged
         case = load_case(name)
         assert SpeedCodes.build(case).n_var == len(gradient_limit_partition(case.line)) - 1 + (
