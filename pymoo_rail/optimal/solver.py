@@ -463,8 +463,9 @@ class OptimalSolver:
 
         An estimate, not a proven bound: ``benchmarks/reference_check.py`` checks it against every
         optimiser result the project's studies committed, ``benchmarks/certificate_coverage.py``
-        against a grid of twice the nodes and the uniform node placement at all their times. The optimum meant is that of the
-        simulator's model on this position grid, the model every optimiser's run is evaluated with.
+        against a grid of twice the nodes and the uniform node placement at all their times. The
+        optimum meant is that of the simulator's model on this position grid, the model every
+        optimiser's run is evaluated with.
         """
         if self._coarse is None:
             self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
@@ -500,8 +501,9 @@ class OptimalSolver:
         The moved energy ``E + lambda (time_s - target_s)`` is the supporting line of the front at
         ``target_s``: at or below the optimum there. Above it lies the chord between this solver's
         closest solves on either side of ``target_s`` (the front is convex); the chord minus the line
-        bounds the error. With no solve on one side: ``lambda |time_s - target_s|`` (the first-order
-        term itself).
+        bounds the error. With no solve on one side, or for a run that is not one of this solver's
+        solves (a moved run, within ``time_tol_s``; a run of the finer grid ``profile`` fell back
+        to): ``lambda |time_s - target_s|``, the first-order term itself.
         """
         slow = [h for h in self._history if h.time_s >= target_s]
         fast = [h for h in self._history if h.time_s <= target_s]
