@@ -62,6 +62,9 @@ def test_four_objectives_offer_a_labelled_best_known_front():
     assert problem.encoding.name == front.attrs["encoding"] == "braking_onset"
     F = front.to_numpy()
     assert len(find_non_dominated(F)) == len(F)
+    # inside the planner's running-time window, as the -bi forms: no run more than 0.3 x the plan late
+    lo, hi = problem.time_window_s
+    assert F[:, 1].max() <= max(hi - problem.case.planned_time_s, problem.case.planned_time_s - lo) + 1e-9
     # every axis is live: the braking onset moves the stop point, so the stop error varies too
     assert np.all(F.max(axis=0) > F.min(axis=0))
     assert F[:, 3].max() <= problem.stop_tolerance_m
@@ -74,17 +77,16 @@ def test_nsga2_beats_random_sampling_against_the_certified_front():
     assert result.n_below_certificate == 0 and result.passed
 
 
-# measured (benchmarks/suite.py --sanity --seeds 5): on this single-objective form NSGA-II ends
-# 0.16 kWh above the optimum with seed 1 and random sampling 0.13 (NSGA-II wins on seeds 2, 3, 5)
-_RANDOM_WINS = {"ttobench-wanyuan-rongjing-single": "seed 1: NSGA-II 0.162 kWh above the optimum, random 0.129"}
+SWEEP_SEEDS = range(1, 6)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=_RANDOM_WINS[n], strict=True))
-                                  if n in _RANDOM_WINS else n for n in list_problems()])
-def test_every_problem_nsga2_beats_random_sampling(name):
-    """The done-when sweep: every suite problem, NSGA2(100, 200 generations) against random sampling."""
-    result = nsga2_against_random(name)
+@pytest.mark.parametrize("seed", SWEEP_SEEDS)
+@pytest.mark.parametrize("name", list_problems())
+def test_every_problem_nsga2_beats_random_sampling(name, seed):
+    """The done-when sweep: every suite problem and seeds 1-5, NSGA2(100, 200 generations) against random
+    sampling of the same budget (about 30 CPU minutes for the 105 cases, `benchmarks/suite.py --sanity --seeds 5`)."""
+    result = nsga2_against_random(name, seed=seed)
     assert np.isfinite(result.igd_nsga2) and result.igd_nsga2 < result.igd_random, result
     assert result.n_below_certificate == 0, result
 
