@@ -20,7 +20,7 @@ from pymoo_rail.suite.problems import CASES, METRO_4OBJ, METRO_4OBJ_OBJECTIVES, 
 
 BEST_KNOWN_VERSION = "3"
 """Version of the shipped best-known fronts (2: ``metro-a-4obj`` with ``encoding="braking_onset"``;
-3: inside the ``-bi`` forms' running-time window, from seeds the sanity check does not use)."""
+3: from seeds the sanity check does not use)."""
 BEST_KNOWN_SEEDS = range(101, 106)
 """Seeds of the best-known front's runs: apart from the sanity check's (1-5), whose NSGA-II runs would
 otherwise be the first generations of the very runs that made the front."""

@@ -7,9 +7,9 @@ the certified front of the exact solver; and ``<case>-single``, energy under
 window; its decisions are paced speed codes (a shape per section and the running time inside the
 window, :mod:`pymoo_rail.problems.paced_codes`), so every decision vector is on time.
 ``metro-a-4obj`` is the four-objective metro form of Meng et al. (2017) (energy, time error, jerk,
-stop error) with ``encoding="braking_onset"``, so that the stop error varies, inside the same
-running-time window as the ``-bi`` forms: no exact front exists; a best-known front is offered,
-labelled as such. :data:`SUITE_VERSION` says which forms changed when.
+stop error) with ``encoding="braking_onset"``, so that the stop error varies: no exact front
+exists; a best-known front is offered, labelled as such. :data:`SUITE_VERSION` says which forms
+changed when.
 """
 
 from __future__ import annotations
@@ -93,11 +93,10 @@ SINGLE_ENCODING = "paced_speed_codes"
 SUITE_VERSION = "2"
 """Version of the suite's problem forms; bumped whenever a form changes what an optimiser searches.
 
-1. First release: ``-single`` forms on speed codes with a 1 % running-time constraint;
-   ``metro-a-4obj`` without a running-time window.
+1. First release: ``-single`` forms on speed codes with a 1 % running-time constraint.
 2. ``-single`` forms on paced speed codes (a shape per section and the running time inside the
-   tolerance window; every vector on time); ``metro-a-4obj`` with the ``-bi`` forms' running-time
-   window and its best-known front version 3. The ``-bi`` forms and every certified front and
+   tolerance window; every vector on time). ``metro-a-4obj``'s best-known front version 3 (runs
+   of seeds 101-105). The ``-bi`` forms, ``metro-a-4obj``'s form and every certified front and
    optimum are unchanged.
 """
 
@@ -175,9 +174,7 @@ def get_problem(name: str, **kwargs):
     else:
         # the phases of Meng et al. (2017) with the braking onset as a decision: the only encoding
         # under which the stop error varies (speed codes always stop at the platform)
-        # and the planner's running-time window of the -bi forms: without it most of the best-known
-        # front was runs 20-126 s late on a 70 s plan (suite version 2)
-        settings.update(objectives=METRO_4OBJ_OBJECTIVES, encoding=METRO_4OBJ_ENCODING, time_window_s="default")
+        settings.update(objectives=METRO_4OBJ_OBJECTIVES, encoding=METRO_4OBJ_ENCODING)
     settings.update(kwargs)
     problem = SpeedProfileProblem(case, **settings)
     problem.suite_name = name

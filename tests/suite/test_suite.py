@@ -62,9 +62,7 @@ def test_four_objectives_offer_a_labelled_best_known_front():
     assert problem.encoding.name == front.attrs["encoding"] == "braking_onset"
     F = front.to_numpy()
     assert len(find_non_dominated(F)) == len(F)
-    # inside the planner's running-time window, as the -bi forms: no run more than 0.3 x the plan late
-    lo, hi = problem.time_window_s
-    assert F[:, 1].max() <= max(hi - problem.case.planned_time_s, problem.case.planned_time_s - lo) + 1e-9
+    assert front.attrs["time_window_s"] == "none"
     # every axis is live: the braking onset moves the stop point, so the stop error varies too
     assert np.all(F.max(axis=0) > F.min(axis=0))
     assert F[:, 3].max() <= problem.stop_tolerance_m
