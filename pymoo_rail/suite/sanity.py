@@ -4,8 +4,9 @@ A benchmark problem whose reference front is right lets a real optimiser get clo
 random sampling: for every suite problem, pymoo's IGD of NSGA-II (population 100, 200
 generations) against ``pareto_front()`` must be finite and smaller than the IGD of as many random
 decision vectors. ``metro-a-4obj`` has no exact front and is measured against its best-known front,
-in pymoo's normalised IGD (``IGD(pf, zero_to_one=True)``): its objectives mix kWh, s, m/s^2 and m
-over three orders of magnitude, and raw IGD is then the distance in time error alone.
+in pymoo's normalised IGD (``IGD(pf, zero_to_one=True)``: each objective scaled to [0, 1] by the
+front's ideal and nadir points): its objectives mix kWh, s, m/s^2 and m, and raw IGD is then the
+distance in time error and energy almost alone (``docs/suite.md``). Raw IGD is reported too.
 """
 
 from __future__ import annotations
