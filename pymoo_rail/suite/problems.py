@@ -156,6 +156,7 @@ def get_problem(name: str, **kwargs):
     Returns
     -------
     SpeedProfileProblem
+        With ``suite_name`` and ``suite_version`` (:data:`SUITE_VERSION`) set.
         ``problem.pareto_front()`` is the certified front (``-bi``), the certified optimum
         (``-single``); ``metro-a-4obj`` raises :class:`~pymoo_rail.problems.reference.NoExactFrontError`
         and :func:`pymoo_rail.suite.best_known_front` gives its best-known front.
@@ -178,4 +179,5 @@ def get_problem(name: str, **kwargs):
     settings.update(kwargs)
     problem = SpeedProfileProblem(case, **settings)
     problem.suite_name = name
+    problem.suite_version = SUITE_VERSION
     return problem

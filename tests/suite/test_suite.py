@@ -15,6 +15,11 @@ def test_names_in_pymoos_style():
     assert len(names) >= 12 and len(set(names)) == len(names)
     assert sum(n.endswith("-bi") for n in names) == sum(n.endswith("-single") for n in names) == len(CASES)
     assert "metro-a-4obj" in names
+    from pymoo_rail.suite import SUITE_VERSION
+
+    single = get_problem("metro-a-single")
+    assert single.suite_version == SUITE_VERSION == "2" and single.encoding.name == "paced_speed_codes"
+    assert get_problem("metro-a-bi").encoding.name == "speed_codes"
     with pytest.raises(ValueError, match="yizhuang-bi"):
         get_problem("zdt1")
 
