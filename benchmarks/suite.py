@@ -335,6 +335,9 @@ def main(argv=None) -> int:
     parser.add_argument("--sanity", action="store_true",
                         help="NSGA-II (100 x 200 generations) against random sampling on every suite problem "
                              "(seed 1, or seeds 1..--seeds), and stop")
+    parser.add_argument("--encoding", default=None,
+                        help="with --sanity: evaluate the problems under this encoding (e.g. speed_codes, the "
+                             "-single forms of suite version 1)")
     parser.add_argument("--trace", nargs="+", metavar=("PROBLEM", "ENCODING"), default=None,
                         help="NSGA-II's population on one problem (seed --seeds or 1) over the generations "
                              "(optionally under another encoding, e.g. speed_codes), and stop")
@@ -368,7 +371,8 @@ def main(argv=None) -> int:
         from pymoo_rail.suite.sanity import nsga2_against_random
 
         names = args.problems or list_problems()
-        rows = [{**asdict(nsga2_against_random(name, seed=seed)), "seed": seed}
+        kwargs = {"encoding": args.encoding} if args.encoding else {}
+        rows = [{**asdict(nsga2_against_random(name, seed=seed, **kwargs)), "seed": seed}
                 for name in tqdm(names, desc="sanity", unit="problem") for seed in range(1, (args.seeds or 1) + 1)]
         table = pd.DataFrame(rows)
         table["passed"] = (np.isfinite(table["igd_nsga2"]) & (table["igd_nsga2"] < table["igd_random"])

@@ -91,7 +91,8 @@ def _igd(pf: np.ndarray, F: np.ndarray, CV: np.ndarray) -> tuple[float, float, i
     return float(IGD(pf)(F)), normalised, n_feasible, len(F)
 
 
-def nsga2_against_random(name: str, pop_size: int = 100, n_gen: int = 200, seed: int = 1) -> SanityResult:
+def nsga2_against_random(name: str, pop_size: int = 100, n_gen: int = 200, seed: int = 1,
+                         **problem_kwargs) -> SanityResult:
     """Run NSGA-II and random sampling with the same budget on suite problem ``name``.
 
     Parameters
@@ -103,6 +104,9 @@ def nsga2_against_random(name: str, pop_size: int = 100, n_gen: int = 200, seed:
         uniformly inside the bounds.
     seed : int
         Seed of both (NSGA-II's ``minimize`` seed; the sampling's ``numpy`` generator).
+    **problem_kwargs
+        Passed to :func:`~pymoo_rail.suite.get_problem` (e.g. ``encoding="speed_codes"``, the
+        ``-single`` forms of suite version 1); the reference front is the problem's.
 
     Returns
     -------
@@ -113,7 +117,7 @@ def nsga2_against_random(name: str, pop_size: int = 100, n_gen: int = 200, seed:
     from pymoo.optimize import minimize
 
     start = time.process_time()
-    problem = get_problem(name)
+    problem = get_problem(name, **problem_kwargs)
     try:
         pf = problem.pareto_front()
         front = problem.certified_front()
