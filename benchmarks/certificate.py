@@ -63,7 +63,7 @@ def main() -> None:
     text = ["# The certificate's parts", "", "Written by `python benchmarks/certificate.py`: the default run (200 speed "
             "nodes, `tie_j` = 100 J) and its certificate with its parts, beside finer grids and the run without the "
             "tie rule, all moved to the default run's time along the front's slope. The certificate is the grid part "
-            "plus the largest of the other three.", "", markdown(table), ""]
+            "plus the floor plus the largest of the other three.", "", markdown(table), ""]
     REPORT.write_text("\n".join(text))
     print("\n".join(text))
 

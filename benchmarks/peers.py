@@ -41,14 +41,14 @@ CASES = [  # (case, running time s, ms-eetc track id or None)
     ("wuguang-crh3", 1050.0, None),
 ]
 GPOPS_II = {"intercity-var-limit-100": (440.14, 7.0)}  # published (ms-eetc paper, fig. 10): kWh, s
-# ms-eetc measured on this machine (2 cores shared by six jobs, load ~14) on 2026-11-24, casadi 3.8.2, in the
+# ms-eetc measured on this machine (2 cores shared by several jobs, load ~10) on 2026-11-24, casadi 3.8.2, in the
 # same run as pymoo-rail's committed figures: IPOPT process time of one solve (the best of 3);
 # ms-eetc's own "CPU time" is IPOPT's wall time.
 MSEETC_RECORDED = {
-    ("intercity-var-limit-100", 100): (448.6395, 0.89), ("intercity-var-limit-100", 300): (441.0839, 3.20),
-    ("intercity-var-limit-100", 1000): (440.3766, 11.96),
-    ("intercity-level-10km", 100): (88.5501, 0.75), ("intercity-level-10km", 300): (88.3277, 2.97),
-    ("intercity-level-10km", 1000): (88.2526, 11.28),
+    ("intercity-var-limit-100", 100): (448.6395, 1.09), ("intercity-var-limit-100", 300): (441.0839, 3.61),
+    ("intercity-var-limit-100", 1000): (440.3766, 12.41),
+    ("intercity-level-10km", 100): (88.5501, 0.88), ("intercity-level-10km", 300): (88.3277, 2.94),
+    ("intercity-level-10km", 1000): (88.2526, 12.42),
 }
 MSEETC_DATE = "2026-11-24"
 

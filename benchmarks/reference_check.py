@@ -1,9 +1,10 @@
 """Every optimiser result committed in ``benchmarks/reports`` against the exact optimum at its own time.
 
 For each front member the project's studies committed (their CSVs in ``benchmarks/reports``), the
-exact solver (``pymoo_rail.optimal.solved_energy_gap``, default grid, the lower of its two
-speed-node placements) solves the optimum at the member's own running time and gives its
-certificate ``energy_bound_kwh``. A member that lies below the optimum by more than the
+exact solver (``pymoo_rail.optimal.solved_energy_gap``, default grid) solves the optimum at the
+member's own running time and gives its certificate ``energy_bound_kwh``
+(``benchmarks/certificate_coverage.py`` checks that certificate against other grids at the same
+times). A member that lies below the optimum by more than the
 certificate is a defect of the reference; the script counts them (and exits with status 1 if
 there is one) and writes the exact gaps the study reports quote.
 
@@ -88,8 +89,7 @@ def check(table: pd.DataFrame) -> pd.DataFrame:
     for name, group in tqdm(list(table.groupby("case", sort=False)), desc="cases", unit="case"):
         ref = ReferenceAtTime(cases[name])
         gap = solved_energy_gap(group[["running_time_s", "energy_kwh"]], ref)["points"]
-        cols = ["optimal_kwh", "gap_kwh", "gap_rel", "energy_bound_kwh", "below_reference", "in_range",
-                "first_kwh", "first_bound_kwh"]
+        cols = ["optimal_kwh", "gap_kwh", "gap_rel", "energy_bound_kwh", "below_reference", "in_range"]
         parts.append(pd.concat([group.reset_index(drop=True), gap[cols].reset_index(drop=True)], axis=1))
     return pd.concat(parts, ignore_index=True)
 
@@ -113,23 +113,6 @@ def summary(table: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def placement_lines(table: pd.DataFrame) -> list[str]:
-    """What the second speed-node placement changed: lower runs, and the first placement's misses."""
-    if "first_kwh" not in table:
-        return []
-    t = table[table["in_range"]]
-    lower = t["first_kwh"] - t["optimal_kwh"]  # > 0: the uniform placement found the lower run
-    rel = lower / t["first_kwh"]
-    missed = lower - t["first_bound_kwh"]  # > 0: the first placement's certificate did not cover it
-    worst, worst_rel, worst_missed = lower.idxmax(), rel.idxmax(), missed.idxmax()
-    return [f"The uniform speed-node placement was lower than the packed one (`top_bias` default) for "
-            f"{int((lower > 1e-9).sum())} of {len(t)} members, by up to {lower[worst]:.4f} kWh ({t.at[worst, 'case']}"
-            f" at {t.at[worst, 'running_time_s']:.2f} s) and {100 * rel[worst_rel]:.2f} % ({t.at[worst_rel, 'case']}"
-            f" at {t.at[worst_rel, 'running_time_s']:.2f} s). The packed placement's own certificate did not cover "
-            f"the uniform run at {int((missed > 1e-9).sum())} members, by up to {1000 * missed[worst_missed]:.1f} Wh "
-            f"({t.at[worst_missed, 'case']} at {t.at[worst_missed, 'running_time_s']:.2f} s)."]
-
-
 def write_report(table: pd.DataFrame, out: Path) -> int:
     """Write and print ``reference_check.md``; returns how many members lie below the reference."""
     s = summary(table)
@@ -137,12 +120,11 @@ def write_report(table: pd.DataFrame, out: Path) -> int:
     lines = ["# Committed optimiser results against the exact optimum at their own running time", "",
              "Written by `python benchmarks/reference_check.py` (it reads the study CSVs of `benchmarks/reports`, "
              "see its docstring for which members). Each member is compared with the optimum solved at its own "
-             "running time (`pymoo_rail.optimal.solved_energy_gap`, default grid; the lower of the two speed-node "
-             "placements it solves, packed towards the envelope and uniform in v^2) and with that solve's certificate "
+             "running time (`pymoo_rail.optimal.solved_energy_gap`, default grid) and with that solve's certificate "
              "`energy_bound_kwh`. *margin* = gap + certificate: a negative margin is a member below the optimum by "
              "more than the certificate, a defect of the reference.", "",
              f"Members in range: {int(table['in_range'].sum())} of {len(table)}; below the reference beyond the "
-             f"certificate: **{n_below}**.", "", *placement_lines(table), "", markdown(s), ""]
+             f"certificate: **{n_below}**.", "", markdown(s), ""]
     (out / "reference_check.md").write_text("\n".join(lines))
     print("\n".join(lines))
     return n_below

@@ -36,7 +36,7 @@ from pymoo_rail.sim.kernel import (
     clamp_to_envelope,
     complete_cell,
     new_totals,
-    record_cell,
+    close_cell,
     run_program,
     trace_arrays,
     write_summary,
@@ -289,15 +289,12 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
 
         # 3. the rest of the cell exactly as the simulator does it
         v, stopped, x1, a_cell, totals = complete_cell(m, totals, i, v, u1, f, w0, regime)
-        if record:
-            record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[TOTAL_TIME], a_cell, f, regime)
         t = totals[TOTAL_TIME]
+        count, reached, stop_pos = close_cell(record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, t, a_cell, f,
+                                              regime, stopped, reached, stop_pos)
         if record:
             tr_u[i] = u_act
-        count = i + 2
         if stopped:
-            reached = False
-            stop_pos = x1
             break
     write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r)
     if record:

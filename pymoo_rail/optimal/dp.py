@@ -191,6 +191,21 @@ def interp_value(v_next, top_u, u, bias):
     return interp_at(v_next, value_position(top_u, u, v_next.shape[0] - 1, bias))
 
 
+@inlined
+def control_cost(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, time_price_w,
+                 v_next, top_u, bias):
+    """Cell cost plus interpolated cost-to-go of one control from ``v0`` (:func:`cell_outcome`, :func:`cell_cost`).
+
+    Infinite when the train stops inside the cell; the cost-to-go ``v_next`` is spread over
+    ``[0, top_u]`` (:func:`interp_value`).
+    """
+    u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+    cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
+    if cost < INF:
+        cost += interp_value(v_next, top_u, u1, bias)
+    return cost
+
+
 # traction, coast, brake, hold. Holding is ``hold_brake``: where coasting decelerates it is ``hold``
 # (partial traction), and where coasting accelerates ``hold`` would only coast, which the coast
 # control already is, while ``hold_brake`` holds the speed by partial (regenerative-first) braking.
@@ -253,10 +268,8 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
     n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
     for c in range(n_fixed):
         mode = _fixed_mode(c)
-        u1, f, w0 = cell_outcome(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
-        if cost < INF:
-            cost += interp_value(v_next, top_u, u1, bias)
+        cost = control_cost(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
+                            time_price_w, v_next, top_u, bias)
         if cost < best:
             best = cost
             best_mode = mode
@@ -267,11 +280,8 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
         stride = _n_targets(k_lo, k_hi, max_targets)[1]
         for k in range(k_lo, k_hi + 1, stride):
             target = math.sqrt(node_u(top_u, k, k_max, bias))
-            u1, f, w0 = cell_outcome(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                     br_u, br_f, br_w)
-            cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
-            if cost < INF:
-                cost += interp_value(v_next, top_u, u1, bias)
+            cost = control_cost(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+                                br_u, br_f, br_w, time_price_w, v_next, top_u, bias)
             if cost < best:
                 best = cost
                 best_mode = MODE_TOWARD
@@ -424,13 +434,11 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         if i > 0 and mode != previous and tie_j > 0.0:
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
-                u1, f, w0 = cell_outcome(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-                c_keep, _ = cell_cost(m, v, u1, f, w0, i, time_price_w[i])
-                if c_keep < INF:
-                    c_keep += interp_value(value[i + 1], m.envelope_ms[i + 1] ** 2, u1, bias)
-                    if c_keep <= cost + tie_j:
-                        tie_cost += c_keep - cost
-                        mode, target = keep, 0.0
+                c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
+                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias)
+                if c_keep < INF and c_keep <= cost + tie_j:
+                    tie_cost += c_keep - cost
+                    mode, target = keep, 0.0
         u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
         c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
         energy += c_energy

@@ -5,11 +5,8 @@ Interpolating a reference front linearly between its points overstates the optim
 is steep. Here each point's running time gets its own DP solve (one solver per case, so the
 transition tables are built once, and a cache by running time), with the solve's certificate.
 
-Two speed-node placements are solved and the lower energy kept: the default one, packed towards the
-braking envelope (fine where runs hold speed limits), and the uniform one in ``v^2`` (finer at low
-speed, where runs on steep short sections spend their time). Both are simulator runs that take the
-requested time, so the lower is the closer upper bound on the optimum; it comes with its own
-certificate (measured on Yizhuang section 1-2: ``benchmarks/reference_check.py``).
+The solve's run lands within the solver's time tolerance of the request (or, across a jump of the
+discrete optimum, up to 0.5 s off it); its energy is moved to the request along the front's slope.
 """
 
 from __future__ import annotations
@@ -24,10 +21,6 @@ from pymoo_rail.indicators.energy import ENERGY_COLUMN, TIME_COLUMN, as_front, g
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.optimal.solver import OptimalSolver
 
-# the second speed-node placement solved beside the default one (``OptimalSolver``'s ``top_bias``)
-UNIFORM_TOP_BIAS = 0.0
-
-
 class ReferenceAtTime:
     """The optimum of one case at any running time, solved on demand and cached.
 
@@ -36,53 +29,41 @@ class ReferenceAtTime:
     case : Case
     decimals : int
         Running times are cached rounded to this many decimals of a second.
-    uniform_too : bool
-        Also solve with the speed nodes uniform in ``v^2`` (``top_bias = 0``) and keep the lower
-        energy (default; no effect when ``top_bias`` is already 0). Costs a second solve per time.
     **settings
         Settings of :class:`~pymoo_rail.optimal.OptimalSolver`.
     """
 
-    def __init__(self, case: Case, decimals: int = 3, uniform_too: bool = True, **settings):
+    def __init__(self, case: Case, decimals: int = 3, **settings):
         self.solver = OptimalSolver(case, **settings)
-        self.solvers = [self.solver]
-        if uniform_too and self.solver.top_bias != UNIFORM_TOP_BIAS:
-            self.solvers.append(OptimalSolver(case, **{**settings, "top_bias": UNIFORM_TOP_BIAS}))
         self.decimals = int(decimals)
         self._cache: dict[float, dict] = {}
-        self._last_lambda_w: list[float | None] = [None] * len(self.solvers)
+        self._last_lambda_w: float | None = None
 
     def at(self, running_time_s: float) -> dict:
         """``optimal_kwh`` at exactly ``running_time_s``, its ``energy_bound_kwh``, ``lambda_kwh_per_s``.
 
-        The DP's run lands within the solver's time tolerance of the request; its energy is moved to
-        the request along the front's slope (``lambda``), and the bound grows by the second-order
-        remainder of that move, bounded by ``lambda x |time difference|``. With ``uniform_too``, the
-        lower of the two placements' answers, with that answer's own bound; ``first_kwh`` and
-        ``first_bound_kwh`` are the first placement's (``top_bias`` of the settings) alone. NaNs
-        below the minimum running time.
+        The DP's run is moved to the request along the front's slope ``lambda`` (the supporting
+        line there), and the bound grows by the chord above that line
+        (:meth:`OptimalSolver.move_remainder_j`, also given alone as ``move_remainder_kwh``: the
+        optimum lies between ``optimal_kwh`` and ``optimal_kwh + move_remainder_kwh`` on the solver's
+        grid). NaNs below the minimum running time.
         """
         key = round(float(running_time_s), self.decimals)
         if key in self._cache:
             return self._cache[key]
-        out = {"optimal_kwh": math.nan, "energy_bound_kwh": math.nan, "lambda_kwh_per_s": math.nan}
-        first = (math.nan, math.nan)
-        for k, solver in enumerate(self.solvers):
-            try:
-                tr = solver.profile(key, lambda_guess_w=self._last_lambda_w[k])
-            except InfeasibleCaseError:
-                continue
-            lam = tr.summary["lambda_w"]
-            self._last_lambda_w[k] = lam
-            shift_kwh = lam * (tr.running_time_s - key) / J_PER_KWH
-            bound = tr.summary.get("energy_bound_kwh", math.nan)
-            energy_kwh = tr.energy.net_kwh + shift_kwh
-            if k == 0:
-                first = (energy_kwh, bound + abs(shift_kwh))
-            if not energy_kwh >= out["optimal_kwh"]:  # also replaces the NaN of no answer yet
-                out = {"optimal_kwh": energy_kwh, "energy_bound_kwh": bound + abs(shift_kwh),
-                       "lambda_kwh_per_s": lam / J_PER_KWH}
-        out = {**out, "first_kwh": first[0], "first_bound_kwh": first[1]}
+        out = {"optimal_kwh": math.nan, "energy_bound_kwh": math.nan, "lambda_kwh_per_s": math.nan,
+               "move_remainder_kwh": math.nan}
+        try:
+            tr = self.solver.profile(key, lambda_guess_w=self._last_lambda_w)
+        except InfeasibleCaseError:
+            self._cache[key] = out
+            return out
+        lam = tr.summary["lambda_w"]
+        self._last_lambda_w = lam
+        remainder_kwh = self.solver.move_remainder_j(tr.running_time_s, lam, key) / J_PER_KWH
+        out = {"optimal_kwh": tr.energy.net_kwh + lam * (tr.running_time_s - key) / J_PER_KWH,
+               "energy_bound_kwh": tr.summary.get("energy_bound_kwh", math.nan) + remainder_kwh,
+               "lambda_kwh_per_s": lam / J_PER_KWH, "move_remainder_kwh": remainder_kwh}
         self._cache[key] = out
         return out
 
@@ -125,8 +106,7 @@ def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> d
         ``points``: DataFrame with ``running_time_s``, ``energy_kwh``, ``optimal_kwh``, ``gap_kwh``,
         ``gap_rel``, ``energy_bound_kwh`` (the reference's certificate), ``below_reference`` (the
         point lies below the optimum by more than the certificate: a defect of the reference) and
-        ``in_range`` (False below the minimum running time), ``first_kwh`` and ``first_bound_kwh``
-        (the first speed-node placement alone, see :meth:`ReferenceAtTime.at`); ``mean_gap_rel``, ``max_gap_rel``,
+        ``in_range`` (False below the minimum running time); ``mean_gap_rel``, ``max_gap_rel``,
         ``min_gap_rel`` over the points in range, ``n_out_of_range`` and ``n_below_reference``.
     """
     ref = reference if isinstance(reference, ReferenceAtTime) else ReferenceAtTime(reference, **settings)
@@ -136,8 +116,6 @@ def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> d
     for k in order:
         rows[k] = ref.at(points[k, 0])
     t, e = points[:, 0], points[:, 1]
-    first = np.array([r["first_kwh"] for r in rows])
-    first_bound = np.array([r["first_bound_kwh"] for r in rows])
     optimal = np.array([r["optimal_kwh"] for r in rows])
     bound = np.array([r["energy_bound_kwh"] for r in rows])
     gap = e - optimal
@@ -145,6 +123,5 @@ def solved_energy_gap(front, reference: Case | ReferenceAtTime, **settings) -> d
     gaps = gap_columns(gap, optimal, bound, in_range)
     table = pd.DataFrame({TIME_COLUMN: t, ENERGY_COLUMN: e, "optimal_kwh": optimal, "gap_kwh": gap,
                           "gap_rel": gaps["gap_rel"], "energy_bound_kwh": bound,
-                          "below_reference": gaps["below_reference"], "in_range": in_range,
-                          "first_kwh": first, "first_bound_kwh": first_bound})
+                          "below_reference": gaps["below_reference"], "in_range": in_range})
     return {**gap_summary(table), "n_below_reference": int(table["below_reference"].sum())}

@@ -290,14 +290,23 @@ def trace_cell_energies(m, x, v, f):
 
 
 @inlined
-def record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime):
-    """Write one cell into the trace arrays."""
-    tr_x[cell + 1] = x1
-    tr_v[cell + 1] = v1
-    tr_t[cell + 1] = t
-    tr_a[cell] = a_cell
-    tr_f[cell] = f
-    tr_r[cell] = regime
+def close_cell(record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, cell, x1, v1, t, a_cell, f, regime, stopped, reached,
+               stop_pos):
+    """The run loop's bookkeeping after a cell: its trace node (if ``record``), the node count and
+    where the train came to rest if it ``stopped`` in the cell.
+
+    Returns ``(count, reached, stop_pos)``; the caller leaves its loop when ``stopped``.
+    """
+    if record:
+        tr_x[cell + 1] = x1
+        tr_v[cell + 1] = v1
+        tr_t[cell + 1] = t
+        tr_a[cell] = a_cell
+        tr_f[cell] = f
+        tr_r[cell] = regime
+    if stopped:
+        return cell + 2, False, x1
+    return cell + 2, reached, stop_pos
 
 
 @inlined
@@ -425,15 +434,22 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     for i in range(n - 1):
         v, row, hold_speed, stopped, x1, a_cell, f, regime, totals = drive_cell(
             m, program, totals, i, v, row, hold_speed)
-        if record:
-            record_cell(tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v, totals[TOTAL_TIME], a_cell, f, regime)
-        count = i + 2
+        count, reached, stop_pos = close_cell(record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, i, x1, v,
+                                              totals[TOTAL_TIME], a_cell, f, regime, stopped, reached, stop_pos)
         if stopped:
-            reached = False
-            stop_pos = x1
             break
     write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r)
     return count
+
+
+@inlined
+def advance_run(m, program, totals, i, v, row, hold_speed, moving, stop_pos):
+    """One cell of a run without traces, or nothing once the run has stopped (``moving`` False)."""
+    if moving:
+        v, row, hold_speed, stopped, x1, _, _, _, totals = drive_cell(m, program, totals, i, v, row, hold_speed)
+        if stopped:
+            return v, row, hold_speed, False, x1, totals
+    return v, row, hold_speed, moving, stop_pos, totals
 
 
 # Two runs advanced cell by cell in one loop. A single run is a chain of dependent operations
@@ -460,18 +476,10 @@ def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
     stop_a = m.position_m[n - 1]
     stop_b = m.position_m[n - 1]
     for i in range(n - 1):
-        if moving_a:
-            v_a, row_a, hold_a, stopped, x1, _, _, _, totals_a = drive_cell(
-                m, program_a, totals_a, i, v_a, row_a, hold_a)
-            if stopped:
-                moving_a = False
-                stop_a = x1
-        if moving_b:
-            v_b, row_b, hold_b, stopped, x1, _, _, _, totals_b = drive_cell(
-                m, program_b, totals_b, i, v_b, row_b, hold_b)
-            if stopped:
-                moving_b = False
-                stop_b = x1
+        v_a, row_a, hold_a, moving_a, stop_a, totals_a = advance_run(
+            m, program_a, totals_a, i, v_a, row_a, hold_a, moving_a, stop_a)
+        v_b, row_b, hold_b, moving_b, stop_b, totals_b = advance_run(
+            m, program_b, totals_b, i, v_b, row_b, hold_b, moving_b, stop_b)
         if not (moving_a or moving_b):
             break
     no_count = n - n  # no trace nodes; a run-time 0: one compiled write_summary for every caller
