@@ -84,7 +84,7 @@ SWEEP_SEEDS = range(1, 6)
 # measured (benchmarks/suite.py --sanity --seeds 5, front version 5): NSGA-II ends 0.0045 kWh *below* the
 # certified optimum -2.7145 kWh, a chord between the nodes at 145.65 and 147.77 s (certificate 0.0118 kWh);
 # the exact solver alone at 146.45 s gives -2.7191 kWh (bound 0.0016), NSGA-II's run; random sampling ends
-# 0.0001-0.0035 kWh above the chord, so its distance to the chord is smaller though its runs are worse
+# 0.0027 kWh below to 0.0035 kWh above the chord: nearer to it, though dearer than NSGA-II on every seed
 _CHORD_ABOVE_OPTIMUM = {"ttobench-xiaohongmen-jiugong-single": "the optimum is a chord 0.0046 kWh above the "
                         "solver's run at its time; NSGA-II reaches the run, below the chord"}
 
@@ -105,6 +105,19 @@ def test_every_problem_nsga2_beats_random_sampling(name, seed):
     result = nsga2_against_random(name, seed=seed)
     assert np.isfinite(result.igd_nsga2) and result.igd_nsga2 < result.igd_random, result
     assert result.n_below_certificate == 0, result
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", SWEEP_SEEDS)
+@pytest.mark.parametrize("name", sorted(_CHORD_ABOVE_OPTIMUM))
+def test_below_the_chord_nsga2_finds_the_cheaper_run(name, seed):
+    """Where the optimum is a chord above the front, NSGA-II's best run is cheaper than random sampling's,
+    and below the chord by no more than the certificate allows."""
+    result = nsga2_against_random(name, seed=seed)
+    problem = get_problem(name)
+    _, bound, _ = ref.constrained_optimum(problem.certified_front(), problem.time_tolerance_s)
+    assert result.gap_nsga2_kwh < result.gap_random_kwh, result
+    assert -bound <= result.gap_nsga2_kwh < 0.0, result
 
 
 def test_study_registry_builds_suite_problems():
