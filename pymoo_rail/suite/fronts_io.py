@@ -136,7 +136,9 @@ def compute_best_known_front(name: str = METRO_4OBJ, seeds=BEST_KNOWN_SEEDS, pop
     """Non-dominated union of NSGA-III and NSGA-II runs (feasible members) on a many-objective problem.
 
     Each seed runs both algorithms (pymoo's, default operators) for ``n_gen`` generations.
-    ``write=True`` stores the result as the shipped best-known front.
+    ``write=True`` stores the result as the shipped best-known front. Not repeatable bit for bit:
+    pymoo 0.6.2's NSGA-III gives another population from the same seed on each run (measured:
+    three runs of seed 101 in one process), so the shipped file, not a recomputation, is the reference.
     """
     from pymoo.algorithms.moo.nsga2 import NSGA2
     from pymoo.algorithms.moo.nsga3 import NSGA3
