@@ -18,6 +18,7 @@ Usage::
     python benchmarks/suite.py --costs                              # CPU per run; the study's budget
     python benchmarks/suite.py --best-known                         # recompute metro-a-4obj's front
     python benchmarks/suite.py --sanity                             # NSGA-II vs random, every problem
+    python benchmarks/suite.py --trace PROBLEM [ENCODING] --seeds S # NSGA-II's population over the run
     python benchmarks/suite.py --ship-fronts                        # recompute the shipped fronts
 
 Records go to ``--work`` (default ``out/suite``, not committed); an interrupted study resumes.
@@ -334,6 +335,12 @@ def main(argv=None) -> int:
     parser.add_argument("--sanity", action="store_true",
                         help="NSGA-II (100 x 200 generations) against random sampling on every suite problem "
                              "(seed 1, or seeds 1..--seeds), and stop")
+    parser.add_argument("--encoding", default=None,
+                        help="with --sanity: evaluate the problems under this encoding (e.g. speed_codes, the "
+                             "-single forms of suite version 1)")
+    parser.add_argument("--trace", nargs="+", metavar=("PROBLEM", "ENCODING"), default=None,
+                        help="NSGA-II's population on one problem (seed --seeds or 1) over the generations "
+                             "(optionally under another encoding, e.g. speed_codes), and stop")
     parser.add_argument("--ship-fronts", nargs="*", metavar="CASE", default=None,
                         help="recompute the shipped certified fronts (all suite cases, or those named), and stop")
     args = parser.parse_args(argv)
@@ -347,6 +354,13 @@ def main(argv=None) -> int:
             print(path.name)
         print(f"{time.process_time() - start:.0f} s CPU")
         return 0
+    if args.trace:
+        from pymoo_rail.experiments.stats import to_markdown
+        from pymoo_rail.suite.sanity import nsga2_trace
+
+        kwargs = {"encoding": args.trace[1]} if len(args.trace) > 1 else {}
+        print(to_markdown(pd.DataFrame(nsga2_trace(args.trace[0], seed=args.seeds or 1, **kwargs)).round(4)))
+        return 0
     if args.sanity:
         from dataclasses import asdict
 
@@ -357,7 +371,8 @@ def main(argv=None) -> int:
         from pymoo_rail.suite.sanity import nsga2_against_random
 
         names = args.problems or list_problems()
-        rows = [{**asdict(nsga2_against_random(name, seed=seed)), "seed": seed}
+        kwargs = {"encoding": args.encoding} if args.encoding else {}
+        rows = [{**asdict(nsga2_against_random(name, seed=seed, **kwargs)), "seed": seed}
                 for name in tqdm(names, desc="sanity", unit="problem") for seed in range(1, (args.seeds or 1) + 1)]
         table = pd.DataFrame(rows)
         table["passed"] = (np.isfinite(table["igd_nsga2"]) & (table["igd_nsga2"] < table["igd_random"])

@@ -336,4 +336,5 @@ class BrakingOnset:
         return replace(tr, stop_error_m=error, summary={**tr.summary, "stop_error_m": error})
 
 
-ENCODINGS = ("speed_codes", "switching_points", "braking_onset")
+ENCODINGS = ("speed_codes", "switching_points", "braking_onset", "paced_speed_codes")
+"""Encoding names of ``SpeedProfileProblem`` (``paced_speed_codes``: :mod:`pymoo_rail.problems.paced_codes`)."""

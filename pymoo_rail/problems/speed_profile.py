@@ -11,6 +11,7 @@ from pymoo.core.problem import Problem
 from pymoo_rail.constants import OBJECTIVES
 from pymoo_rail.model import Case
 from pymoo_rail.problems.encodings import ENCODINGS, BrakingOnset, SpeedCodes, SwitchingPoints
+from pymoo_rail.problems.paced_codes import PacedCodes
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 
@@ -145,11 +146,14 @@ class SpeedProfileProblem(Problem):
         ``"stop_error"`` (m, Meng et al. (2017) eq. 6). Several give the Pareto form; one with
         ``time_tolerance_s`` gives the constrained form of Liu (2019) 4.4; ``weights`` give the
         weighted sum of Meng et al. (2017) eq. 9.
-    encoding : {"speed_codes", "switching_points", "braking_onset"}
+    encoding : {"speed_codes", "switching_points", "braking_onset", "paced_speed_codes"}
         Speed codes per section (km/h), regime switching positions (m), or the phases of
         Meng et al. (2017) with the braking onset (m) and deceleration (m/s^2) as decisions (the
         only one where the stop error varies without ``tracking``); see
-        :mod:`pymoo_rail.problems.encodings`. An objective that cannot vary under the chosen
+        :mod:`pymoo_rail.problems.encodings`; ``"paced_speed_codes"``: a speed-code shape per
+        section and the running time (s), each shape paced to its time, so every vector is on time
+        (needs ``time_tolerance_s`` or ``time_window_s``; :mod:`pymoo_rail.problems.paced_codes`).
+        An objective that cannot vary under the chosen
         encoding (the stop error of speed codes) triggers a ``ConstantObjectiveWarning``.
     partition : {"gradient_limit", "equal"}
         Sections of the speed-code encoding (Liu (2019) figs. 4-4 and 4-3).
@@ -232,6 +236,13 @@ class SpeedProfileProblem(Problem):
                                  "curve that ends at the platform; use speed_codes or switching_points")
             self.encoding = BrakingOnset.build(case, tuple(regimes) if regimes is not None else None,
                                                decel_range_ms2, dx_m=dx_m)
+        elif encoding == "paced_speed_codes":
+            if tracking is not None or integer_codes:
+                raise ValueError("encoding = 'paced_speed_codes' with tracking or integer_codes: the pace solve "
+                                 "moves every code together to meet a running time; use speed_codes")
+            # the sections of speed codes; the encoding itself needs the simulator and window (below)
+            sections = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh).boundaries_m
+            self.encoding = None
         else:
             raise ValueError(f"encoding = {encoding!r} is unknown (known: {', '.join(ENCODINGS)})")
         if time_tolerance_s is not None and not (np.isfinite(time_tolerance_s) and time_tolerance_s > 0):
@@ -254,6 +265,8 @@ class SpeedProfileProblem(Problem):
             self.simulator.check_planned_time()  # raises, naming planned_time_s, when impossible
         self.min_running_time_s = fastest.running_time_s
         self.time_window_s = self._check_window(time_window_s, case)
+        if self.encoding is None:
+            self.encoding = PacedCodes.build(case, self.simulator, sections, self._pacing_window(time_tolerance_s))
         if tracking is None:
             warn_constant_objectives(objectives, self.encoding)
 
@@ -276,6 +289,8 @@ class SpeedProfileProblem(Problem):
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != self.n_var:
             raise ValueError(f"decision vectors have {X.shape[1]} values: this problem has n_var = {self.n_var}")
+        if isinstance(self.encoding, PacedCodes):  # the pace solve has run every program already
+            return self.encoding.paced(np.ascontiguousarray(X)).summaries
         programs = self.encoding.programs(np.ascontiguousarray(X))
         if self.tracker is not None:
             return self.tracker.run_batch(programs)
@@ -314,6 +329,18 @@ class SpeedProfileProblem(Problem):
         out["energy_kwh"] = s[:, k.OUT_NET_KWH]
         out["running_time_s"] = s[:, k.OUT_RUNNING_TIME_S]
         out["stop_error_m"] = s[:, k.OUT_STOP_ERROR_M]
+
+    def _pacing_window(self, time_tolerance_s: float | None) -> tuple[float, float]:
+        """Running times paced speed codes may choose: the tolerance window, inside the time window."""
+        lo, hi = -np.inf, np.inf
+        if time_tolerance_s is not None:
+            lo, hi = self.case.planned_time_s - time_tolerance_s, self.case.planned_time_s + time_tolerance_s
+        if self.time_window_s is not None:
+            lo, hi = max(lo, self.time_window_s[0]), min(hi, self.time_window_s[1])
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise ValueError("encoding = 'paced_speed_codes' needs time_tolerance_s or time_window_s: "
+                             "the running times its runs are paced to")
+        return lo, hi
 
     def _check_window(self, window, case: Case):
         if window is None:

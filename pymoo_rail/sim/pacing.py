@@ -256,7 +256,7 @@ def _times(simulator: Simulator, encoding: PacedSpeedCodes, shapes: np.ndarray, 
 
 
 def solve_pace(simulator: Simulator, encoding: PacedSpeedCodes, shapes: np.ndarray,
-               time_tol_s: float = DEFAULT_TIME_TOL_S) -> PacedRuns:
+               time_tol_s: float = DEFAULT_TIME_TOL_S, target_s: np.ndarray | float | None = None) -> PacedRuns:
     """The pace at which each shape runs in ``encoding.planned_time_s`` (a population at once).
 
     Parameters
@@ -270,6 +270,8 @@ def solve_pace(simulator: Simulator, encoding: PacedSpeedCodes, shapes: np.ndarr
         The encoding's genes (speed-code shapes in [0, 1]).
     time_tol_s : float
         Stop once every run is this close to the plan (or its pace bracket has shrunk to 1e-9).
+    target_s : float or (N,) array, optional
+        Running time of each run (s), instead of ``encoding.planned_time_s``.
 
     Returns
     -------
@@ -280,7 +282,7 @@ def solve_pace(simulator: Simulator, encoding: PacedSpeedCodes, shapes: np.ndarr
     """
     shapes = np.atleast_2d(np.asarray(shapes, dtype=float))
     n = shapes.shape[0]
-    target = encoding.planned_time_s
+    target = np.broadcast_to(np.asarray(encoding.planned_time_s if target_s is None else target_s, dtype=float), (n,))
     pace_min, pace_max = encoding.pace_bounds
     lo = np.full(n, pace_min)  # slow side: time >= target
     hi = np.full(n, pace_max)  # fast side: time <= target
@@ -303,7 +305,7 @@ def solve_pace(simulator: Simulator, encoding: PacedSpeedCodes, shapes: np.ndarr
         mid = 0.5 * (a + b)
         trial = np.where(finite & (secant > a) & (secant < b), secant, mid)
         t, o = _times(simulator, encoding, shapes[idx], trial)
-        f = t - target
+        f = t - target[idx]
         err = np.abs(f)
         better = err < best_err[idx]
         pace[idx[better]] = trial[better]

@@ -9,7 +9,15 @@ See ``docs/suite.md`` for the problems, how their fronts were computed and how e
 
 from pymoo_rail.problems.reference import CertifiedFront, NoExactFrontError
 from pymoo_rail.suite.fronts_io import best_known_front, compute_best_known_front, verify
-from pymoo_rail.suite.problems import CASES, SuiteCase, get_problem, list_problems, suite_case, tolerance_s
+from pymoo_rail.suite.problems import (
+    CASES,
+    SUITE_VERSION,
+    SuiteCase,
+    get_problem,
+    list_problems,
+    suite_case,
+    tolerance_s,
+)
 
-__all__ = ["get_problem", "list_problems", "suite_case", "tolerance_s", "CASES", "SuiteCase", "verify",
-           "best_known_front", "compute_best_known_front", "CertifiedFront", "NoExactFrontError"]
+__all__ = ["get_problem", "list_problems", "suite_case", "tolerance_s", "CASES", "SUITE_VERSION", "SuiteCase",
+           "verify", "best_known_front", "compute_best_known_front", "CertifiedFront", "NoExactFrontError"]

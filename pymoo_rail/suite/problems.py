@@ -4,9 +4,12 @@ Every case gives two problems: ``<case>-bi``, energy and running time inside the
 running-time window (:func:`pymoo_rail.problems.reference.default_window`), whose Pareto front is
 the certified front of the exact solver; and ``<case>-single``, energy under
 ``|T - T_plan| <= 1 % of T_plan`` (at least 1 s), whose optimum is the front's least energy in that
-window. ``metro-a-4obj`` is the four-objective metro form of Meng et al. (2017) (energy, time
-error, jerk, stop error) with ``encoding="braking_onset"``, so that the stop error varies: no exact
-front exists; a best-known front is offered, labelled as such.
+window; its decisions are paced speed codes (a shape per section and the running time inside the
+window, :mod:`pymoo_rail.problems.paced_codes`), so every decision vector is on time.
+``metro-a-4obj`` is the four-objective metro form of Meng et al. (2017) (energy, time error, jerk,
+stop error) with ``encoding="braking_onset"``, so that the stop error varies: no exact front
+exists; a best-known front is offered, labelled as such. :data:`SUITE_VERSION` says which forms
+changed when.
 """
 
 from __future__ import annotations
@@ -85,6 +88,18 @@ CASES: tuple[SuiteCase, ...] = (
               builtin="ttobench-ref-limit120"),
 )
 
+SINGLE_ENCODING = "paced_speed_codes"
+"""Encoding of the ``-single`` forms (:mod:`pymoo_rail.problems.paced_codes`)."""
+SUITE_VERSION = "2"
+"""Version of the suite's problem forms; bumped whenever a form changes what an optimiser searches.
+
+1. First release: ``-single`` forms on speed codes with a 1 % running-time constraint.
+2. ``-single`` forms on paced speed codes (a shape per section and the running time inside the
+   tolerance window; every vector on time). ``metro-a-4obj``'s best-known front version 3 (runs
+   of seeds 101-105). The ``-bi`` forms, ``metro-a-4obj``'s form and every certified front and
+   optimum are unchanged.
+"""
+
 METRO_4OBJ = "metro-a-4obj"
 METRO_4OBJ_OBJECTIVES = ("energy", "time_error", "jerk", "stop_error")
 METRO_4OBJ_ENCODING = "braking_onset"
@@ -141,6 +156,7 @@ def get_problem(name: str, **kwargs):
     Returns
     -------
     SpeedProfileProblem
+        With ``suite_name`` and ``suite_version`` (:data:`SUITE_VERSION`) set.
         ``problem.pareto_front()`` is the certified front (``-bi``), the certified optimum
         (``-single``); ``metro-a-4obj`` raises :class:`~pymoo_rail.problems.reference.NoExactFrontError`
         and :func:`pymoo_rail.suite.best_known_front` gives its best-known front.
@@ -154,7 +170,8 @@ def get_problem(name: str, **kwargs):
     if form == "bi":
         settings.update(objectives=("energy", "running_time"), time_window_s="default")
     elif form == "single":
-        settings.update(objectives=("energy",), time_tolerance_s=tolerance_s(case))
+        # paced: the running time is a decision inside the tolerance window, every vector on time (suite version 2)
+        settings.update(objectives=("energy",), time_tolerance_s=tolerance_s(case), encoding=SINGLE_ENCODING)
     else:
         # the phases of Meng et al. (2017) with the braking onset as a decision: the only encoding
         # under which the stop error varies (speed codes always stop at the platform)
@@ -162,4 +179,5 @@ def get_problem(name: str, **kwargs):
     settings.update(kwargs)
     problem = SpeedProfileProblem(case, **settings)
     problem.suite_name = name
+    problem.suite_version = SUITE_VERSION
     return problem

@@ -15,6 +15,11 @@ def test_names_in_pymoos_style():
     assert len(names) >= 12 and len(set(names)) == len(names)
     assert sum(n.endswith("-bi") for n in names) == sum(n.endswith("-single") for n in names) == len(CASES)
     assert "metro-a-4obj" in names
+    from pymoo_rail.suite import SUITE_VERSION
+
+    single = get_problem("metro-a-single")
+    assert single.suite_version == SUITE_VERSION == "2" and single.encoding.name == "paced_speed_codes"
+    assert get_problem("metro-a-bi").encoding.name == "speed_codes"
     with pytest.raises(ValueError, match="yizhuang-bi"):
         get_problem("zdt1")
 
@@ -62,6 +67,7 @@ def test_four_objectives_offer_a_labelled_best_known_front():
     assert problem.encoding.name == front.attrs["encoding"] == "braking_onset"
     F = front.to_numpy()
     assert len(find_non_dominated(F)) == len(F)
+    assert front.attrs["time_window_s"] == "none"
     # every axis is live: the braking onset moves the stop point, so the stop error varies too
     assert np.all(F.max(axis=0) > F.min(axis=0))
     assert F[:, 3].max() <= problem.stop_tolerance_m
@@ -74,19 +80,44 @@ def test_nsga2_beats_random_sampling_against_the_certified_front():
     assert result.n_below_certificate == 0 and result.passed
 
 
-# measured (benchmarks/suite.py --sanity --seeds 5): on this single-objective form NSGA-II ends
-# 0.16 kWh above the optimum with seed 1 and random sampling 0.13 (NSGA-II wins on seeds 2, 3, 5)
-_RANDOM_WINS = {"ttobench-wanyuan-rongjing-single": "seed 1: NSGA-II 0.162 kWh above the optimum, random 0.129"}
+SWEEP_SEEDS = range(1, 6)
+# measured (benchmarks/suite.py --sanity --seeds 5, front version 5): NSGA-II ends 0.0045 kWh *below* the
+# certified optimum -2.7145 kWh, a chord between the nodes at 145.65 and 147.77 s (certificate 0.0118 kWh);
+# the exact solver alone at 146.45 s gives -2.7191 kWh (bound 0.0016), NSGA-II's run; random sampling ends
+# 0.0027 kWh below to 0.0035 kWh above the chord: nearer to it, though dearer than NSGA-II on every seed
+_CHORD_ABOVE_OPTIMUM = {"ttobench-xiaohongmen-jiugong-single": "the optimum is a chord 0.0046 kWh above the "
+                        "solver's run at its time; NSGA-II reaches the run, below the chord"}
+
+
+def _sweep_case(name):
+    if name in _CHORD_ABOVE_OPTIMUM:
+        return pytest.param(name, marks=pytest.mark.xfail(reason=_CHORD_ABOVE_OPTIMUM[name], strict=True))
+    return name
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(reason=_RANDOM_WINS[n], strict=True))
-                                  if n in _RANDOM_WINS else n for n in list_problems()])
-def test_every_problem_nsga2_beats_random_sampling(name):
-    """The done-when sweep: every suite problem, NSGA2(100, 200 generations) against random sampling."""
-    result = nsga2_against_random(name)
+@pytest.mark.parametrize("seed", SWEEP_SEEDS)
+@pytest.mark.parametrize("name", [_sweep_case(n) for n in list_problems()])
+def test_every_problem_nsga2_beats_random_sampling(name, seed):
+    """The done-when sweep: every suite problem and seeds 1-5, NSGA2(100, 200 generations) against random
+    sampling of the same budget (40 CPU minutes for the 105 cases on the loaded machine, the sum of the
+    per-case CPU times of `benchmarks/suite.py --sanity --seeds 5`)."""
+    result = nsga2_against_random(name, seed=seed)
     assert np.isfinite(result.igd_nsga2) and result.igd_nsga2 < result.igd_random, result
     assert result.n_below_certificate == 0, result
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", SWEEP_SEEDS)
+@pytest.mark.parametrize("name", sorted(_CHORD_ABOVE_OPTIMUM))
+def test_below_the_chord_nsga2_finds_the_cheaper_run(name, seed):
+    """Where the optimum is a chord above the front, NSGA-II's best run is cheaper than random sampling's,
+    and below the chord by no more than the certificate allows."""
+    result = nsga2_against_random(name, seed=seed)
+    problem = get_problem(name)
+    _, bound, _ = ref.constrained_optimum(problem.certified_front(), problem.time_tolerance_s)
+    assert result.gap_nsga2_kwh < result.gap_random_kwh, result
+    assert -bound <= result.gap_nsga2_kwh < 0.0, result
 
 
 def test_study_registry_builds_suite_problems():
