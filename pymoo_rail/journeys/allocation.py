@@ -21,7 +21,6 @@ import pandas as pd
 
 from pymoo_rail.journeys.fronts import (
     FRONT_COLUMNS,
-    STRATEGY_VERSION,
     FrontSource,
     convex_front,
     front_energy,
@@ -117,6 +116,7 @@ def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_
         else:
             raise CaseError("fronts", fronts, f"unknown front source (known: {', '.join(FRONT_SOURCES)}, "
                                               "a callable, or one DataFrame per section)")
+        from pymoo_rail.journeys.fronts import STRATEGY_VERSION  # read at the call (tests change them)
         from pymoo_rail.optimal.solver import SOLVER_VERSION
 
         label = fronts
@@ -124,7 +124,8 @@ def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_
                    "combined": f"solver {SOLVER_VERSION} + strategy {STRATEGY_VERSION}"}[fronts]
     elif callable(fronts):
         compute = _sampled(fronts, n_times, max_time_factor, dx_m, running_times)
-        label = getattr(fronts, "__qualname__", repr(fronts))
+        # a function's qualified name, or a callable object's class (its repr would hold its address)
+        label = getattr(fronts, "__qualname__", None) or type(fronts).__qualname__
         version = ""
     else:
         fronts = list(fronts)
