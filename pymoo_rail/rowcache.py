@@ -98,8 +98,10 @@ class RowCache:
         if not text.endswith("\n"):
             return pd.DataFrame(), "its last line is cut off (an interrupted write)"
         try:
-            table = pd.read_csv(io.StringIO(text), dtype={c: str for c in self.text_columns})
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError) as err:
+            with warnings.catch_warnings():  # a row longer than the header: pandas warns and drops data
+                warnings.simplefilter("error", pd.errors.ParserWarning)
+                table = pd.read_csv(io.StringIO(text), index_col=False, dtype={c: str for c in self.text_columns})
+        except (pd.errors.ParserError, pd.errors.ParserWarning, pd.errors.EmptyDataError, ValueError) as err:
             detail = str(err).strip().splitlines()
             return pd.DataFrame(), f"not a CSV table ({detail[-1] if detail else type(err).__name__})"
         if KEY_COLUMN not in table.columns:
