@@ -17,8 +17,10 @@ Usage::
 
 Writes ``journeys.md``, ``journeys.png`` and the fronts ``journeys_fronts_optimal.csv`` /
 ``journeys_fronts_simulated.csv`` into ``--out``. The exact fronts take minutes; each finished
-section is appended to its CSV at once and read back on a re-run, so an interrupted run loses
-nothing that had finished. Delete the CSVs to recompute after a change to the solver or the data.
+section is added to its CSV at once and read back on a re-run, so an interrupted run loses
+nothing that had finished. A section is read back only when its content, the version of what
+computed it (``pymoo_rail.optimal.solver.SOLVER_VERSION``, ``pymoo_rail.journeys.fronts.STRATEGY_VERSION``)
+and the settings match (``pymoo_rail.journeys.section_fronts``); anything else is recomputed.
 """
 
 from __future__ import annotations
@@ -79,12 +81,12 @@ def on_fronts(fronts, times):
 
 
 def timed_fronts(journey, source, cache, **kwargs):
-    done_before = 0
-    if cache.is_file():
-        done_before = pd.read_csv(cache).groupby(["section", "case"]).ngroups
+    """The fronts, the wall seconds they took, and how many sections were read from ``cache``."""
+    read = []
     t0 = time.perf_counter()
-    fronts = section_fronts(journey, source, cache_path=cache, **kwargs)
-    return fronts, time.perf_counter() - t0, done_before
+    fronts = section_fronts(journey, source, cache_path=cache, on_front=lambda k, computed: read.append(not computed),
+                            **kwargs)
+    return fronts, time.perf_counter() - t0, sum(read)
 
 
 def main(argv=None) -> None:
