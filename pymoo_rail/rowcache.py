@@ -105,7 +105,7 @@ class RowCache:
             detail = str(err).strip().splitlines()
             return pd.DataFrame(), f"not a CSV table ({detail[-1] if detail else type(err).__name__})"
         if KEY_COLUMN not in table.columns:
-            return table, None  # written before rows carried keys: kept, never served
+            return table, None  # written before rows carried keys: never served, dropped by the next add
         if table.columns[-1] != KEY_COLUMN or table[KEY_COLUMN].isna().any():
             return pd.DataFrame(), f"a row lacks its '{KEY_COLUMN}' (the last column)"
         for column in self.value_columns:

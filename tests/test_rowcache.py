@@ -1,4 +1,4 @@
-"""pymoo_rail.rowcache: rows served by key only, atomic rewrites, a lock for concurrent writers, corrupt files set aside."""
+"""pymoo_rail.rowcache: rows served by key only, atomic rewrites, a lock for two writers, corrupt files set aside."""
 
 from __future__ import annotations
 

@@ -520,5 +520,6 @@ def exact_points(case: Case, running_times_s: Sequence[float], path: str | Path,
 
 
 __all__ = ["CertifiedFront", "NoExactFrontError", "case_hash", "cache_dir", "certified_front", "compute_front",
-           "constrained_optimum", "default_window", "exact_points", "exact_points_key", "find_front", "forget_fronts", "front_key", "front_times",
-           "mirrored", "punctual_tolerance_s", "EXACT_POINT_COLUMNS", "FRONT_VERSION", "PUNCTUAL_TOLERANCE_MIN_S", "PUNCTUAL_TOLERANCE_REL"]
+           "constrained_optimum", "default_window", "exact_points", "exact_points_key", "find_front", "forget_fronts",
+           "front_key", "front_times", "mirrored", "punctual_tolerance_s", "EXACT_POINT_COLUMNS", "FRONT_VERSION",
+           "PUNCTUAL_TOLERANCE_MIN_S", "PUNCTUAL_TOLERANCE_REL"]
