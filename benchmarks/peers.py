@@ -12,14 +12,17 @@ count), beside
   case: 440.14 kWh in 7.0 s;
 - the closed form (Pontryagin, ``pymoo_rail.optimal.flat``) on the level case.
 
-Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--quick]``
-(``--quick``: only the two intercity cases). Writes ``benchmarks/reports/peers.md``.
+Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--quick] [--breakdown]``
+(``--quick``: only the two intercity cases; ``--breakdown``: also where pymoo-rail's CPU time goes, per
+Numba kernel of the exact solver, from a second run under cProfile). Writes ``benchmarks/reports/peers.md``.
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
 import json
+import pstats
 import subprocess
 import sys
 import tempfile
@@ -139,6 +142,33 @@ def pymoo_rail_row(name: str, running_time_s: float) -> dict:
     return row
 
 
+def cpu_breakdown(name: str, running_time_s: float) -> dict:
+    """CPU seconds of one profile (as timed by :func:`pymoo_rail_row`) per kernel of the exact solver.
+
+    cProfile in ``time.process_time``: tables (``_count_targets`` + ``_fill_transitions``, default and
+    half grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
+    """
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.optimal import OptimalSolver
+
+    case = load_case(name)
+    profiler = cProfile.Profile(time.process_time)
+    profiler.enable()
+    OptimalSolver(case).profile(running_time_s)
+    profiler.disable()
+    stats = pstats.Stats(profiler).stats  # (file, line, function) -> (calls, ..., own time, cumulative time, ...)
+    own = {name: [0, 0.0] for name in ("_count_targets", "_fill_transitions", "backward_sweep", "forward_rollout")}
+    for (path, _, function), (_, calls, tottime, _, _) in stats.items():
+        if path.endswith("dp.py") and function in own:
+            own[function][0] += calls
+            own[function][1] += tottime
+    total = sum(v[2] for v in stats.values())
+    tables = own["_count_targets"][1] + own["_fill_transitions"][1]
+    sweeps, runs = own["backward_sweep"], own["forward_rollout"]
+    return {"case": case.name, "cpu_s": total, "tables_s": tables, "sweeps": sweeps[0], "sweeps_s": sweeps[1],
+            "forward_runs": runs[0], "forward_runs_s": runs[1], "rest_s": total - tables - sweeps[1] - runs[1]}
+
+
 def speed_ratios(ours: pd.DataFrame, theirs: pd.DataFrame) -> pd.DataFrame:
     """Per peer row: its CPU time over pymoo-rail's on the same case, and the energy difference (%)."""
     if len(theirs) == 0:
@@ -155,16 +185,20 @@ def main() -> None:
     parser.add_argument("--mseetc", type=Path, help="an ms-eetc checkout to run here")
     parser.add_argument("--mseetc-python", default=sys.executable, help="interpreter with ms-eetc's dependencies")
     parser.add_argument("--quick", action="store_true", help="only the two intercity cases")
+    parser.add_argument("--breakdown", action="store_true", help="also pymoo-rail's CPU time per solver kernel")
     args = parser.parse_args()
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import OptimalSolver
 
     OptimalSolver(load_case("yizhuang"), n_speeds=20).profile(150.0)  # warm-up: load the Numba cache
-    rows, peers = [], []
+    rows, peers, breakdown = [], [], []
     for name, t, track_id in (CASES[:2] if args.quick else CASES):
         row = pymoo_rail_row(name, t)
         rows.append(row)
         print(row, flush=True)
+        if args.breakdown:
+            breakdown.append(cpu_breakdown(name, t))
+            print(breakdown[-1], flush=True)
         if track_id is None:
             continue
         for n in (100, 300, 1000):
@@ -198,6 +232,12 @@ def main() -> None:
             " faster; none for a published time); `energy_diff_pct` ="
             " pymoo-rail's energy at the requested time over the peer's, minus 1.", "",
             markdown(ratios) if len(ratios) else "(none)", ""]
+    if breakdown:
+        text += ["## Where pymoo-rail's CPU time goes", "",
+                 "A second run of each profile under cProfile (`time.process_time`, so slightly slower): the"
+                 " transition tables of the default and the half speed grid, the backward sweeps and forward runs"
+                 " (the lambda search's, one on the half grid and one without the tie rule for the certificate),"
+                 " and the rest.", "", markdown(pd.DataFrame(breakdown)), ""]
     REPORT.write_text("\n".join(text))
     print("\n".join(text))
 
