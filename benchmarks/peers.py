@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import cProfile
 import json
+import os
 import pstats
 import subprocess
 import sys
@@ -44,14 +45,14 @@ CASES = [  # (case, running time s, ms-eetc track id or None)
     ("wuguang-crh3", 1050.0, None),
 ]
 GPOPS_II = {"intercity-var-limit-100": (440.14, 7.0)}  # published (ms-eetc paper, fig. 10): kWh, s
-# ms-eetc measured on this machine (2 cores shared by several jobs, load ~10) on 2026-11-24, casadi 3.8.2, in the
+# ms-eetc measured on this machine (2 cores, load average 1.1-1.2) on 2026-11-24, casadi 3.8.2, in the
 # same run as pymoo-rail's committed figures: IPOPT process time of one solve (the best of 3);
 # ms-eetc's own "CPU time" is IPOPT's wall time.
 MSEETC_RECORDED = {
-    ("intercity-var-limit-100", 100): (448.6395, 1.09), ("intercity-var-limit-100", 300): (441.0839, 3.61),
-    ("intercity-var-limit-100", 1000): (440.3766, 12.41),
-    ("intercity-level-10km", 100): (88.5501, 0.88), ("intercity-level-10km", 300): (88.3277, 2.94),
-    ("intercity-level-10km", 1000): (88.2526, 12.42),
+    ("intercity-var-limit-100", 100): (448.6395, 0.89), ("intercity-var-limit-100", 300): (441.0839, 3.44),
+    ("intercity-var-limit-100", 1000): (440.3766, 12.31),
+    ("intercity-level-10km", 100): (88.5501, 0.64), ("intercity-level-10km", 300): (88.3277, 2.69),
+    ("intercity-level-10km", 1000): (88.2526, 11.20),
 }
 MSEETC_DATE = "2026-11-24"
 
@@ -191,6 +192,7 @@ def main() -> None:
     from pymoo_rail.optimal import OptimalSolver
 
     OptimalSolver(load_case("yizhuang"), n_speeds=20).profile(150.0)  # warm-up: load the Numba cache
+    load_at_start = os.getloadavg()[0]
     rows, peers, breakdown = [], [], []
     for name, t, track_id in (CASES[:2] if args.quick else CASES):
         row = pymoo_rail_row(name, t)
@@ -224,7 +226,8 @@ def main() -> None:
     text = ["# pymoo-rail's exact solver beside continuous optimal-control solvers", "",
             "Written by `python benchmarks/peers.py`. CPU times are `time.process_time` on a 2-core machine",
             "shared with other jobs (wall times there are meaningless); pymoo-rail's include building the",
-            "transition tables, the lambda search, the simulator replay and the certificate.", "",
+            "transition tables, the lambda search, the simulator replay and the certificate. Load average"
+            f" (1 min) at the start and the end of this run: {load_at_start:.2f} / {os.getloadavg()[0]:.2f}.", "",
             "## pymoo-rail", "", markdown(ours), "",
             "## Peers", "", markdown(theirs) if len(theirs) else "(none)", "",
             "## Side by side", "",
