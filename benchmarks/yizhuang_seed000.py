@@ -251,7 +251,8 @@ def reference_available() -> bool:
 
 def reference_front(case, tolerance_s: float, path: Path) -> dict:
     """Exact optimum (pymoo_rail.optimal) at running times around T_plan and over the MOABC range,
-    cached in ``path`` by ``pymoo_rail.problems.reference.exact_points``."""
+    cached in ``path`` by ``pymoo_rail.problems.reference.exact_points`` (rows of another case content
+    or solver version are solved again)."""
     from pymoo_rail.problems.reference import exact_points
 
     planned = case.planned_time_s

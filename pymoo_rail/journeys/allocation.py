@@ -29,6 +29,8 @@ from pymoo_rail.journeys.fronts import (
 )
 from pymoo_rail.journeys.journey import Journey, as_journey
 from pymoo_rail.model import Case, CaseError, InfeasibleCaseError
+from pymoo_rail.problems.reference import case_hash
+from pymoo_rail.rowcache import RowCache
 from pymoo_rail.sim import Simulator
 
 FRONT_SOURCES = ("optimal", "simulated", "combined")
@@ -53,7 +55,8 @@ _GRID = "quadratic"  # recorded in front caches: a cache made with another spaci
 def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_SOURCE, *, n_times: int = 16,
                    max_time_factor: float = 1.5, dx_m: float | None = None,
                    running_times: Callable[[Case], np.ndarray] | None = None,
-                   cache_path: str | Path | None = None) -> list[pd.DataFrame]:
+                   cache_path: str | Path | None = None,
+                   on_front: Callable[[int, bool], None] | None = None) -> list[pd.DataFrame]:
     """Convex energy-time fronts of a journey's sections.
 
     Parameters
@@ -78,10 +81,20 @@ def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_
     running_times : callable, optional
         ``case -> running times`` for a callable source, replacing that default grid.
     cache_path : path, optional
-        A CSV file of finished section fronts: sections already there (same source and settings)
-        are read back, each new one is appended as soon as it is computed, so an interrupted run
-        loses nothing that had finished. The cache keeps the columns ``running_time_s`` and
-        ``energy_kwh`` of each convex front.
+        A CSV file of finished section fronts (:class:`pymoo_rail.rowcache.RowCache`). A section is
+        read back only under the same key: its content (:func:`~pymoo_rail.problems.reference.case_hash`,
+        so a renamed section keeps its front and a changed one under the same name is computed
+        anew), the version of the source (``pymoo_rail.optimal.solver.SOLVER_VERSION``,
+        :data:`~pymoo_rail.journeys.fronts.STRATEGY_VERSION`, both for ``"combined"``; a callable is
+        known by its qualified name only) and the settings above. Each new front is added as soon
+        as it is computed, replacing the rows of its section index (an atomic rewrite under a file
+        lock), so an interrupted run keeps every finished section and two runs on one file lose
+        none. A corrupt file is moved aside with a warning and its sections computed again. The
+        file keeps each convex front's ``running_time_s`` and ``energy_kwh``, ``section``,
+        ``case`` (the name, for reading), then the key.
+    on_front : callable, optional
+        Called as ``on_front(k, computed)`` after section ``k``; ``computed`` is False when its
+        front was read from ``cache_path``.
     """
     journey = as_journey(journey)
     if isinstance(fronts, str):
@@ -103,25 +116,40 @@ def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_
         else:
             raise CaseError("fronts", fronts, f"unknown front source (known: {', '.join(FRONT_SOURCES)}, "
                                               "a callable, or one DataFrame per section)")
+        from pymoo_rail.journeys.fronts import STRATEGY_VERSION  # read at the call (tests change them)
+        from pymoo_rail.optimal.solver import SOLVER_VERSION
+
         label = fronts
+        version = {"simulated": f"strategy {STRATEGY_VERSION}", "optimal": f"solver {SOLVER_VERSION}",
+                   "combined": f"solver {SOLVER_VERSION} + strategy {STRATEGY_VERSION}"}[fronts]
     elif callable(fronts):
         compute = _sampled(fronts, n_times, max_time_factor, dx_m, running_times)
-        label = getattr(fronts, "__qualname__", repr(fronts))
+        # a function's qualified name, or a callable object's class (its repr would hold its address)
+        label = getattr(fronts, "__qualname__", None) or type(fronts).__qualname__
+        version = ""
     else:
         fronts = list(fronts)
         if len(fronts) != journey.n_sections:
             raise CaseError("fronts", len(fronts), f"needs one front per section ({journey.n_sections})")
         return [convex_front(f, f"fronts[{k}]") for k, f in enumerate(fronts)]
-    key = {"source": label, "grid": _GRID if running_times is None else "custom", "n_times": n_times,
-           "max_time_factor": max_time_factor, "dx_m": dx_m or 0.0}
-    cached = _read_cache(cache_path, key) if cache_path is not None else {}
-    out = []
+    cache = None if cache_path is None else RowCache(cache_path, value_columns=(*FRONT_COLUMNS, "section"),
+                                                     text_columns=("case", "case_hash", "version"))
+    settings = {"source": label, "version": version, "grid": _GRID if running_times is None else "custom",
+                "n_times": int(n_times), "max_time_factor": float(max_time_factor), "dx_m": float(dx_m or 0.0)}
+    out: list[pd.DataFrame] = []
     for k, case in enumerate(journey.sections):
-        front = cached.get((k, case.name))
-        if front is None:
+        key = {"case_hash": case_hash(case)[:16], **settings}
+        rows = cache.rows(key) if cache is not None else None
+        computed = rows is None or len(rows) == 0
+        if computed:
             front = convex_front(compute(k, case), f"fronts[{k}]")
-            if cache_path is not None:
-                _append_cache(cache_path, front[list(FRONT_COLUMNS)].assign(section=k, case=case.name, **key))
+            if cache is not None:  # at once: an interrupted run keeps every finished section
+                cache.add(front[list(FRONT_COLUMNS)].assign(section=k, case=case.name), key,
+                          replace=lambda table, k=k: table["section"] == k)
+        else:
+            front = convex_front(rows[list(FRONT_COLUMNS)], f"fronts[{k}]")
+        if on_front is not None:
+            on_front(k, computed)
         out.append(front)
     return out
 
@@ -137,31 +165,6 @@ def _sampled(source: Callable, n_times: int, max_time_factor: float, dx_m: float
         flat_out = pd.DataFrame({"running_time_s": [fastest.running_time_s], "energy_kwh": [fastest.energy.net_kwh]})
         return pd.concat([flat_out, front], ignore_index=True)
     return compute
-
-
-_CACHE_KEYS = ("section", "case", "source", "grid", "n_times", "max_time_factor", "dx_m")
-
-
-def _read_cache(path: str | Path, key: dict) -> dict[tuple[int, str], pd.DataFrame]:
-    path = Path(path)
-    if not path.is_file():
-        return {}
-    table = pd.read_csv(path)
-    match = np.ones(len(table), dtype=bool)
-    for name, value in key.items():
-        column = table[name]
-        match &= np.isclose(column.astype(float), float(value)) if isinstance(value, (int, float)) \
-            else (column.astype(str) == str(value)).to_numpy()
-    out = {}
-    for (section, case), rows in table[match].groupby(["section", "case"]):
-        out[(int(section), str(case))] = rows.drop(columns=list(_CACHE_KEYS)).reset_index(drop=True)
-    return out
-
-
-def _append_cache(path: str | Path, rows: pd.DataFrame) -> None:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    rows.to_csv(path, mode="a", header=not path.is_file(), index=False)
 
 
 def allocate_on_fronts(fronts: Sequence[pd.DataFrame], total_time_s: float) -> tuple[np.ndarray, np.ndarray, float]:

@@ -21,6 +21,10 @@ from pymoo_rail.sim import Simulator
 from pymoo_rail.sim import kernel as k
 
 FRONT_COLUMNS = ("running_time_s", "energy_kwh")
+STRATEGY_VERSION = "1"
+"""Version of :func:`strategy_front`'s answers: bump it whenever the front it returns for a case can
+change (the strategies searched, the hull, or the simulator that runs them), so cached fronts
+(:func:`pymoo_rail.journeys.section_fronts` with ``cache_path``) stop serving the old rows."""
 FrontSource = Union[str, Callable[[Case, np.ndarray], pd.DataFrame], Sequence[pd.DataFrame]]
 
 

@@ -45,11 +45,18 @@ from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, case_to_dict
 
-FRONT_VERSION = "5"
-"""Version of the front computation; bump it when the solver or the node choice changes
+FRONT_VERSION = "6"
+"""Version of the front computation; bump it when the solver (with
+:data:`pymoo_rail.optimal.solver.SOLVER_VERSION`) or the node choice changes
 (4: every node solved in the sweep and alone, the lower kept, the bound at least their difference;
 5: the solver keeps a run with its last switch moved only near the front, its certificate compares
-the half grid at the run's price and has a floor of 1e-4 of the energy)."""
+the half grid at the run's price and has a floor of 1e-4 of the energy;
+6: nodes also at the ends of the punctuality window, so that the optimum of a single-objective
+form is a solved run, not a point on a chord)."""
+PUNCTUAL_TOLERANCE_REL = 0.01
+"""Default punctuality window: ``|T - T_plan| <= 1 %`` of the planned time (at least
+:data:`PUNCTUAL_TOLERANCE_MIN_S`); fronts have nodes at both of its ends."""
+PUNCTUAL_TOLERANCE_MIN_S = 1.0
 FRONT_SPAN = 1.3
 """Fronts cover running times from the minimum to ``FRONT_SPAN`` x the planned time."""
 DEFAULT_N_TIMES = 33
@@ -241,17 +248,27 @@ def default_window(min_time_s: float, planned_time_s: float) -> tuple[float, flo
     return min_time_s * 1.005, max(FRONT_SPAN * planned_time_s, 1.2 * min_time_s)
 
 
-def front_times(min_time_s: float, planned_time_s: float, n_times: int = DEFAULT_N_TIMES) -> np.ndarray:
-    """Requested running times of the nodes: across :func:`default_window`, with the planned time.
+def punctual_tolerance_s(planned_time_s: float) -> float:
+    """Half-width of the default punctuality window: 1 % of the planned time, at least 1 s."""
+    return max(PUNCTUAL_TOLERANCE_MIN_S, PUNCTUAL_TOLERANCE_REL * float(planned_time_s))
 
-    Spaced quadratically (denser near the minimum time, where the front is steepest).
+
+def front_times(min_time_s: float, planned_time_s: float, n_times: int = DEFAULT_N_TIMES) -> np.ndarray:
+    """Requested running times of the nodes: across :func:`default_window`, with the planned time
+    and both ends of its punctuality window (:func:`punctual_tolerance_s`).
+
+    Spaced quadratically (denser near the minimum time, where the front is steepest). The ends of
+    the punctuality window are nodes because the optimum under ``|T - T_plan| <= tolerance`` lies on
+    one of them (the slow end, energy falling with time): a node there is a solved run with its own
+    bound, where a chord between nodes lies above the convex front (by 0.0045 kWh on the
+    xiaohongmen-jiugong section, more than optimisers then end below it).
     """
     lo, hi = default_window(min_time_s, planned_time_s)
     u = np.linspace(0.0, 1.0, max(int(n_times) - 1, 2))
     times = lo + (hi - lo) * u ** 2
-    if lo < planned_time_s < hi:
-        times = np.union1d(times, [planned_time_s])
-    return times
+    tolerance = punctual_tolerance_s(planned_time_s)
+    extra = [t for t in (planned_time_s - tolerance, planned_time_s, planned_time_s + tolerance) if lo < t < hi]
+    return np.union1d(times, extra)
 
 
 def n_times_for(case: Case) -> int:
@@ -414,15 +431,37 @@ def constrained_optimum(front: CertifiedFront, tolerance_s: float, n_points: int
     return float(energy[k]), float(bound[k]), float(t[k])
 
 
+EXACT_POINT_COLUMNS = ("requested_time_s", "running_time_s", "energy_kwh", "traction_kwh", "regen_kwh",
+                       "lambda_kwh_per_s", "neutral_traction_j", "limit_excess_ms", "stop_error_m", "n_speeds",
+                       "solve_s")
+"""Columns of :func:`exact_points` (then the key columns ``case_hash``, ``solver_version``, ``cache_key``)."""
+
+
+def exact_points_key(case: Case, n_speeds: int) -> dict[str, object]:
+    """The key of :func:`exact_points` rows: the case's content, the solver's version, the speed nodes.
+
+    ``case_hash`` is :func:`case_hash` (names and prose left out, so a renamed case keeps its rows);
+    ``solver_version`` is :data:`pymoo_rail.optimal.solver.SOLVER_VERSION`.
+    """
+    from pymoo_rail.optimal.solver import SOLVER_VERSION
+
+    return {"case_hash": case_hash(case)[:16], "solver_version": SOLVER_VERSION, "n_speeds": int(n_speeds)}
+
+
 def exact_points(case: Case, running_times_s: Sequence[float], path: str | Path, *, n_speeds: int | None = None,
                  redo_s: Sequence[float] = (), on_run: Callable[[float, Any], None] | None = None) -> pd.DataFrame:
     """The exact solver's runs at chosen running times, cached row by row in a CSV file.
 
     The resumable form of :func:`~pymoo_rail.optimal.optimal_front` for long lines, where one
-    running time costs minutes: each finished time is written at once (atomically), so an
-    interrupted computation resumes where it stopped. Rows computed with another ``n_speeds`` are
-    recomputed. The times are solved in increasing order, each warm-started from the slope of the
-    one before, as :func:`~pymoo_rail.optimal.optimal_front` does.
+    running time costs minutes: each finished time is added to the file at once
+    (:class:`pymoo_rail.rowcache.RowCache`: atomic rewrite under a file lock), so an interrupted
+    computation resumes where it stopped and two processes on one file lose no row. A row is
+    served only under the same key (:func:`exact_points_key`: the case's content hash, the
+    solver's :data:`~pymoo_rail.optimal.solver.SOLVER_VERSION` and ``n_speeds``); rows of another
+    key are never served, and a new row replaces every row of its requested time. A corrupt file
+    is moved aside with a :class:`~pymoo_rail.rowcache.CorruptCacheWarning` and its times solved
+    again. The times are solved in increasing order, each warm-started from the slope of the one
+    before, as :func:`~pymoo_rail.optimal.optimal_front` does.
 
     Parameters
     ----------
@@ -443,21 +482,20 @@ def exact_points(case: Case, running_times_s: Sequence[float], path: str | Path,
     Returns
     -------
     pandas.DataFrame
-        The rows of ``running_times_s``, sorted by running time: ``requested_time_s``,
-        ``running_time_s``, ``energy_kwh`` (net), ``traction_kwh``, ``regen_kwh``,
-        ``lambda_kwh_per_s``, ``neutral_traction_j``, ``limit_excess_ms``, ``stop_error_m``,
-        ``n_speeds`` and ``solve_s`` (wall seconds of the solve).
+        The rows of ``running_times_s``, sorted by running time: :data:`EXACT_POINT_COLUMNS`
+        (``energy_kwh`` is net; ``solve_s`` is the wall seconds of the solve).
     """
     import time
 
     from pymoo_rail.optimal import OptimalSolver
     from pymoo_rail.optimal.solver import DEFAULT_N_SPEEDS
+    from pymoo_rail.rowcache import RowCache
 
-    path = Path(path)
     n_speeds = DEFAULT_N_SPEEDS if n_speeds is None else int(n_speeds)
-    rows = pd.read_csv(path).to_dict("records") if path.exists() else []
-    rows = [r for r in rows if int(r.get("n_speeds", -1)) == n_speeds]
-    done = {float(r["requested_time_s"]) for r in rows} - {float(t) for t in redo_s}
+    key = exact_points_key(case, n_speeds)
+    cache = RowCache(path, value_columns=EXACT_POINT_COLUMNS, text_columns=("case_hash", "solver_version"))
+    rows = {float(r["requested_time_s"]): r for r in cache.rows(key).to_dict("records")}
+    done = set(rows) - {float(t) for t in redo_s}
     solver, guess = None, None
     for t in sorted({float(t) for t in running_times_s} | {float(t) for t in redo_s}):
         if t in done:
@@ -472,16 +510,16 @@ def exact_points(case: Case, running_times_s: Sequence[float], path: str | Path,
                "lambda_kwh_per_s": guess / J_PER_KWH, "neutral_traction_j": traj.summary["neutral_traction_j"],
                "limit_excess_ms": traj.summary["limit_excess_ms"], "stop_error_m": traj.stop_error_m,
                "n_speeds": n_speeds, "solve_s": time.perf_counter() - start}
-        rows = sorted([r for r in rows if float(r["requested_time_s"]) != t] + [row],
-                      key=lambda r: float(r["requested_time_s"]))
-        atomic_write_text(path, pd.DataFrame(rows).to_csv(index=False))
+        cache.add(pd.DataFrame([row]), key, replace=lambda table, t=t: table["requested_time_s"] == t)
+        rows[t] = row
         if on_run is not None:
             on_run(t, traj)
-    frame = pd.DataFrame(rows)
-    wanted = frame["requested_time_s"].isin([float(t) for t in running_times_s])
-    return frame[wanted].sort_values("running_time_s").reset_index(drop=True)
+    wanted = sorted({float(t) for t in running_times_s})
+    frame = pd.DataFrame([rows[t] for t in wanted], columns=list(EXACT_POINT_COLUMNS))
+    return frame.sort_values("running_time_s", kind="stable").reset_index(drop=True)
 
 
 __all__ = ["CertifiedFront", "NoExactFrontError", "case_hash", "cache_dir", "certified_front", "compute_front",
-           "constrained_optimum", "default_window", "exact_points", "find_front", "forget_fronts", "front_key", "front_times",
-           "mirrored", "FRONT_VERSION"]
+           "constrained_optimum", "default_window", "exact_points", "exact_points_key", "find_front", "forget_fronts",
+           "front_key", "front_times", "mirrored", "punctual_tolerance_s", "EXACT_POINT_COLUMNS", "FRONT_VERSION",
+           "PUNCTUAL_TOLERANCE_MIN_S", "PUNCTUAL_TOLERANCE_REL"]

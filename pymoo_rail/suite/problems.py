@@ -19,9 +19,11 @@ from functools import lru_cache
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.model import Case
+from pymoo_rail.problems.reference import PUNCTUAL_TOLERANCE_REL, punctual_tolerance_s
 
-TOLERANCE_REL = 0.01
-"""Running-time tolerance of the single-objective forms, relative to the planned time."""
+TOLERANCE_REL = PUNCTUAL_TOLERANCE_REL
+"""Running-time tolerance of the single-objective forms, relative to the planned time (the fronts'
+punctuality window, :data:`pymoo_rail.problems.reference.PUNCTUAL_TOLERANCE_REL`)."""
 SECTIONS_PER_LINE = 12
 """Speed-code sections of a suite problem: gradient/limit sections split to at most length / 12."""
 
@@ -139,7 +141,7 @@ def suite_case(name: str) -> Case:
 
 def tolerance_s(case: Case) -> float:
     """Running-time tolerance of the single-objective form: 1 % of the planned time, at least 1 s."""
-    return max(1.0, TOLERANCE_REL * case.planned_time_s)
+    return punctual_tolerance_s(case.planned_time_s)
 
 
 def get_problem(name: str, **kwargs):
