@@ -12,14 +12,18 @@ count), beside
   case: 440.14 kWh in 7.0 s;
 - the closed form (Pontryagin, ``pymoo_rail.optimal.flat``) on the level case.
 
-Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--quick]``
-(``--quick``: only the two intercity cases). Writes ``benchmarks/reports/peers.md``.
+Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--quick] [--breakdown]``
+(``--quick``: only the two intercity cases; ``--breakdown``: also where pymoo-rail's CPU time goes, per
+Numba kernel of the exact solver, from a second run under cProfile). Writes ``benchmarks/reports/peers.md``.
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
 import json
+import os
+import pstats
 import subprocess
 import sys
 import tempfile
@@ -41,14 +45,14 @@ CASES = [  # (case, running time s, ms-eetc track id or None)
     ("wuguang-crh3", 1050.0, None),
 ]
 GPOPS_II = {"intercity-var-limit-100": (440.14, 7.0)}  # published (ms-eetc paper, fig. 10): kWh, s
-# ms-eetc measured on this machine (2 cores shared by several jobs, load ~10) on 2026-11-24, casadi 3.8.2, in the
+# ms-eetc measured on this machine (2 cores, load average 1.1-1.2) on 2026-11-24, casadi 3.8.2, in the
 # same run as pymoo-rail's committed figures: IPOPT process time of one solve (the best of 3);
 # ms-eetc's own "CPU time" is IPOPT's wall time.
 MSEETC_RECORDED = {
-    ("intercity-var-limit-100", 100): (448.6395, 1.09), ("intercity-var-limit-100", 300): (441.0839, 3.61),
-    ("intercity-var-limit-100", 1000): (440.3766, 12.41),
-    ("intercity-level-10km", 100): (88.5501, 0.88), ("intercity-level-10km", 300): (88.3277, 2.94),
-    ("intercity-level-10km", 1000): (88.2526, 12.42),
+    ("intercity-var-limit-100", 100): (448.6395, 0.89), ("intercity-var-limit-100", 300): (441.0839, 3.44),
+    ("intercity-var-limit-100", 1000): (440.3766, 12.31),
+    ("intercity-level-10km", 100): (88.5501, 0.64), ("intercity-level-10km", 300): (88.3277, 2.69),
+    ("intercity-level-10km", 1000): (88.2526, 11.20),
 }
 MSEETC_DATE = "2026-11-24"
 
@@ -139,6 +143,33 @@ def pymoo_rail_row(name: str, running_time_s: float) -> dict:
     return row
 
 
+def cpu_breakdown(name: str, running_time_s: float) -> dict:
+    """CPU seconds of one profile (as timed by :func:`pymoo_rail_row`) per kernel of the exact solver.
+
+    cProfile in ``time.process_time``: tables (``_count_targets`` + ``_fill_transitions``, default and
+    half grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
+    """
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.optimal import OptimalSolver
+
+    case = load_case(name)
+    profiler = cProfile.Profile(time.process_time)
+    profiler.enable()
+    OptimalSolver(case).profile(running_time_s)
+    profiler.disable()
+    stats = pstats.Stats(profiler).stats  # (file, line, function) -> (calls, ..., own time, cumulative time, ...)
+    own = {name: [0, 0.0] for name in ("_count_targets", "_fill_transitions", "backward_sweep", "forward_rollout")}
+    for (path, _, function), (_, calls, tottime, _, _) in stats.items():
+        if path.endswith("dp.py") and function in own:
+            own[function][0] += calls
+            own[function][1] += tottime
+    total = sum(v[2] for v in stats.values())
+    tables = own["_count_targets"][1] + own["_fill_transitions"][1]
+    sweeps, runs = own["backward_sweep"], own["forward_rollout"]
+    return {"case": case.name, "cpu_s": total, "tables_s": tables, "sweeps": sweeps[0], "sweeps_s": sweeps[1],
+            "forward_runs": runs[0], "forward_runs_s": runs[1], "rest_s": total - tables - sweeps[1] - runs[1]}
+
+
 def speed_ratios(ours: pd.DataFrame, theirs: pd.DataFrame) -> pd.DataFrame:
     """Per peer row: its CPU time over pymoo-rail's on the same case, and the energy difference (%)."""
     if len(theirs) == 0:
@@ -155,16 +186,21 @@ def main() -> None:
     parser.add_argument("--mseetc", type=Path, help="an ms-eetc checkout to run here")
     parser.add_argument("--mseetc-python", default=sys.executable, help="interpreter with ms-eetc's dependencies")
     parser.add_argument("--quick", action="store_true", help="only the two intercity cases")
+    parser.add_argument("--breakdown", action="store_true", help="also pymoo-rail's CPU time per solver kernel")
     args = parser.parse_args()
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import OptimalSolver
 
     OptimalSolver(load_case("yizhuang"), n_speeds=20).profile(150.0)  # warm-up: load the Numba cache
-    rows, peers = [], []
+    load_at_start = os.getloadavg()[0]
+    rows, peers, breakdown = [], [], []
     for name, t, track_id in (CASES[:2] if args.quick else CASES):
         row = pymoo_rail_row(name, t)
         rows.append(row)
         print(row, flush=True)
+        if args.breakdown:
+            breakdown.append(cpu_breakdown(name, t))
+            print(breakdown[-1], flush=True)
         if track_id is None:
             continue
         for n in (100, 300, 1000):
@@ -190,7 +226,8 @@ def main() -> None:
     text = ["# pymoo-rail's exact solver beside continuous optimal-control solvers", "",
             "Written by `python benchmarks/peers.py`. CPU times are `time.process_time` on a 2-core machine",
             "shared with other jobs (wall times there are meaningless); pymoo-rail's include building the",
-            "transition tables, the lambda search, the simulator replay and the certificate.", "",
+            "transition tables, the lambda search, the simulator replay and the certificate. Load average"
+            f" (1 min) at the start and the end of this run: {load_at_start:.2f} / {os.getloadavg()[0]:.2f}.", "",
             "## pymoo-rail", "", markdown(ours), "",
             "## Peers", "", markdown(theirs) if len(theirs) else "(none)", "",
             "## Side by side", "",
@@ -198,6 +235,12 @@ def main() -> None:
             " faster; none for a published time); `energy_diff_pct` ="
             " pymoo-rail's energy at the requested time over the peer's, minus 1.", "",
             markdown(ratios) if len(ratios) else "(none)", ""]
+    if breakdown:
+        text += ["## Where pymoo-rail's CPU time goes", "",
+                 "A second run of each profile under cProfile (`time.process_time`, so slightly slower): the"
+                 " transition tables of the default and the half speed grid, the backward sweeps and forward runs"
+                 " (the lambda search's, one on the half grid and one without the tie rule for the certificate),"
+                 " and the rest.", "", markdown(pd.DataFrame(breakdown)), ""]
     REPORT.write_text("\n".join(text))
     print("\n".join(text))
 

@@ -336,9 +336,9 @@ def test_a_journey_is_a_case_with_legs(journey, fronts):
     assert [leg.dwell_s for leg in case.legs] == [30.0] * 12 + [0.0]
     assert case.line.length_m == journey.length_m and case.planned_time_s == pytest.approx(
         journey.planned_running_times_s.sum())
-    for k in (0, 9, 12):  # each section is the case's leg
-        assert journey.sections[k].line == case.leg(k).line
-        assert journey.sections[k].line == from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, k, k + 1, 1.0).line
+    for j in (0, 9, 12):  # each section is the case's leg
+        assert journey.sections[j].line == case.leg(j).line
+        assert journey.sections[j].line == from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, j, j + 1, 1.0).line
     total = journey.running_time_s(30 * 60)
     by_case = allocate_running_time(case, total, fronts=fronts)  # the case itself, no Journey needed
     by_journey = allocate_running_time(journey, total, fronts=fronts)

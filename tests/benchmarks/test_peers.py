@@ -42,6 +42,14 @@ def test_speed_ratios():
     assert peers.speed_ratios(ours, published)["cpu_ratio"].isna().all()  # another machine's time
 
 
+def test_cpu_breakdown_finds_the_solvers_kernels():
+    """Every part is measured (a renamed kernel would read as 0 s) and the parts add up to the whole."""
+    b = _script().cpu_breakdown("yizhuang", 150.0)
+    assert b["tables_s"] > 0.0 and b["sweeps_s"] > 0.0 and b["forward_runs_s"] > 0.0
+    assert b["forward_runs"] == b["sweeps"] >= 3  # one per solve: the search's, the half grid's, the untied run's
+    assert 0.0 <= b["rest_s"] < b["cpu_s"]
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(not (MSEETC / "mseetc").is_dir() or not Path(MSEETC_PYTHON).exists(),
                     reason="no ms-eetc checkout (MSEETC_CHECKOUT) or interpreter (MSEETC_PYTHON)")
