@@ -19,7 +19,10 @@ The exact front of ``pymoo_rail.optimal`` at 13 running times from 990 to 1110 s
 and cached in ``reports/emu_wuguang_optimal.csv`` by ``pymoo_rail.problems.reference.exact_points``
 (``--no-exact`` leaves it out). Its rows are read back only for the same case content, speed nodes
 and solver version (``pymoo_rail.optimal.solver.SOLVER_VERSION``); rows without that key (written
-before rows carried it) or of another key are solved again, 13 solves of minutes each at 800 nodes.
+before rows carried it) or of another key are solved again (13 solves at 800 nodes; the CSV's
+``solve_s`` gives their wall seconds).
+``--resolution`` prints how that front moves with the solver's speed nodes (200 / 400 / 800) and
+where the stored fronts' lowest members lie against each.
 
 Algorithms (seed 003, 4.1: crossover 0.9, mutation 0.01; 2m = 40, Pc_max 0.9, Pm_max 0.1):
 
@@ -41,6 +44,7 @@ Usage::
     nice -n 10 python benchmarks/emu_wuguang.py                   # both studies, then the report
     nice -n 10 python benchmarks/emu_wuguang.py --seeds 5 --budget 30000
     python benchmarks/emu_wuguang.py --report-only                # re-analyse stored runs
+    python benchmarks/emu_wuguang.py --resolution                 # exact front vs speed nodes
 
 Interrupting loses only the runs in flight; the next start runs the missing ones. The main
 study runs seed by seed, so an interrupted study still holds as many runs of each algorithm.
@@ -121,8 +125,8 @@ def make_study(name: str, encodings, seeds, budget: int, pop_size: int = POP_SIZ
 
 EXACT_TIMES_S = (990.0, 995.0, 1000.0, 1010.0, 1020.0, 1030.0, 1040.0, 1050.0, 1060.0, 1070.0, 1080.0, 1095.0,
                  1110.0)
-# 4x the solver's default speed nodes: with the default 200 the front moves by up to 0.15 % between
-# refinements on this 47.6 km line, as much as the optimisers' fronts differ from it (see the report)
+# 4x the solver's default speed nodes: the older solver's front moved by up to 0.15 % between 200,
+# 400 and 800 nodes on this 47.6 km line; the current one's by under 0.01 % (--resolution)
 EXACT_N_SPEEDS = 800
 
 
@@ -142,6 +146,51 @@ def exact_front(path: Path, times_s=EXACT_TIMES_S, profile_path: Path | None = N
 
     redo = [case.planned_time_s] if profile_path is not None and not profile_path.exists() else []
     return exact_points(case, times_s, path, n_speeds=n_speeds, redo_s=redo, on_run=keep_profile)
+
+
+RESOLUTION_N_SPEEDS = (200, 400, 800)
+RESOLUTION_TIMES_S = (1050.0, 1060.0, 1100.0)  # the planned time, and two on the front
+
+
+def resolution(results, n_speeds=RESOLUTION_N_SPEEDS, times_s=RESOLUTION_TIMES_S, front_times_s=EXACT_TIMES_S):
+    """How the exact front moves with the solver's speed nodes, and where the stored fronts lie against it.
+
+    For each number of speed nodes, ``pymoo_rail.optimal.ReferenceAtTime`` solves the optimum at
+    exactly ``times_s`` (with its certificate) and at ``front_times_s``; each run's feasible front
+    in ``results`` is compared with that front, interpolated between its points, as the report
+    compares it with the exact front (:func:`gap_to_exact`). The lowest member of each problem is
+    then solved at its own running time too. Returns one row per number of nodes: the energies
+    and certificates at ``times_s``, the CPU seconds of the solves, and per problem the lowest
+    member's gap (%) to the interpolated front and to the optimum at its own time.
+    """
+    import pandas as pd
+
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.indicators.energy import energy_gap
+    from pymoo_rail.optimal import ReferenceAtTime
+
+    case = load_case(CASE)
+    rows = []
+    for n in n_speeds:
+        cpu0 = time.process_time()
+        ref = ReferenceAtTime(case, n_speeds=int(n))
+        row = {"speed nodes": int(n)}
+        for t in times_s:
+            at = ref.at(t)
+            row[f"E({t:g} s) kWh"] = at["optimal_kwh"]
+            row[f"certificate {t:g} s kWh"] = at["energy_bound_kwh"]
+        front = pd.DataFrame({"running_time_s": front_times_s,
+                              "energy_kwh": [ref.at(t)["optimal_kwh"] for t in front_times_s]})
+        for problem, group in results.groupby("problem", sort=False):
+            points = pd.concat([energy_gap(run["F"][run["CV"] <= 0][:, ::-1], front)["points"]
+                                for _, run in group.iterrows()], ignore_index=True)
+            lowest = points.loc[points["gap_rel"].idxmin()]
+            own = ref.at(lowest["running_time_s"])["optimal_kwh"]
+            row[f"lowest {problem} %"] = 100 * lowest["gap_rel"]
+            row[f"same at own time {problem} %"] = 100 * (lowest["energy_kwh"] / own - 1)
+        row["solve CPU s"] = time.process_time() - cpu0
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
 def most_punctual(F: np.ndarray, planned_time_s: float) -> int:
@@ -195,6 +244,7 @@ def analyse(results, problems_by_label: dict, verify: bool = True, exact=None):
         planned = problem.case.planned_time_s
         row = {"problem": run["problem"], "algorithm": run["algorithm"], "seed": int(run["seed"]),
                "n_eval": int(run["n_eval"]), "n_gen": int(run["n_gen"]), "wall_time_s": float(run["wall_time_s"]),
+               "cpu_time_s": float(run.get("cpu_time_s", np.nan)),
                "n_points": len(F), "n_infeasible": int((~feasible).sum()),
                "hv_ref": run["hv_ref"], "igd_ref": run["igd_ref"], "gd_ref": run["gd_ref"],
                "gd_seed": gd_seed(F, refs[run["problem"]]) if len(F) else np.nan,
@@ -433,7 +483,8 @@ TABLE4 = [("points in the front", "n_points"), ("SP (Schott, kWh and s)", "spaci
           ("largest energy gap to the exact front (%)", "gap_max_pct"),
           ("smallest energy gap to the exact front (%)", "gap_min_pct"),
           ("HV / HV of the exact front", "hv_ratio_exact"), ("evaluations", "n_eval"),
-          ("generations", "n_gen"), ("wall time (s)", "wall_time_s")]
+          ("generations", "n_gen"), ("wall time (s)", "wall_time_s"),
+          ("CPU time (s)", "cpu_time_s")]
 SEED_KEYS = {"spacing": "sp", "gd_seed": "gd", "t_max": "t_max", "t_min": "t_min", "e_max": "e_max", "e_min": "e_min"}
 TESTED = (("hv_ref", False), ("igd_ref", True), ("gd_ref", True), ("gd_seed", True), ("spacing", True),
           ("gap_mean_pct", True), ("hv_ratio_exact", False), ("e_at_plan", True), ("punctual_e", True),
@@ -712,8 +763,11 @@ def main(argv=None) -> int:
     parser.add_argument("--prefix", default="emu_wuguang")
     parser.add_argument("--report-only", action="store_true", help="analyse the stored runs only")
     parser.add_argument("--no-exact", action="store_true",
-                        help="leave out the exact front of pymoo_rail.optimal (about 1-2 min per running time)")
+                        help="leave out the exact front of pymoo_rail.optimal (13 solves at 800 speed nodes, cached)")
     parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--resolution", action="store_true",
+                        help="print how the exact front moves with the speed nodes (200/400/800 at 1050, 1060 "
+                             "and 1100 s) and the stored main-study fronts' lowest member against each; no report")
     args = parser.parse_args(argv)
     if args.encodings[0] != MAIN_ENCODING:
         parser.error(f"--encodings: the first encoding must be {MAIN_ENCODING!r} (figs. 10-12 are drawn on it)")
@@ -725,6 +779,11 @@ def main(argv=None) -> int:
     main_study = make_study("emu_wuguang", args.encodings, range(1, args.seeds + 1), args.budget, args.pop_size,
                             args.local_size)
     enc_dir, main_dir = args.work / "encodings", args.work / "main"
+    if args.resolution:
+        from benchmarks.optimal import markdown
+
+        print(markdown(resolution(load_results(main_dir, study=main_study))), flush=True)
+        return 0
     if not args.report_only:
         t0 = time.perf_counter()
         for study, directory in ((enc_study, enc_dir), (main_study, main_dir)):
