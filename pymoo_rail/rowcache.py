@@ -62,6 +62,36 @@ def _stamp() -> str:
     return dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%S.%fZ")
 
 
+def set_aside(path: str | Path, reason: str, consequence: str, stacklevel: int = 2) -> Path | None:
+    """Move an untrustworthy cache file to ``<file>.corrupt-<UTC time>`` and warn, naming both.
+
+    Parameters
+    ----------
+    path : str or Path
+        The cache file.
+    reason : str
+        What is wrong with it (goes into the :class:`CorruptCacheWarning`).
+    consequence : str
+        What the caller does instead, e.g. "its rows will be computed again".
+    stacklevel : int
+        Frames above the caller of this function that the warning points at (2: the caller's caller).
+
+    Returns
+    -------
+    Path or None
+        Where the file went; None when it had already gone (another process moved it).
+    """
+    path = Path(path)
+    target = path.with_name(f"{path.name}.corrupt-{_stamp()}")
+    try:
+        os.replace(path, target)
+    except FileNotFoundError:
+        return None
+    warnings.warn(f"{path}: {reason}; moved to {target.name}, {consequence}", CorruptCacheWarning,
+                  stacklevel=stacklevel + 1)
+    return target
+
+
 class RowCache:
     """Rows of a CSV file served by key, added under a lock and written atomically.
 
@@ -118,13 +148,7 @@ class RowCache:
         return table, None
 
     def _set_aside(self, reason: str) -> None:
-        target = self.path.with_name(f"{self.path.name}.corrupt-{_stamp()}")
-        try:
-            os.replace(self.path, target)
-        except FileNotFoundError:
-            return
-        warnings.warn(f"{self.path}: {reason}; moved to {target.name}, its rows will be computed again",
-                      CorruptCacheWarning, stacklevel=3)
+        set_aside(self.path, reason, "its rows will be computed again", stacklevel=3)
 
     def _read_locked(self) -> pd.DataFrame:
         table, problem = self._parse()
@@ -186,4 +210,4 @@ class RowCache:
         return table
 
 
-__all__ = ["RowCache", "CorruptCacheWarning", "row_key", "KEY_COLUMN"]
+__all__ = ["RowCache", "CorruptCacheWarning", "row_key", "set_aside", "KEY_COLUMN"]

@@ -44,6 +44,7 @@ from pymoo_rail import __version__
 from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import Case, case_to_dict
+from pymoo_rail.rowcache import set_aside
 
 FRONT_VERSION = "6"
 """Version of the front computation; bump it when the solver (with
@@ -230,11 +231,18 @@ class CertifiedFront:
     def read_csv(cls, path: str | Path) -> CertifiedFront:
         """Read a front written by :meth:`to_csv_text` (raises ValueError naming the file if malformed)."""
         path = Path(path)
+        if not path.read_bytes().endswith(b"\n"):
+            raise ValueError(f"{path}: its last line is cut off (an interrupted write)")
         meta, table = read_commented_csv(path)
         missing = [c for c in COLUMNS if c not in table.columns]
         needed = ("case_hash", "case_name", "planned_time_s", "dx_m", "certificate", "version")
         if missing or any(k not in meta for k in needed) or len(table) < 2:
             raise ValueError(f"{path}: not a certified front file (missing columns {missing} or header fields)")
+        for column in COLUMNS:
+            values = pd.to_numeric(table[column], errors="coerce").to_numpy(dtype=float)
+            if not np.isfinite(values).all():
+                row = int(np.argmax(~np.isfinite(values)))
+                raise ValueError(f"{path}: column '{column}' row {row}: {table[column].iloc[row]!r} is not a number")
         return cls(table, meta["case_hash"], meta["case_name"], float(meta["planned_time_s"]), float(meta["dx_m"]),
                    meta["certificate"], meta["version"])
 
@@ -347,6 +355,9 @@ def certified_front(case: Case, dx_m: float | None = None, n_times: int | None =
 
     A computed front is written to the user cache atomically (a reader never sees half a file),
     named ``<case name>-<key>.csv`` where the key is :func:`front_key` (content hash, step, nodes, version).
+    A cached file that cannot be read (damaged, not a number, another case's content) is moved aside
+    with a :class:`~pymoo_rail.rowcache.CorruptCacheWarning` naming it, and the front is computed
+    again; a damaged shipped front raises ``ValueError`` naming the file.
     """
     step = default_dx_m(case) if dx_m is None else float(dx_m)
     n_times = n_times or n_times_for(case)
@@ -354,11 +365,18 @@ def certified_front(case: Case, dx_m: float | None = None, n_times: int | None =
     if use_cache and key in _MEMORY:
         return _MEMORY[key]
     path = find_front(case, step, n_times) if use_cache else None
+    front = None
     if path is not None:
-        front = CertifiedFront.read_csv(path)
-        if front.case_hash != case_hash(case):
-            raise ValueError(f"{path}: front of case hash {front.case_hash[:16]}, not of this case's content")
-    else:
+        try:
+            front = CertifiedFront.read_csv(path)
+            if front.case_hash != case_hash(case):
+                raise ValueError(f"{path}: front of case hash {front.case_hash[:16]}, not of this case's content")
+        except ValueError as err:  # also pandas' parser errors and undecodable bytes
+            if path.parent == SHIPPED_DIR:
+                raise  # a damaged installation: recomputing would hide it
+            set_aside(path, str(err).removeprefix(f"{path}: "), "the front will be computed again")
+            front = None
+    if front is None:
         front = compute_front(case, step, n_times)
         safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in case.name)
         atomic_write_text(cache_dir() / f"{safe}-{key}.csv", front.to_csv_text())

@@ -113,3 +113,34 @@ def test_time_window_constraint(cache, metro):
     out = problem.evaluate(x, return_as_dictionary=True)
     t = out["running_time_s"]
     assert np.allclose(out["G"][:, -1], np.maximum(75.0 - t, t - 90.0))
+
+
+@pytest.mark.parametrize("damage", ["not a number", "cut off"])
+def test_a_damaged_cached_front_is_set_aside_and_computed_again(cache, metro, damage, monkeypatch):
+    from pymoo_rail.rowcache import CorruptCacheWarning
+
+    ref.forget_fronts()
+    front = ref.certified_front(metro, n_times=5)
+    path = ref.find_front(metro, front.dx_m, 5)
+    text = path.read_text()
+    last = text.splitlines(keepends=True)[-1]
+    cells = last.split(",")
+    cells[2] = "x"  # energy_kwh of the last node
+    not_a_number = text[: len(text) - len(last)] + ",".join(cells)
+    path.write_text(not_a_number if damage == "not a number" else text[: len(text) - len(last) // 2])
+    ref.forget_fronts()
+    with pytest.warns(CorruptCacheWarning, match=f"{path.name}: .*moved to {path.name}.corrupt-"):
+        again = ref.certified_front(metro, n_times=5)
+    assert np.allclose(again.table.to_numpy(float), front.table.to_numpy(float), rtol=1e-9)
+    assert path.read_text() == text  # rewritten whole
+    assert len(list(path.parent.glob(f"{path.name}.corrupt-*"))) >= 1
+
+    # the same damage in a shipped front is an error naming the file, never a silent recompute
+    shipped = cache / "shipped"
+    shipped.mkdir(exist_ok=True)
+    (shipped / path.name).write_text(not_a_number)
+    monkeypatch.setattr(ref, "SHIPPED_DIR", shipped)
+    ref.forget_fronts()
+    with pytest.raises(ValueError, match=f"{path.name}: column 'energy_kwh'"):
+        ref.certified_front(metro, n_times=5)
+    ref.forget_fronts()
