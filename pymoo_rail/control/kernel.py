@@ -232,7 +232,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
     t_last = 0.0
     v = 0.0
     t = 0.0
-    reached = True
+    reached = n > 0  # a run-time True, not the literal: one compiled close_cell for every caller
     stop_pos = m.position_m[n - 1]
     count = 1
     n_noise = noise_ms.shape[0]

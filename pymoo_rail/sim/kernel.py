@@ -424,7 +424,7 @@ def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     v = m.initial_speed_ms
     row = n - n  # a run-time 0, not the literal: one compiled drive_cell for both loops
     hold_speed = -1.0
-    reached = True
+    reached = n > 0  # a run-time True, not the literal: one compiled close_cell for every caller
     stop_pos = m.position_m[n - 1]
     count = 1
     if record:
@@ -471,8 +471,8 @@ def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
     row_b = n - n
     hold_a = -1.0
     hold_b = -1.0
-    moving_a = True
-    moving_b = True
+    moving_a = n > 0  # run-time Trues, not literals: one compiled advance_run
+    moving_b = n > 0
     stop_a = m.position_m[n - 1]
     stop_b = m.position_m[n - 1]
     for i in range(n - 1):
