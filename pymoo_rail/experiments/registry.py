@@ -34,10 +34,10 @@ class UntrustedCodeError(StudyError):
     """A study or results folder names code to import (``"module:callable"``) and the caller did not trust it."""
 
 
-def _forwards(module: str, attribute: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """Mark a factory whose ``**params`` go to ``module.attribute`` (whose signature then checks them)."""
+def _forwards(module: str, *attributes: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Mark a factory whose ``**params`` go to ``module.attribute`` (whose signatures then check them)."""
     def mark(factory: Callable[..., Any]) -> Callable[..., Any]:
-        factory.forwards_to = (module, attribute)
+        factory.forwards_to = tuple((module, attribute) for attribute in attributes)
         return factory
 
     return mark
@@ -244,7 +244,7 @@ def _agemoea(problem, **params):
     return AGEMOEA(**params)
 
 
-@_forwards("pymoo.algorithms.soo.nonconvex.de", "DE")
+@_forwards("pymoo.algorithms.soo.nonconvex.de", "DE", "Variant")  # DE hands its keywords to its variant too
 def _de(problem, **params):
     from pymoo.algorithms.soo.nonconvex.de import DE
 
@@ -469,11 +469,15 @@ def accepted_parameters(target: Callable[..., Any]) -> frozenset[str] | None:
     forwards = getattr(target, "forwards_to", None)
     if forwards is None:
         return None
-    try:
-        inner = accepted_parameters(getattr(importlib.import_module(forwards[0]), forwards[1]))
-    except (ImportError, AttributeError):
-        return None
-    return None if inner is None else frozenset(names | inner)
+    for module, attribute in forwards:
+        try:
+            inner = accepted_parameters(getattr(importlib.import_module(module), attribute))
+        except (ImportError, AttributeError):
+            return None
+        if inner is None:
+            return None
+        names |= inner
+    return frozenset(names)
 
 
 def _add_parameters(names: set[str], function: Callable[..., Any]) -> bool:
