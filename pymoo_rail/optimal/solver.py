@@ -511,6 +511,16 @@ class OptimalSolver:
         return (parts["grid_kwh"] + parts["floor_kwh"]
                 + max(parts["moved_kwh"], parts["kept_regimes_kwh"], parts["untied_kwh"]))
 
+    def transition_tables(self) -> tuple:
+        """The DP's transitions of this solver's model (:func:`pymoo_rail.optimal.dp.transitions`), built once.
+
+        They do not depend on the price of time: a caller sweeping its own prices
+        (``dp.backward_sweep``, e.g. :class:`pymoo_rail.control.OptimalPolicy`) reuses them.
+        """
+        if self._tables is None:
+            self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
+        return self._tables
+
     def solves(self) -> list[_Solve]:
         """Every run this solver found at a price of time so far (``lambda_w``, ``time_s``, ``energy_j`` ...)."""
         return list(self._history)

@@ -403,14 +403,23 @@ class SpeedProfileProblem(Problem):
                     "front covers the planner's times: pass time_window_s='default' (or a (lo, hi) inside it)")
         return ""
 
-    def _calc_pareto_front(self, n_pareto_points: int = 100, *args, **kwargs):
-        """pymoo's hook: the certified front in this problem's objective space (or the constrained optimum)."""
+    def _calc_pareto_front(self, n_pareto_points: int | None = None, *args, **kwargs):
+        """pymoo's hook: the certified front in this problem's objective space (or the constrained optimum).
+
+        ``pareto_front()`` gives the front's nodes (its vertices) plus 100 evenly spaced points;
+        ``pareto_front(n_pareto_points=n)`` at most ``n`` evenly spaced points (fewer where some are
+        dominated). pymoo caches the first answer: pass ``use_cache=False`` to ask again with another ``n``.
+        """
         from pymoo_rail.problems import reference
 
         front = self.certified_front()
         if len(self.objectives) == 1:
             energy, _, _ = reference.constrained_optimum(front, self.time_tolerance_s, window_s=self.time_window_s)
             return np.array([[energy]])
+        if n_pareto_points is not None and (isinstance(n_pareto_points, bool)
+                                            or not isinstance(n_pareto_points, (int, np.integer))
+                                            or n_pareto_points < 2):
+            raise ValueError(f"n_pareto_points must be an integer >= 2 or None, got {n_pareto_points!r}")
         F, _ = reference.mirrored(front, self.objectives, n_pareto_points, self.time_window_s)
         return F
 
