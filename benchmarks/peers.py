@@ -149,8 +149,8 @@ def parse_mseetc_output(stdout: str) -> tuple[float, float]:
         energy, cpu = float(result["energy_kwh"]), float(result["cpu_s"])
     except (json.JSONDecodeError, KeyError, TypeError) as err:
         raise ValueError(f"ms-eetc's last line {lines[-1]!r} is not JSON with energy_kwh and cpu_s") from err
-    if not (energy > 0.0 and cpu > 0.0):
-        raise ValueError(f"ms-eetc's last line {lines[-1]!r}: energy_kwh and cpu_s must be > 0")
+    if not (math.isfinite(energy) and cpu > 0.0):  # net energy < 0 on a line that descends enough
+        raise ValueError(f"ms-eetc's last line {lines[-1]!r}: energy_kwh must be finite and cpu_s > 0")
     return energy, cpu
 
 
