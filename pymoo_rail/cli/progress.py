@@ -40,7 +40,7 @@ def ticking(description: str, disable: bool = False, delay_s: float = WAIT_DELAY
     def tick() -> None:
         while not stop.wait(1.0):
             if time.monotonic() - started >= delay_s:
-                bar.refresh()
+                bar.update(0)  # redraws the clock (and marks the line as shown, so close ends it)
 
     thread = threading.Thread(target=tick, name="pymoo-rail-ticking", daemon=True)
     thread.start()
@@ -50,5 +50,5 @@ def ticking(description: str, disable: bool = False, delay_s: float = WAIT_DELAY
         stop.set()
         thread.join()
         if time.monotonic() - started >= delay_s:
-            bar.refresh()
+            bar.update(0)
         bar.close()

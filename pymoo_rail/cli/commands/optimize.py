@@ -135,8 +135,8 @@ def _optimize(args, written: list[Path]) -> None:
         result = optimize_profile(problem, algorithm, ("n_gen", args.n_gen), seed=args.seed,
                                   callback=GenerationBar(bar), reference=False, penalty=penalty)
     written += _write_tables(result, out)
-    with ticking(f"exact reference: the certified optimal front of {case.name} (computed once per case and "
-                 "grid, then read from the cache) and the optimal run", disable=args.quiet):
+    with ticking(f"exact reference: certified front of {case.name} (once per case and grid, then cached)",
+                 disable=args.quiet):
         result = replace(result, optimum=optimum_at(problem, result.trajectory, reference=not args.no_reference))
     written += _write_figures(result, out, args.algorithm, args.seed)
     _report(result)
