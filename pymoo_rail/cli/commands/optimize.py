@@ -108,10 +108,15 @@ def _report(result) -> None:
     say(result.optimum.message)
 
 
-def _load_kernels(problem) -> None:
-    """Evaluate one decision and trace its run: a first run compiles the kernels here, before the bar."""
+def _load_kernels(problem, n_rows: int) -> None:
+    """Evaluate a population's worth of one decision and trace its run: a first run compiles here, before the bar.
+
+    ``n_rows`` as many as a generation evaluates, so the batch takes the same (serial or parallel) kernel.
+    """
+    import numpy as np
+
     x = (problem.xl + problem.xu) / 2.0
-    problem.evaluate(x[None, :])
+    problem.evaluate(np.repeat(x[None, :], n_rows, axis=0))
     problem.trajectory(x)
 
 
@@ -129,14 +134,14 @@ def _optimize(args, written: list[Path]) -> None:
     out = out_dir(args.out)
     say(f"{problem.describe()}\n{args.algorithm}, population {args.pop_size}, {args.n_gen} generations, "
         f"seed {args.seed}")
-    with ticking("loading the simulator", disable=args.quiet):
-        _load_kernels(problem)  # so that the bar's rate and ETA are the search's own
+    with ticking("preparing the simulator", disable=args.quiet):
+        _load_kernels(problem, args.pop_size)  # so that the bar's rate and ETA are the search's own
     with tqdm(total=args.n_gen, desc=f"optimize {case.name}", unit="gen", disable=args.quiet) as bar:
         result = optimize_profile(problem, algorithm, ("n_gen", args.n_gen), seed=args.seed,
                                   callback=GenerationBar(bar), reference=False, penalty=penalty)
     written += _write_tables(result, out)
-    with ticking(f"exact reference: certified front of {case.name} (once per case and grid, then cached)",
-                 disable=args.quiet):
+    with ticking(f"exact reference: the optimum at the chosen time, and the certified front of {case.name} if "
+                 "not yet cached", disable=args.quiet):
         result = replace(result, optimum=optimum_at(problem, result.trajectory, reference=not args.no_reference))
     written += _write_figures(result, out, args.algorithm, args.seed)
     _report(result)
