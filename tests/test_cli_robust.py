@@ -178,3 +178,24 @@ def test_optimize_says_what_a_first_run_compiles():
 
     assert COMPILE_NOTICE.startswith("compiling the simulator") and "first run only" in COMPILE_NOTICE
     assert "s of CPU" in COMPILE_NOTICE  # roughly how long (benchmarks/first_run.py)
+
+
+def test_a_small_job_runs_in_one_thread_and_gives_the_threads_back(capsys, tmp_path, monkeypatch):
+    # the parallel batch kernel costs more to compile than it saves on a small job; results are the same
+    import numba
+
+    from pymoo_rail.experiments import optimize
+
+    seen = []
+    real = optimize.minimize
+
+    def counting(*args, **kwargs):
+        seen.append(numba.get_num_threads())
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(optimize, "minimize", counting)
+    before = numba.get_num_threads()
+    code, _, err = run(capsys, "optimize", "yizhuang", "--pop-size", 8, "--n-gen", 2, "--no-reference",
+                       "--out", tmp_path, "-q")
+    assert code == 0, err
+    assert seen == [1] and numba.get_num_threads() == before

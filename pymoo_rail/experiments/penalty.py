@@ -10,8 +10,9 @@ violations), as :func:`pymoo_rail.experiments.optimize.optimize_profile` does.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
-from pymoo.algorithms.moo.moead import MOEAD
 from pymoo.constraints.as_penalty import ConstraintsAsPenalty
 from pymoo.core.individual import calc_cv
 
@@ -52,4 +53,6 @@ class PenalisedConstraints(ConstraintsAsPenalty):
 
 def handles_constraints(algorithm) -> bool:
     """False for an algorithm that refuses constrained problems: pymoo's MOEA/D (it asserts on them)."""
-    return not isinstance(algorithm, MOEAD)
+    # not imported, no instance of it exists: the main job does not pay for importing MOEA/D
+    moead = sys.modules.get("pymoo.algorithms.moo.moead")
+    return moead is None or not isinstance(algorithm, moead.MOEAD)

@@ -7,7 +7,9 @@ calls it, writes the files and prints.
 from __future__ import annotations
 
 import textwrap
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Iterator
 
 from pymoo_rail.cli.arguments import add_command, count, out_dir, say
 from pymoo_rail.cli.case_options import add_case_arguments, case_from_args
@@ -108,6 +110,30 @@ def _report(result) -> None:
     say(result.optimum.message)
 
 
+SERIAL_MAX_CELLS = 50_000_000
+"""Below this many simulated cells (population x generations x grid nodes) a run uses one thread.
+
+At about 14 ns per cell (``benchmarks/throughput.py``) that is under a second of simulation,
+while compiling the parallel batch kernel costs about 6 s of CPU on a first run
+(``benchmarks/compile_profile.py`` with and without ``NUMBA_NUM_THREADS=1``); results are the same.
+"""
+
+
+@contextmanager
+def _threads_for(problem, args) -> Iterator[None]:
+    """One Numba thread for a small job (see :data:`SERIAL_MAX_CELLS`), the machine's otherwise."""
+    import numba
+
+    cells = args.pop_size * args.n_gen * problem.simulator.grid.n_nodes
+    before = numba.get_num_threads()
+    if cells < SERIAL_MAX_CELLS:
+        numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
+
+
 def _load_kernels(problem, n_rows: int) -> None:
     """Evaluate a population's worth of one decision and trace its run: a first run compiles here, before the bar.
 
@@ -134,11 +160,12 @@ def _optimize(args, written: list[Path]) -> None:
     out = out_dir(args.out)
     say(f"{problem.describe()}\n{args.algorithm}, population {args.pop_size}, {args.n_gen} generations, "
         f"seed {args.seed}")
-    with ticking("preparing the simulator", disable=args.quiet):
-        _load_kernels(problem, args.pop_size)  # so that the bar's rate and ETA are the search's own
-    with tqdm(total=args.n_gen, desc=f"optimize {case.name}", unit="gen", disable=args.quiet) as bar:
-        result = optimize_profile(problem, algorithm, ("n_gen", args.n_gen), seed=args.seed,
-                                  callback=GenerationBar(bar), reference=False, penalty=penalty)
+    with _threads_for(problem, args):
+        with ticking("preparing the simulator", disable=args.quiet):
+            _load_kernels(problem, args.pop_size)  # so that the bar's rate and ETA are the search's own
+        with tqdm(total=args.n_gen, desc=f"optimize {case.name}", unit="gen", disable=args.quiet) as bar:
+            result = optimize_profile(problem, algorithm, ("n_gen", args.n_gen), seed=args.seed,
+                                      callback=GenerationBar(bar), reference=False, penalty=penalty)
     written += _write_tables(result, out)
     with ticking(f"exact reference: the optimum at the chosen time, and the certified front of {case.name} if "
                  "not yet cached", disable=args.quiet):
