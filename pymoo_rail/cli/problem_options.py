@@ -33,8 +33,17 @@ def add_problem_arguments(p: argparse.ArgumentParser) -> None:
                    help="running-time window constraint LO HI in seconds; 'default' (the minimum running time "
                         "to 1.3 x planned, where the certified optimal front is known: the times a timetable "
                         "planner uses) or 'none'; applies to running_time / time_error fronts")
+    add_grid_argument(p)
     p.add_argument("--no-reference", action="store_true",
                    help="skip the certified optimal front, the optimal profile and the gap to the optimum")
+
+
+def add_grid_argument(p: argparse.ArgumentParser) -> None:
+    """``--dx M``: the position step of the simulation and of the exact reference."""
+    p.add_argument("--dx", type=positive_float, default=None, metavar="M",
+                   help="position step of the simulation grid and of the exact reference, in m (default: the "
+                        "case's, 1 m on metro lines); a finer step lets the exact reference meet running times "
+                        "a coarse grid jumps over")
 
 
 def _objectives(values: Sequence[str]) -> tuple[str, ...]:
@@ -93,6 +102,8 @@ def problem_from_args(case, args):
               "time_tolerance_s": time_tolerance_s, "time_window_s": _time_window(args, objectives)}
     if args.n_sections is not None:
         kwargs["n_sections"] = args.n_sections
+    if args.dx is not None:
+        kwargs["dx_m"] = args.dx
     if args.weights is not None:
         kwargs["weights"] = args.weights
     try:
@@ -104,13 +115,30 @@ def problem_from_args(case, args):
 
 
 def algorithm_from_args(problem, args):
-    """The pymoo algorithm of ``--algorithm`` and ``--pop-size`` for ``problem``."""
-    from pymoo_rail.experiments.registry import build_algorithm
+    """The pymoo algorithm of ``--algorithm`` and ``--pop-size`` for ``problem``, and its constraint penalty.
+
+    Returns
+    -------
+    (Algorithm, float or None)
+        The algorithm, and the penalty for ``optimize_profile`` when the algorithm has no
+        constraint handling (MOEA/D) and the problem has constraints (the user is told), else None.
+    """
+    from pymoo_rail.experiments.penalty import DEFAULT_PENALTY, handles_constraints
+    from pymoo_rail.experiments.registry import ALGORITHMS, build_algorithm, canonical_name
     from pymoo_rail.experiments.spec import AlgorithmSpec, StudyError
 
     try:
-        return build_algorithm(AlgorithmSpec(args.algorithm, {"pop_size": args.pop_size}), problem)
+        algorithm = build_algorithm(AlgorithmSpec(args.algorithm, {"pop_size": args.pop_size}), problem)
     except StudyError as err:
         raise UsageError("--algorithm", f"{args.algorithm!r}: {err.reason}") from None
     except ValueError as err:
         raise UsageError("--pop-size", f"{args.pop_size} with {args.algorithm}: {err}") from None
+    if handles_constraints(algorithm) or not problem.has_constraints():
+        return algorithm, None
+    others = [name for name, entry in ALGORITHMS.items()
+              if entry.objectives != "single" and name != canonical_name(args.algorithm)]
+    say(f"{args.algorithm} has no constraint handling (pymoo's {type(algorithm).__name__}): the problem's "
+        f"{problem.n_ieq_constr} constraints are added to every objective as a penalty ({DEFAULT_PENALTY:g} per "
+        f"unit of violation), and the front is reported with its true objectives and violations; "
+        f"{', '.join(others)} handle the constraints themselves")
+    return algorithm, DEFAULT_PENALTY
