@@ -108,19 +108,6 @@ class PacedTrain:
         return coop.clocked_run(self.simulator.model, self.simulator.run(program), departure_s, self.start_m)
 
 
-def check_vectors(X, n_var: int, names=None) -> np.ndarray:
-    """Decision vectors (N, n_var) as floats; a ``ValueError`` naming the first bad entry (by ``names``)."""
-    X = np.atleast_2d(np.asarray(X, dtype=float))
-    if X.ndim != 2 or X.shape[1] != n_var:
-        raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {n_var}")
-    bad = np.argwhere(~np.isfinite(X))
-    if bad.size:
-        r, c = (int(i) for i in bad[0])
-        name = names[c] if names is not None else c
-        raise ValueError(f"decision vector {r}, variable {name} = {X[r, c]}: must be finite")
-    return X
-
-
 @dataclass(frozen=True, eq=False)
 class CooperativeSolution:
     """A decoded decision vector: both runs, the shared energy and the constraint values."""

@@ -5,7 +5,7 @@ import pytest
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.control import PID, Disturbance, draw_disturbances, track, track_disturbed
-from pymoo_rail.control.tuning import ControllerTuningProblem, controller_from_gains
+from pymoo_rail.problems.controller_tuning import ControllerTuningProblem, controller_from_gains
 from pymoo_rail.sim import Simulator
 
 
