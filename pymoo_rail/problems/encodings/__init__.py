@@ -24,13 +24,15 @@ import dataclasses
 import importlib
 from typing import Any
 
-REGISTRY: dict[str, tuple[str, str]] = {
-    "speed_codes": ("speed_codes", "SpeedCodes"),
-    "switching_points": ("switching_points", "SwitchingPoints"),
-    "braking_onset": ("braking_onset", "BrakingOnset"),
-    "paced_speed_codes": ("paced_codes", "PacedCodes"),
+REGISTRY: dict[str, tuple[str, str, str]] = {
+    "speed_codes": ("speed_codes", "SpeedCodes", "a target speed per section (km/h)"),
+    "switching_points": ("switching_points", "SwitchingPoints", "the positions where a regime sequence switches (m)"),
+    "braking_onset": ("braking_onset", "BrakingOnset",
+                      "phases, the braking onset (m) and the deceleration (m/s^2): a live stop error"),
+    "paced_speed_codes": ("paced_codes", "PacedCodes",
+                          "speed-code shapes (share of each limit), then the running time (s): on time"),
 }
-"""Encoding name -> (module of this package, class)."""
+"""Encoding name -> (module of this package, class, one line for help texts)."""
 
 ENCODINGS = tuple(REGISTRY)
 """Encoding names of ``SpeedProfileProblem``."""
@@ -41,9 +43,10 @@ BOUND_FIELDS = ("boundaries_m", "xl", "xu", "coast_points", "length_m", "platfor
 # the other public names of the modules, loaded on first use (see ``__getattr__``)
 _MODULE_OF = {"overrun_case": "braking_onset", "sparse_code_floor_kmh": "speed_codes", "PARTITIONS": "speed_codes",
               "EncodingSetup": "base", "Encoding": "base", "ProgramEncoding": "base", "Runner": "base",
-              "decision_columns": "base", **{cls: module for module, cls in REGISTRY.values()}}
+              "decision_columns": "base", **{cls: module for module, cls, _ in REGISTRY.values()}}
 
-__all__ = ["REGISTRY", "ENCODINGS", "BOUND_FIELDS", "encoding_names", "encoding_class", "encoding_settings",
+__all__ = ["REGISTRY", "ENCODINGS", "BOUND_FIELDS", "encoding_names", "encodings_help", "encoding_class",
+           "encoding_settings",
            "make_encoding", "resolve_encoding",
            *_MODULE_OF]
 
@@ -63,8 +66,13 @@ def encoding_class(name: str) -> type:
     """
     if name not in REGISTRY:
         raise ValueError(f"encoding = {name!r} is unknown (known: {', '.join(ENCODINGS)})")
-    module, cls = REGISTRY[name]
+    module, cls, _ = REGISTRY[name]
     return getattr(importlib.import_module(f"{__name__}.{module}"), cls)
+
+
+def encodings_help() -> str:
+    """One line per encoding, ``name: meaning``, for help texts."""
+    return "\n".join(f"{name}: {meaning}" for name, (_, _, meaning) in REGISTRY.items())
 
 
 def encoding_settings(name: str) -> tuple[str, ...]:
