@@ -6,7 +6,7 @@ or the encoding names (:mod:`pymoo_rail.problems.encodings`) costs neither Numba
 
 from __future__ import annotations
 
-import importlib
+from pymoo_rail.problems.lazy import lazy_names
 
 # public name -> module of this package that defines it
 _MODULE_OF = {
@@ -27,11 +27,4 @@ _MODULE_OF = {
 __all__ = list(_MODULE_OF)
 
 
-def __getattr__(name: str):
-    if name in _MODULE_OF:
-        return getattr(importlib.import_module(f"{__name__}.{_MODULE_OF[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(__all__)
+__getattr__, __dir__ = lazy_names(__name__, _MODULE_OF, __all__)

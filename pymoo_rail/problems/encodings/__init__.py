@@ -24,6 +24,8 @@ import dataclasses
 import importlib
 from typing import Any
 
+from pymoo_rail.problems.lazy import lazy_names
+
 REGISTRY: dict[str, tuple[str, str, str]] = {
     "speed_codes": ("speed_codes", "SpeedCodes", "a target speed per section (km/h)"),
     "switching_points": ("switching_points", "SwitchingPoints", "the positions where a regime sequence switches (m)"),
@@ -139,11 +141,4 @@ def _same(a: Any, b: Any) -> bool:
     return a is b or (isinstance(a, (str, int, float)) and isinstance(b, (str, int, float)) and a == b)
 
 
-def __getattr__(name: str):
-    if name in _MODULE_OF:
-        return getattr(importlib.import_module(f"{__name__}.{_MODULE_OF[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(__all__)
+__getattr__, __dir__ = lazy_names(__name__, _MODULE_OF, __all__)
