@@ -244,8 +244,8 @@ class SpeedProfileProblem(Problem):
                  tracking=None, control_period_s: float = 0.2, time_window_s=None, integer_codes: bool = False,
                  decel_range_ms2: tuple[float, float] | None = None, **kwargs):
         objectives = check_objectives(objectives)
-        encoding = resolve_encoding(encoding, ENCODING_SETTINGS, partition=partition, n_sections=n_sections, max_section_m=max_section_m,
-                                    floor_kmh=floor_kmh, integer_codes=integer_codes,
+        encoding = resolve_encoding(encoding, ENCODING_SETTINGS, partition=partition, n_sections=n_sections,
+                                    max_section_m=max_section_m, floor_kmh=floor_kmh, integer_codes=integer_codes,
                                     regimes=tuple(regimes) if regimes is not None else None,
                                     decel_range_ms2=decel_range_ms2)
         if time_tolerance_s is not None and not (np.isfinite(time_tolerance_s) and time_tolerance_s > 0):
