@@ -1,15 +1,14 @@
-"""Speed codes: one target speed (km/h) per section of the line (Liu (2019) 4.3.3).
+"""Speed codes: one target speed (km/h) per section of a partition of the line (Liu (2019) 4.3.3).
 
-``SpeedCodes``: one target speed (km/h) per section of a partition of the line (Liu (2019)
-  4.3.3): ``"gradient_limit"`` cuts at every gradient, limit and neutral-section change (the
-  non-equal partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``;
-  ``"equal"`` cuts ``n_sections`` equal pieces (fig. 4-3). Bounds run from a floor to the highest
-  limit in the section; sections inside a neutral section are fixed at the floor (coasting).
-  On long sparse lines (sections averaging more than 2 km, ``max_section_m`` not given) each
-  section also gets a coasting point (m): the train heads for its code up to that point and coasts
-  from there to the section's end, so one section holds the optimal structure of a long stretch
-  (reach a speed, hold it, coast into the next limit or the stop) with two variables. There the
-  codes start at the planned mean speed (:func:`sparse_code_floor_kmh`), not at ``floor_kmh``.
+``"gradient_limit"`` cuts at every gradient, limit and neutral-section change (the non-equal
+partition of fig. 4-4), optionally splitting sections longer than ``max_section_m``; ``"equal"``
+cuts ``n_sections`` equal pieces (fig. 4-3). Bounds run from a floor to the highest limit in the
+section; sections inside a neutral section are fixed at the floor (coasting). On long sparse lines
+(sections averaging more than 2 km, ``max_section_m`` not given) each section also gets a coasting
+point (m): the train heads for its code up to that point and coasts from there to the section's
+end, so one section holds the optimal structure of a long stretch (reach a speed, hold it, coast
+into the next limit or the stop) with two variables. There the codes start at the planned mean
+speed (:func:`sparse_code_floor_kmh`), not at ``floor_kmh``.
 
 Speed codes can be integers (``integer_codes=True``: whole km/h, as the on-board codes of Liu (2019)),
 for pymoo's integer operators.
