@@ -13,7 +13,7 @@ and :meth:`ProgramEncoding.trajectory`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Protocol, runtime_checkable
+from typing import ClassVar, Protocol
 
 import numpy as np
 
@@ -49,7 +49,6 @@ class EncodingSetup:
     time_range_s: tuple[float, float] = (-np.inf, np.inf)
 
 
-@runtime_checkable
 class Runner(Protocol):
     """Runs kernel programs: :class:`~pymoo_rail.sim.Simulator`, or a tracker behind the same two calls."""
 
@@ -60,7 +59,6 @@ class Runner(Protocol):
         """The trajectory of one program."""
 
 
-@runtime_checkable
 class Encoding(Protocol):
     """The protocol of an encoding (see the module docstring); :class:`ProgramEncoding` implements most of it."""
 
