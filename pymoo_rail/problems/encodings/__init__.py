@@ -39,18 +39,13 @@ REGISTRY: dict[str, tuple[str, str, str]] = {
 ENCODINGS = tuple(REGISTRY)
 """Encoding names of ``SpeedProfileProblem``."""
 
-BOUND_FIELDS = ("boundaries_m", "xl", "xu", "coast_points", "length_m", "platform_m", "simulator", "codes")
-"""Fields an encoding sets when it is bound to a case: not settings."""
-
 # the other public names of the modules, loaded on first use (see ``__getattr__``)
 _MODULE_OF = {"overrun_case": "braking_onset", "sparse_code_floor_kmh": "speed_codes", "PARTITIONS": "speed_codes",
               "EncodingSetup": "base", "Encoding": "base", "ProgramEncoding": "base", "Runner": "base",
               "decision_columns": "base", **{cls: module for module, cls, _ in REGISTRY.values()}}
 
-__all__ = ["REGISTRY", "ENCODINGS", "BOUND_FIELDS", "encoding_names", "encodings_help", "encoding_class",
-           "encoding_settings",
-           "make_encoding", "resolve_encoding",
-           *_MODULE_OF]
+__all__ = ["REGISTRY", "ENCODINGS", "encoding_names", "encodings_help", "encoding_class", "encoding_settings",
+           "make_encoding", "resolve_encoding", *_MODULE_OF]
 
 
 def encoding_names() -> tuple[str, ...]:
@@ -79,7 +74,9 @@ def encodings_help() -> str:
 
 def encoding_settings(name: str) -> tuple[str, ...]:
     """The settings an encoding takes (its fields you may give, e.g. ``partition`` for speed codes)."""
-    return tuple(f.name for f in dataclasses.fields(encoding_class(name)) if f.init and f.name not in BOUND_FIELDS)
+    from pymoo_rail.problems.encodings.base import is_setting  # base loads the simulator: only when needed
+
+    return tuple(f.name for f in dataclasses.fields(encoding_class(name)) if is_setting(f))
 
 
 def make_encoding(name: str, defaults: dict[str, Any] | None = None, **settings) -> Any:

@@ -12,8 +12,8 @@ and :meth:`ProgramEncoding.trajectory`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import ClassVar, Protocol
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
@@ -22,6 +22,16 @@ from pymoo_rail.sim import Simulator, Trajectory
 
 COLUMN_SUFFIXES = {"km/h": "kmh", "m/s^2": "ms2", "1": "share"}
 """Unit -> suffix of a table column (``x3_kmh``): units with characters a column name avoids."""
+
+
+def bound_field(default: Any = None) -> Any:
+    """A dataclass field that :meth:`Encoding.bind` sets (bounds, sections, a simulator): not a setting."""
+    return field(default=default, metadata={"bound": True})
+
+
+def is_setting(f) -> bool:
+    """Whether a dataclass field of an encoding is a setting a user gives (not set by binding)."""
+    return f.init and not f.metadata.get("bound", False)
 
 
 @dataclass(frozen=True)
@@ -97,8 +107,9 @@ class Encoding(Protocol):
 class ProgramEncoding:
     """The shared part of the encodings: bounds, a check that the encoding is bound, running through the runner.
 
-    A subclass is a frozen dataclass with ``xl`` and ``xu`` fields (``None`` until bound) and
-    implements ``bind``, ``programs`` and ``units``.
+    A subclass is a frozen dataclass whose settings are plain fields and whose ``xl``, ``xu`` and
+    other fields set by binding are :func:`bound_field` (``None`` until bound); it implements
+    ``bind``, ``programs`` and ``units``.
     """
 
     name: ClassVar[str] = ""

@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from pymoo_rail.model import Case, Line
-from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding
+from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding, bound_field
 from pymoo_rail.sim import Simulator, Trajectory, braking_programs
 from pymoo_rail.sim import kernel as k
 
@@ -75,10 +75,10 @@ class BrakingOnset(ProgramEncoding):
     regimes: tuple[str, ...] | None = None
     decel_range_ms2: tuple[float, float] | None = None
     overrun_m: float = 20.0
-    platform_m: float | None = None
-    simulator: Simulator | None = None
-    xl: np.ndarray | None = None
-    xu: np.ndarray | None = None
+    platform_m: float | None = bound_field()
+    simulator: Simulator | None = bound_field()
+    xl: np.ndarray | None = bound_field()
+    xu: np.ndarray | None = bound_field()
 
     name = "braking_onset"
 

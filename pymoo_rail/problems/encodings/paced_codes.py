@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding
+from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding, bound_field
 from pymoo_rail.problems.encodings.speed_codes import SpeedCodes
 from pymoo_rail.sim import Simulator
 from pymoo_rail.sim.pacing import DEFAULT_TIME_TOL_S, PacedRuns, PacedSpeedCodes, section_limits_ms, solve_pace
@@ -56,10 +56,10 @@ class PacedCodes(ProgramEncoding):
     max_section_m: float | None = None
     floor_kmh: float = 10.0
     time_tol_s: float = DEFAULT_TIME_TOL_S
-    codes: PacedSpeedCodes | None = None
-    simulator: Simulator | None = None
-    xl: np.ndarray | None = None
-    xu: np.ndarray | None = None
+    codes: PacedSpeedCodes | None = bound_field()
+    simulator: Simulator | None = bound_field()
+    xl: np.ndarray | None = bound_field()
+    xu: np.ndarray | None = bound_field()
 
     name = "paced_speed_codes"
     # every run lands on the platform through the braking envelope

@@ -22,7 +22,7 @@ import numpy as np
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case
-from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding
+from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding, bound_field
 from pymoo_rail.sim import equal_partition, gradient_limit_partition, speed_code_programs
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.pacing import split_long_sections
@@ -90,10 +90,10 @@ class SpeedCodes(ProgramEncoding):
     max_section_m: float | None = None
     floor_kmh: float = 10.0
     integer_codes: bool = False
-    boundaries_m: np.ndarray | None = None
-    xl: np.ndarray | None = None
-    xu: np.ndarray | None = None
-    coast_points: bool = False
+    boundaries_m: np.ndarray | None = bound_field()
+    xl: np.ndarray | None = bound_field()
+    xu: np.ndarray | None = bound_field()
+    coast_points: bool = bound_field(False)
 
     name = "speed_codes"
     # every run lands on the platform through the braking envelope

@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding
+from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding, bound_field
 from pymoo_rail.sim import switching_programs
 
 
@@ -29,9 +29,9 @@ class SwitchingPoints(ProgramEncoding):
     """
 
     regimes: tuple[str, ...] | None = None
-    length_m: float | None = None
-    xl: np.ndarray | None = None
-    xu: np.ndarray | None = None
+    length_m: float | None = bound_field()
+    xl: np.ndarray | None = bound_field()
+    xu: np.ndarray | None = bound_field()
 
     name = "switching_points"
 
