@@ -440,7 +440,8 @@ def check_trust(study: Study, trusted: bool) -> None:
 
 # pymoo's base classes take **kwargs and drop what they do not know: a keyword that reaches them
 # unused is a mistake, not an extension point
-_DROPPING_BASES = {("pymoo.core.algorithm", "Algorithm"), ("pymoo.core.problem", "Problem")}
+_DROPPING_BASES = {("pymoo.core.algorithm", "Algorithm"), ("pymoo.core.problem", "Problem"),
+                   ("pymoo.core.infill", "InfillCriterion")}
 
 
 def accepted_parameters(target: Callable[..., Any]) -> frozenset[str] | None:
