@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -50,7 +51,8 @@ def case_path(name: str) -> Path:
     return path
 
 
-def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
+def load_case(name_or_path: str | Path, load: str | None = None, *,
+              allow_implausible: bool | Sequence[str] | None = None) -> Case:
     """Load a built-in case by name, or any case file by path.
 
     Parameters
@@ -60,14 +62,18 @@ def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
     load : str, optional
         A passenger load state of the case (``LOADS_T``), e.g. ``load_case("yizhuang", load="AW3")``:
         the train mass of that load, the rest of the case unchanged.
+    allow_implausible : bool or sequence of str, optional
+        Waive the plausibility bounds (``True``) or some kinds of them (``["gradient"]``) for a
+        research case; replaces the file's own ``allow_implausible`` key when given
+        (``docs/case-format.md``).
     """
     candidate = Path(name_or_path)
     if candidate.suffix == ".toml" or candidate.is_file():
         if not candidate.is_file():
             raise CaseError("path", str(candidate), "no such case file")
-        case = read_case(candidate)
+        case = read_case(candidate, allow_implausible=allow_implausible)
     else:
-        case = read_case(case_path(str(name_or_path)))
+        case = read_case(case_path(str(name_or_path)), allow_implausible=allow_implausible)
     return case if load is None else with_load(case, load)
 
 

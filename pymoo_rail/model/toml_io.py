@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
+
+import rtoml
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -18,7 +21,7 @@ from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
-_TOP = {"name", "source", "description", "run", "train", "line"}
+_TOP = {"name", "source", "description", "allow_implausible", "run", "train", "line"}
 _RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs", "initial_speed_kmh", "final_speed_kmh"}
 _LEG = {"start_m", "end_m", "planned_time_s", "dwell_s"}
 _TRAIN = {"name", "mass_t", "rotary_factor", "length_m", "max_speed_kmh", "max_accel_ms2", "max_decel_ms2",
@@ -67,6 +70,8 @@ def _list(value: Any, field: str, source: str) -> list:
 
 def _rows(value: Any, field: str, source: str) -> tuple[tuple, ...]:
     """An array of arrays (e.g. ``[[start_m, end_m, permille], ...]``), each checked to be an array."""
+    if isinstance(value, list) and all(type(row) is list for row in value):
+        return tuple(map(tuple, value))  # the usual case, at C speed for a line of a million rows
     return tuple(tuple(_list(row, f"{field}[{k}]", source)) for k, row in enumerate(_list(value, field, source)))
 
 
@@ -92,9 +97,16 @@ def _speed_ms(run: dict, key: str) -> float:
     return check_number(f"run.{key}", run.get(key, 0.0), nonneg=True) / KMH_PER_MS
 
 
-def case_from_dict(data: dict, source: str = "<dict>") -> Case:
-    """Build a :class:`Case` from the parsed TOML structure; every error names the field."""
+def case_from_dict(data: dict, source: str = "<dict>", *, allow_implausible: bool | Sequence[str] | None = None) -> Case:
+    """Build a :class:`Case` from the parsed TOML structure; every error names the field.
+
+    ``allow_implausible`` (``True``, or kinds of bound) replaces the file's own key when given:
+    see :class:`Case`.
+    """
     data = _table(data, "", _TOP, {"name", "run", "train", "line"}, source)
+    allow = data.get("allow_implausible", False) if allow_implausible is None else allow_implausible
+    if not isinstance(allow, (bool, list, tuple)):
+        raise CaseError("allow_implausible", allow, "must be true, false or an array of kinds of bound", source)
     run = _table(data["run"], "run", _RUN, {"planned_time_s"}, source)
     tr = _table(data["train"], "train", _TRAIN,
                 {"mass_t", "length_m", "max_speed_kmh", "resistance", "traction", "braking"}, source)
@@ -132,7 +144,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
                     train=train, line=line_obj, planned_time_s=run["planned_time_s"],
                     dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs,
                     initial_speed_ms=_speed_ms(run, "initial_speed_kmh"),
-                    final_speed_ms=_speed_ms(run, "final_speed_kmh"))
+                    final_speed_ms=_speed_ms(run, "final_speed_kmh"), allow_implausible=allow)
     except CaseError as err:
         if err.source is None:
             raise CaseError(err.field, err.value, err.reason, source) from None
@@ -141,15 +153,41 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
         raise CaseError("case", type(err).__name__, f"malformed value: {err}", source) from None
 
 
-def read_case(path: str | Path) -> Case:
-    """Read a case file."""
+_UTF8_BOM = b"\xef\xbb\xbf"
+_UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
+
+
+def parse_toml(raw: bytes, source: str) -> dict:
+    """The TOML document in ``raw``; every way it can fail is a :class:`CaseError` naming ``source``.
+
+    A UTF-8 byte-order mark (written by some Windows editors) is skipped; other encodings
+    (UTF-16, Latin-1) and binary files are named as such instead of a decoding traceback.
+    """
+    if raw.startswith(_UTF8_BOM):
+        raw = raw[len(_UTF8_BOM):]
+    if raw.startswith(_UTF16_BOMS):
+        raise CaseError("toml", source, "is UTF-16 text: save the file as UTF-8 (TOML files are UTF-8)", source)
+    if b"\x00" in raw:
+        raise CaseError("toml", source, "is a binary file (it holds NUL bytes), not a TOML text file", source)
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise CaseError("toml", source, f"is not UTF-8 text (byte {raw[err.start]:#04x} at offset {err.start}): "
+                                        "save the file as UTF-8; Latin-1 or another legacy encoding?", source) from None
+    try:  # rtoml (Rust) parses a million-row line ~3x faster than tomllib, and bounds the nesting depth
+        return rtoml.loads(text)
+    except rtoml.TomlParsingError as err:
+        raise CaseError("toml", source, f"is not valid TOML: {err}", source) from None
+
+
+def read_case(path: str | Path, *, allow_implausible: bool | Sequence[str] | None = None) -> Case:
+    """Read a case file (``allow_implausible`` as in :func:`case_from_dict`)."""
     path = Path(path)
     try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as err:
-        raise CaseError("toml", str(path), f"is not valid TOML: {err}", str(path)) from None
-    return case_from_dict(data, source=str(path))
+        raw = path.read_bytes()
+    except OSError as err:
+        raise CaseError("path", str(path), f"cannot be read: {err.strerror or err}", str(path)) from None
+    return case_from_dict(parse_toml(raw, str(path)), source=str(path), allow_implausible=allow_implausible)
 
 
 def _toml_value(value: Any) -> str:
@@ -213,16 +251,20 @@ def case_to_dict(case: Case) -> dict:
             "neutral_sections": [list(r) for r in ln.neutral_sections]}
     if ln.curve_model != "tang2020":  # the default stays out of the file (older files read the same)
         line["curve_model"] = ln.curve_model
-    return {"name": case.name, "source": case.source, "description": case.description, "run": run,
-            "train": train, "line": line}
+    out = {"name": case.name, "source": case.source, "description": case.description}
+    if case.allow_implausible:  # only when set: the files (and fingerprints) of other cases stay as they were
+        out["allow_implausible"] = case.allow_implausible if isinstance(case.allow_implausible, bool) \
+            else list(case.allow_implausible)
+    return {**out, "run": run, "train": train, "line": line}
 
 
 def write_case(case: Case, path: str | Path) -> Path:
     """Write a case file that :func:`read_case` reads back to an equal case."""
     data = case_to_dict(case)
     lines: list[str] = []
-    for key in ("name", "source", "description"):
-        lines.append(f"{key} = {_toml_value(data[key])}")
+    for key in ("name", "source", "description", "allow_implausible"):
+        if key in data:
+            lines.append(f"{key} = {_toml_value(data[key])}")
 
     def section(title: str, table: dict) -> None:
         lines.append(f"\n[{title}]")

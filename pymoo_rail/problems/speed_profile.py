@@ -216,6 +216,7 @@ class SpeedProfileProblem(Problem):
                  floor_kmh: float = 10.0, dx_m: float | None = None, tracking=None,
                  control_period_s: float = 0.2, time_window_s=None, integer_codes: bool = False,
                  decel_range_ms2: tuple[float, float] | None = None, **kwargs):
+        case = case.require_single_run(type(self).__name__)
         if isinstance(objectives, str):
             objectives = (objectives,)
         objectives = tuple(objectives)
