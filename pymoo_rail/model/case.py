@@ -11,6 +11,10 @@ from pymoo_rail.model.line import Line
 from pymoo_rail.model.plausibility import allowed_kinds, check_plausible
 from pymoo_rail.model.train import Train
 
+END_SPEED_TOL_MS = 0.01
+"""A simulated run meets the end speed asked for when it arrives within this of it (m/s), or of its
+window (``Case.end_speed_window_ms``); the exact solver lands on it exactly (docs/case-format.md)."""
+
 
 @dataclass(frozen=True)
 class Leg:
@@ -34,6 +38,11 @@ class Case:
     e.g. at a timing point of a journey or in a benchmark that fixes boundary speeds. Case files
     give them in km/h (``run.initial_speed_kmh``, ``run.final_speed_kmh``).
 
+    The final speed is the speed asked for at the end, not a ceiling: a run arriving slower does not
+    meet the case. ``final_speed_window_ms`` = ``(lo, hi)`` allows any arrival speed in between instead
+    (``run.final_speed_window_kmh``); its upper end is then ``final_speed_ms`` (where the braking
+    envelope ends). See :meth:`end_speed_window_ms` and :data:`END_SPEED_TOL_MS`.
+
     Values no train or line has (a 120 permille gradient, a force in N where kN is meant; the
     bounds of :mod:`pymoo_rail.model.plausibility`) raise :class:`CaseError`;
     ``allow_implausible`` waives them for a research case: ``True`` for all, or a tuple of kinds
@@ -51,6 +60,7 @@ class Case:
     legs: tuple[Leg, ...] = ()
     initial_speed_ms: float = 0.0
     final_speed_ms: float = 0.0
+    final_speed_window_ms: tuple[float, float] | None = None
     allow_implausible: bool | tuple[str, ...] = False
 
     def __post_init__(self) -> None:
@@ -98,9 +108,36 @@ class Case:
             cap = min(limit_kmh, self.train.max_speed_kmh)
             if kmh > cap + 1e-9:
                 raise CaseError(name, kmh, f"is above the speed limit there ({cap:g} km/h)")
+        window = self.final_speed_window_ms
+        if window is not None:
+            name = "run.final_speed_window_kmh"
+            if (isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2
+                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                               for v in window)):
+                raise CaseError(name, window, "must be two finite speeds [lo, hi]")
+            lo, hi = float(window[0]), float(window[1])
+            if not 0.0 <= lo <= hi:
+                raise CaseError(name, [lo * KMH_PER_MS, hi * KMH_PER_MS], "needs 0 <= lo <= hi")
+            if abs(hi - self.final_speed_ms) > 1e-9:
+                raise CaseError(name, [lo * KMH_PER_MS, hi * KMH_PER_MS],
+                                f"its upper end must be run.final_speed_kmh = {self.final_speed_ms * KMH_PER_MS:g} "
+                                "(the braking envelope ends there)")
+            object.__setattr__(self, "final_speed_window_ms", (lo, hi))
         if self.legs and (self.initial_speed_ms or self.final_speed_ms):
             raise CaseError("run.legs", len(self.legs), "a case with legs starts and ends each leg at rest: "
                                                         "boundary speeds are not supported with legs")
+
+    @property
+    def final_speed_window_kmh(self) -> tuple[float, float] | None:
+        """``final_speed_window_ms`` in km/h, as in the case file (None without a window)."""
+        w = self.final_speed_window_ms
+        return None if w is None else (w[0] * KMH_PER_MS, w[1] * KMH_PER_MS)
+
+    def end_speed_window_ms(self) -> tuple[float, float]:
+        """The arrival speeds the case asks for (m/s): its window, or the final speed itself (lo = hi)."""
+        if self.final_speed_window_ms is not None:
+            return self.final_speed_window_ms
+        return self.final_speed_ms, self.final_speed_ms
 
     def require_single_run(self, user: str) -> Case:
         """This case when it is one stop-to-stop run; a :class:`CaseError` naming the leg API when

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from pymoo_rail.cases import from_ttobench, list_cases, load_case
+from pymoo_rail.cases import KINDS, from_ttobench, generate_case, list_cases, load_case
 from pymoo_rail.cases.ttobench import read_track
 from pymoo_rail.cases.ttobench_release import release_pairs
 from pymoo_rail.model import CaseError, build_grid, case_from_dict, case_to_dict
@@ -27,10 +27,11 @@ def _every_real_case():
         n = len(read_track(track).stops_m)
         cases += [from_ttobench(track, train, i, i + 1, 100.0) for i in range(n - 1)]
         cases.append(from_ttobench(track, train, 0, n - 1, 100.0))
+    cases += [generate_case(seed, kind=kind) for kind in KINDS for seed in range(8)]
     return cases + [case.leg(k) for case in cases for k in range(len(case.legs))]
 
 
-def test_every_built_in_ttobench_and_benchmark_case_is_plausible():
+def test_every_built_in_ttobench_benchmark_and_generated_case_is_plausible():
     cases = _every_real_case()
     assert len(cases) > 60
     for case in cases:
