@@ -136,7 +136,7 @@ def test_a_research_case_waives_the_kind_it_names(what, edit, kind, field, words
 def test_the_file_key_waives_and_the_keyword_replaces_it(tmp_path):
     data = _set(copy.deepcopy(BASE), ("line", "gradients", 0, 2), 90.0)
     path = tmp_path / "steep.toml"
-    from pymoo_rail.model import write_case
+    from pymoo_rail.cases import write_case
 
     with pytest.raises(CaseError, match="gradients"):
         write_case(case_from_dict(data), path)
