@@ -243,6 +243,7 @@ class SpeedProfileProblem(Problem):
                  regimes: Sequence[str] | None = None, floor_kmh: float = 10.0, dx_m: float | None = None,
                  tracking=None, control_period_s: float = 0.2, time_window_s=None, integer_codes: bool = False,
                  decel_range_ms2: tuple[float, float] | None = None, **kwargs):
+        case = case.require_single_run(type(self).__name__)
         objectives = check_objectives(objectives)
         encoding = resolve_encoding(encoding, ENCODING_SETTINGS, partition=partition, n_sections=n_sections,
                                     max_section_m=max_section_m, floor_kmh=floor_kmh, integer_codes=integer_codes,
