@@ -12,6 +12,7 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
+from pymoo_rail.cases.generate import KINDS, generate_case
 from pymoo_rail.model import Case, CaseError, read_case
 
 _HERE = Path(__file__).resolve().parent
@@ -101,4 +102,5 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'pymoo_rail.cases' has no attribute {name!r}")
 
 
-__all__ = ["load_case", "list_cases", "case_path", "with_load", "LOADS_T", "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench"]
+__all__ = ["load_case", "generate_case", "KINDS", "list_cases", "case_path", "with_load", "LOADS_T",
+           "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench"]
