@@ -29,7 +29,9 @@ autodoc_typehints = "description"
 autodoc_member_order = "bysource"
 # numpy and pymoo types in signatures are not documented here
 nitpicky = False
-suppress_warnings = []
+# numpydoc array shapes such as ``(n_sections + 1,)`` become cross-references to every attribute of
+# that name (SpeedCodes.n_sections, Journey.n_sections): "more than one target" is not an error there
+suppress_warnings = ["ref.python"]
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
 html_theme = "alabaster"
 html_title = "pymoo-rail"
