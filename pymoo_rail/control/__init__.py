@@ -30,8 +30,19 @@ from pymoo_rail.control.disturbances import (  # noqa: E402 (needs Tracker)
     draw_disturbances,
     track_disturbed,
 )
+from pymoo_rail.control.closed_loop import (
+    CurveTracking,
+    LoopController,
+    LoopDisturbance,
+    LoopState,
+    Recovery,
+    Replanning,
+    closed_loop,
+)
 
 __all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMMETRIC_RULES",
            "symmetric_rules", "make_controller", "TERMS", "Tracker", "track",
            "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
-           "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES", "OptimalPolicy", "SpeedRestriction"]
+           "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES", "OptimalPolicy", "SpeedRestriction",
+           "closed_loop", "LoopController", "LoopDisturbance", "LoopState", "CurveTracking", "Replanning",
+           "Recovery"]

@@ -5,7 +5,7 @@
 time`` from position ``x`` at speed ``v`` to the platform) answers "what is optimal from here" for
 a whole grid of states at once, so a re-plan needs no new solve:
 
-1. ``V_lambda`` is kept for a lattice of prices of time ``lambda_k = lambda_plan r^k`` (computed
+1. ``V_lambda`` is kept for a lattice of prices of time, ``lambda_k + P_aux = (lambda_plan + P_aux) r^k`` (computed
    lazily, each by one backward sweep over the line still ahead);
 2. ``dV/dlambda`` is the running time of the optimal rest of the run (envelope theorem), so the
    slope of ``V`` between two neighbouring prices, read at the train's state, says which price
@@ -48,8 +48,9 @@ ARRIVAL_TOL_S = 0.25
 # A re-planned run counts as on time within this of the plan (moving the switch by one cell
 # changes the time by dx / v: 0.07 s at 50 km/h on a 1 m grid)
 ON_TIME_TOL_S = 1.0
-LAMBDA_MIN_W = 1.0e2
-LAMBDA_MAX_W = 1.0e10
+# Bounds of the total price of time (lambda plus the auxiliary power) the lattice spans
+TIME_PRICE_MIN_W = 1.0e2
+TIME_PRICE_MAX_W = 1.0e10
 
 
 @dataclass(frozen=True)
@@ -214,6 +215,7 @@ class OptimalPolicy:
         self._solvers: dict[float, OptimalSolver] = {}
         model = self.solver.simulator.model
         self.dx_m = float(self.solver.dx_m)
+        self.aux_w = float(model.aux_power_w)
         self._lines[(self.case.train.mass_t, None)] = _Line(model, self.solver.transition_tables())
 
     # ------------------------------------------------------------------ inputs
@@ -263,9 +265,18 @@ class OptimalPolicy:
         line.last_k = base.last_k
         return line
 
+    def envelope_ms(self, position_m: float, restriction: SpeedRestriction | None = None,
+                    mass_t: float | None = None) -> float:
+        """The planner's braking envelope at the grid node nearest ``position_m`` (m/s): the highest speed it plans from."""
+        model = self._line(restriction, mass_t).model
+        node = min(max(int(round(float(position_m) / self.dx_m)), 0), model.position_m.shape[0] - 1)
+        return float(model.envelope_ms[node])
+
     # ------------------------------------------------------------------ the lattice of prices
     def _price(self, k: int) -> float:
-        return self.lambda_w * PRICE_RATIO ** k
+        # geometric in the total price of time: towards cheap prices time becomes free (lambda ->
+        # -P_aux), so a train ahead of its plan is not driven faster to save auxiliary energy
+        return (self.lambda_w + self.aux_w) * PRICE_RATIO ** k - self.aux_w
 
     def _value(self, line: _Line, k: int, node: int) -> np.ndarray:
         """Cost-to-go at lattice price ``k``, valid from ``node`` on (swept over the line ahead only)."""
@@ -301,8 +312,9 @@ class OptimalPolicy:
         A galloping search from the last price chosen: a re-plan close to the last one tests one or
         two prices, already swept; a large change (a late departure) doubles its steps.
         """
-        k_min = int(math.floor(math.log(LAMBDA_MIN_W / self.lambda_w) / math.log(PRICE_RATIO)))
-        k_max = int(math.ceil(math.log(LAMBDA_MAX_W / self.lambda_w) / math.log(PRICE_RATIO)))
+        total = self.lambda_w + self.aux_w
+        k_min = int(math.floor(math.log(TIME_PRICE_MIN_W / total) / math.log(PRICE_RATIO)))
+        k_max = int(math.ceil(math.log(TIME_PRICE_MAX_W / total) / math.log(PRICE_RATIO)))
 
         def too_slow(k: int) -> bool:  # between prices k and k + 1 the rest still takes too long
             return k < k_max and self._run_time_between(line, k, node, speed_ms) > remaining_s + ARRIVAL_TOL_S
