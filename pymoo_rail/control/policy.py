@@ -160,9 +160,10 @@ def merged_tables(old_model: KernelModel, old_tables: tuple, new_model: KernelMo
 class _Line:
     """What the policy knows of one variant of the line and train: model, tables, cost-to-go per price."""
 
-    def __init__(self, model: KernelModel, tables: tuple):
+    def __init__(self, model: KernelModel, tables: tuple, terminal_j: np.ndarray):
         self.model = model
         self.tables = tables
+        self.terminal_j = terminal_j  # cost-to-go at the end of the line (the case's end speed)
         self.values: dict[int, tuple[int, np.ndarray]] = {}  # lattice index -> (first valid node, V)
         self.last_k = 0
 
@@ -216,7 +217,11 @@ class OptimalPolicy:
         model = self.solver.simulator.model
         self.dx_m = float(self.solver.dx_m)
         self.aux_w = float(model.aux_power_w)
-        self._lines[(self.case.train.mass_t, None)] = _Line(model, self.solver.transition_tables())
+        self._lines[(self.case.train.mass_t, None)] = _Line(model, self.solver.transition_tables(),
+                                                            self._terminal(model))
+
+    def _terminal(self, model: KernelModel) -> np.ndarray:
+        return dp.terminal_cost(model, self.n_speeds, self.bias, self.case.end_speed_window_ms()[0])
 
     # ------------------------------------------------------------------ inputs
     def _check_state(self, model: KernelModel, position_m, speed_ms, elapsed_s,
@@ -255,13 +260,14 @@ class OptimalPolicy:
             case = replace(self.case, train=replace(self.case.train, mass_t=mass))
             solver = OptimalSolver(case, self.dx_m, self.n_speeds, self.max_targets, top_bias=self.bias,
                                    tie_j=self.tie_j, certify=False)
-            self._lines[base_key] = _Line(solver.simulator.model, solver.transition_tables())
+            self._lines[base_key] = _Line(solver.simulator.model, solver.transition_tables(),
+                                          self._terminal(solver.simulator.model))
         base = self._lines[base_key]
         if restriction is None:
             return base
         model = restricted_model(base.model, restriction, float(self.case.train.length_m))
         tables = merged_tables(base.model, base.tables, model, self.n_speeds, self.max_targets, self.bias)
-        self._lines[key] = line = _Line(model, tables)
+        self._lines[key] = line = _Line(model, tables, base.terminal_j)
         line.last_k = base.last_k
         return line
 
@@ -288,7 +294,7 @@ class OptimalPolicy:
         value = np.zeros((n, self.n_speeds)) if entry is None else entry[1]
         prices = np.full(n - 1 - node, self._price(k))
         tables = line.tables[:-1] + (np.ascontiguousarray(line.tables[-1][node:]),)
-        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64))
+        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), line.terminal_j)
         self.n_sweeps += 1
         line.values[k] = (node, value)
         if len(line.values) > MAX_PRICES_KEPT:  # forget the price farthest from this one
