@@ -35,6 +35,7 @@ from pymoo_rail.control.closed_loop import (
     LoopController,
     LoopDisturbance,
     LoopState,
+    OptimalControls,
     Recovery,
     Replanning,
     closed_loop,
@@ -45,4 +46,4 @@ __all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMM
            "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
            "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES", "OptimalPolicy", "SpeedRestriction",
            "closed_loop", "LoopController", "LoopDisturbance", "LoopState", "CurveTracking", "Replanning",
-           "Recovery"]
+           "Recovery", "OptimalControls"]

@@ -17,7 +17,9 @@ members:
 - :class:`CurveTracking`: the offline optimal curve, never changed;
 - :class:`Replanning`: :meth:`OptimalPolicy.replan` from the measured state;
 - :class:`Recovery`: when late, maximum traction until the plan's clock is caught up, then coast
-  down to the plan's curve and follow it (the time-optimal recovery of a driver without a planner).
+  down to the plan's curve and follow it (the time-optimal recovery of a driver without a planner);
+- :class:`OptimalControls`: the policy's own controls applied directly (no tracking controller),
+  the exact policy a driver's advice is measured against (:mod:`pymoo_rail.control.advice`).
 """
 
 from __future__ import annotations
@@ -112,7 +114,12 @@ class LoopState:
 
 
 class LoopController(Protocol):
-    """A controller of the closed loop: a reference for the rest of the run at each decision."""
+    """A controller of the closed loop: a reference for the rest of the run at each decision.
+
+    Instead of ``reference`` (followed by ``tracker``), a controller may give ``program(state)``:
+    a driving program (``end_m, mode, target_ms`` rows, absolute positions) that drives the real
+    train itself until the next decision, as a driver following advice or the optimal controls do.
+    """
 
     name: str
     tracker: Controller
@@ -149,14 +156,7 @@ class Replanning:
     def reference(self, state: LoopState) -> Trajectory:
         """The policy's optimal rest of the run, or the fastest run once the plan's time is past."""
         started = _time.process_time()
-        # the planner's train may be less able than the real one (resistance error): a state above
-        # its braking envelope is taken at the envelope
-        top = self.policy.envelope_ms(state.position_m, state.restriction, state.mass_t)
-        speed = min(state.speed_ms, top)
-        if state.elapsed_s >= self.policy.planned_time_s:
-            ref = self.policy.fastest(state.position_m, speed, state.elapsed_s, state.restriction, state.mass_t)
-        else:
-            ref = self.policy.replan(state.position_m, speed, state.elapsed_s, state.restriction, state.mass_t)
+        ref = plan_for(self.policy, state)
         self.cpu_s.append(_time.process_time() - started)
         return ref
 
@@ -200,6 +200,33 @@ class Recovery:
         t = np.concatenate([flat.time_s[:j], coast.time_s[: q + 1], plan.time_s[rest]])
         return replace(plan, position_m=x, speed_ms=v, regime=r, time_s=t, accel_ms2=np.zeros_like(x), force_n=f,
                        limit_ms=np.zeros_like(x))
+
+
+@dataclass
+class OptimalControls:
+    """Apply the policy's optimal controls directly, re-planned every ``decide_every_s`` s and on announcements."""
+
+    policy: OptimalPolicy
+    decide_every_s: float = DEFAULT_DECIDE_EVERY_S
+    name: str = "optimal controls"
+    tracker: Controller | None = None
+
+    def program(self, state: LoopState) -> np.ndarray:
+        """The driving program of the policy's optimal rest of the run from ``state``."""
+        plan_for(self.policy, state)
+        return self.policy.last_program
+
+
+def plan_for(policy: OptimalPolicy, state: LoopState) -> Trajectory:
+    """The policy's rest of the run from a loop state: :meth:`~OptimalPolicy.replan`, or the fastest run once the plan's time is past.
+
+    The planner's train may be less able than the real one (a resistance error): a state above its
+    braking envelope is taken at the envelope.
+    """
+    speed = min(state.speed_ms, policy.envelope_ms(state.position_m, state.restriction, state.mass_t))
+    if state.elapsed_s >= policy.planned_time_s:
+        return policy.fastest(state.position_m, speed, state.elapsed_s, state.restriction, state.mass_t)
+    return policy.replan(state.position_m, speed, state.elapsed_s, state.restriction, state.mass_t)
 
 
 def reference_command(model: KernelModel, reference: Trajectory) -> float:
@@ -246,7 +273,8 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
         variation), ``regime_changes``, ``reached``, ``n_decisions`` and ``decision_points_m``.
     """
     d = as_loop_disturbance(disturbance)
-    tracker = check_controller(controller.tracker)
+    direct = callable(getattr(controller, "program", None))
+    tracker = check_controller(PID() if direct else controller.tracker)
     planned = float(case.planned_time_s if planned_time_s is None else planned_time_s)
     every_s = float(controller.decide_every_s)
     if not every_s > 0.0:
@@ -267,24 +295,32 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
         if pending and d.announce_m <= float(model.position_m[node]):  # announced before departure
             known, pending = d.restriction, False
         state = LoopState(float(model.position_m[node]), v, t, known, case.train.mass_t * d.mass_factor, event)
-        ref = controller.reference(state)
         decisions.append(state.position_m)
-        x_ref = np.ascontiguousarray(ref.position_m, dtype=float)
-        regime = np.ascontiguousarray(ref.regime, dtype=np.int8)
-        x_start, x_stop = ck.reference_phases(x_ref, regime, x_ref.shape[0])
         ahead = model_from(model, node, v)
-        v_ref = np.interp(ahead.position_m, x_ref, np.asarray(ref.speed_ms, dtype=float), right=0.0)
-        if carry[ck.C_RESUME] > 0.0 and ref is not previous:
-            # a new reference: the controller starts from the reference's own command
-            ck.align_controller(code, params, carry, reference_command(ahead, ref))
-        previous = ref
         x_end = float(d.announce_m) if pending and d.announce_m > state.position_m else math.inf
-        out, x, vs, ts, a, f, r, _ = ck.track_trace(ahead, v_ref, float(x_start), float(x_stop), code, params,
-                                                    float(control_period_s), noise, float(d.traction_lag_s), carry,
-                                                    every_s, x_end)
-        carry[ck.C_RESUME] = 1.0
-        count = x.shape[0]
-        finished = out[sk.OUT_REACHED] == 0.0 or count == ahead.position_m.shape[0]
+        if direct:  # the controller's program drives the real train itself
+            run = run_trace(ahead, controller.program(state))
+            x, vs, ts, a, f, r = (run.position_m, run.speed_ms, run.time_s, run.accel_ms2, run.force_n, run.regime)
+            cut = np.flatnonzero((ts[1:] >= every_s - 1e-9) | (x[1:] >= x_end))
+            count = x.shape[0] if cut.size == 0 else int(cut[0]) + 2
+            finished = count >= x.shape[0]
+            x, vs, ts, a, f, r = (y[:count] for y in (x, vs, ts, a, f, r))
+        else:
+            ref = controller.reference(state)
+            x_ref = np.ascontiguousarray(ref.position_m, dtype=float)
+            regime = np.ascontiguousarray(ref.regime, dtype=np.int8)
+            x_start, x_stop = ck.reference_phases(x_ref, regime, x_ref.shape[0])
+            v_ref = np.interp(ahead.position_m, x_ref, np.asarray(ref.speed_ms, dtype=float), right=0.0)
+            if carry[ck.C_RESUME] > 0.0 and ref is not previous:
+                # a new reference: the controller starts from the reference's own command
+                ck.align_controller(code, params, carry, reference_command(ahead, ref))
+            previous = ref
+            out, x, vs, ts, a, f, r, _ = ck.track_trace(ahead, v_ref, float(x_start), float(x_stop), code, params,
+                                                        float(control_period_s), noise, float(d.traction_lag_s),
+                                                        carry, every_s, x_end)
+            carry[ck.C_RESUME] = 1.0
+            count = x.shape[0]
+            finished = out[sk.OUT_REACHED] == 0.0 or count == ahead.position_m.shape[0]
         keep = slice(0, count) if finished else slice(0, count - 1)
         parts.append((x[keep], vs[keep], ts[keep] + t, a[keep], f[keep], r[keep]))
         if finished:

@@ -188,6 +188,9 @@ class OptimalPolicy:
         Its price of time (W), the centre of the lattice of prices the policy keeps.
     n_sweeps : int
         Backward sweeps done so far (a re-plan that reuses the lattice does none).
+    last_program : array (rows, 3)
+        The driving program (``end_m, mode, target_ms``, absolute positions) of the last run
+        returned: the optimal controls themselves, for a controller that applies them directly.
 
     Examples
     --------
@@ -212,6 +215,7 @@ class OptimalPolicy:
         self.bias = self.solver.top_bias
         self.tie_j = self.solver.tie_j
         self.n_sweeps = 0
+        self.last_program: np.ndarray | None = None
         self._lines: dict[tuple, _Line] = {}
         self._solvers: dict[float, OptimalSolver] = {}
         model = self.solver.simulator.model
@@ -424,7 +428,8 @@ class OptimalPolicy:
         line = self._line(restriction, mass_t)
         node, v, elapsed = self._check_state(line.model, position_m, speed_ms, elapsed_s, before_plan=False)
         model = model_from(line.model, node, v)
-        tr = run_trace(model, flat_out_program(float(model.position_m[-1])), elapsed)
+        self.last_program = flat_out_program(float(model.position_m[-1]))
+        tr = run_trace(model, self.last_program, elapsed)
         return self._finish(tr, elapsed, math.inf, math.nan,
                             on_time=abs(tr.time_s[-1] - self.planned_time_s) <= ON_TIME_TOL_S)
 
@@ -483,12 +488,14 @@ class OptimalPolicy:
         model = model_from(line.model, node, v)
         fastest = flat_out_program(float(model.position_m[-1]))
         t_min = self._times(model, fastest[None])[0]
-        if t_min >= remaining - ARRIVAL_TOL_S:
+        if t_min >= remaining:  # not even the fastest run is on time: the earliest arrival
+            self.last_program = fastest
             tr = run_trace(model, fastest, elapsed)
             return self._finish(tr, elapsed, math.inf, math.nan, on_time=t_min <= remaining + ON_TIME_TOL_S,
                                 cpu_s=_time.process_time() - started)
         k = self._choose_price(line, node, v, remaining)
         program = self.meet_time(model, self._rollout(line, k, node, v), remaining)
+        self.last_program = program
         tr = run_trace(model, program, elapsed)
         # weak duality: E*(T) >= V_lambda(state) - lambda T for every price swept so far
         lower = max(self._cost_to_go(line, j, node, v) - self._price(j) * remaining

@@ -106,3 +106,15 @@ def test_bad_disturbances(kwargs, field):
 def test_bad_decision_period(metro, policy):
     with pytest.raises(FieldError, match="'controller.decide_every_s' = 0.0"):
         closed_loop(metro, CurveTracking(policy.plan, PID(), decide_every_s=0.0))
+
+
+def test_the_optimal_controls_applied_directly_arrive_on_time(metro, policy):
+    from pymoo_rail.control.closed_loop import OptimalControls
+
+    nominal = closed_loop(metro, OptimalControls(policy, 10.0), planned_time_s=PLANNED_S)
+    assert abs(nominal.summary["lateness_s"]) <= 0.5
+    # nominal: re-planning on the plan changes nothing but the grid's rounding
+    assert nominal.energy.net_kwh == pytest.approx(policy.plan.energy.net_kwh, rel=0.01)
+    heavy_late = LoopDisturbance(departure_delay_s=3.0, mass_factor=1.1, resistance_factor=1.1)
+    run = closed_loop(metro, OptimalControls(policy, 5.0), heavy_late, planned_time_s=PLANNED_S)
+    assert abs(run.summary["lateness_s"]) <= 1.0 and run.summary["reached"] == 1.0
