@@ -282,6 +282,13 @@ class OptimalPolicy:
         node = min(max(int(round(float(position_m) / self.dx_m)), 0), model.position_m.shape[0] - 1)
         return float(model.envelope_ms[node])
 
+    def model_ahead(self, position_m: float, speed_ms: float, restriction: SpeedRestriction | None = None,
+                    mass_t: float | None = None) -> KernelModel:
+        """The planner's model of the line ahead of ``position_m`` (nearest node) with the train at ``speed_ms``."""
+        model = self._line(restriction, mass_t).model
+        node = min(max(int(round(float(position_m) / self.dx_m)), 0), model.position_m.shape[0] - 2)
+        return model_from(model, node, min(float(speed_ms), float(model.envelope_ms[node])))
+
     # ------------------------------------------------------------------ the lattice of prices
     def _price(self, k: int) -> float:
         # geometric in the total price of time: towards cheap prices time becomes free (lambda ->
