@@ -68,15 +68,14 @@ class Advice:
 def advice_from_run(run: Trajectory, min_duration_s: float = 5.0, speed_band_kmh: float = 3.0) -> tuple[Advice, ...]:
     """The regimes of a run as advice, merging any pull or brake shorter than ``min_duration_s`` into the regime before.
 
-    Traction and holding are one instruction: "power to" the speed reached when the speed rises
-    by more than ``speed_band_kmh`` over it, else "hold" its mean speed; the last braking is the stop.
+    A pull or hold is "power to" the speed reached when the speed rises by more than
+    ``speed_band_kmh`` over it, else "hold" its mean speed; the last braking is the stop.
     """
     check_number("min_duration_s", min_duration_s, nonneg=True, error=FieldError)
     x = np.asarray(run.position_m, dtype=float)
     t = np.asarray(run.time_s, dtype=float)
     v_kmh = np.asarray(run.speed_ms, dtype=float) * KMH_PER_MS
-    regime = np.asarray(run.regime[:-1], dtype=int).copy()  # per cell
-    regime[regime == sk.REGIME_HOLD] = sk.REGIME_TRACTION  # told apart below by the speed
+    regime = np.asarray(run.regime[:-1], dtype=int)  # per cell
     if regime.size == 0:
         return ()
     starts = np.concatenate([[0], np.flatnonzero(np.diff(regime)) + 1])
@@ -99,7 +98,9 @@ def advice_from_run(run: Trajectory, min_duration_s: float = 5.0, speed_band_kmh
     for k, (s, e, r) in enumerate(merged):
         action = ADVICE_WORDS[r]
         if action == "power" and v_kmh[e] - v_kmh[s] <= speed_band_kmh:
-            action = "hold"
+            action = "hold"  # pulling (with short holds merged in) that barely changes the speed
+        elif action == "hold" and v_kmh[e] - v_kmh[s] > speed_band_kmh:
+            action = "power"  # holding (with short pulls merged in) that gains speed
         if action == "power":
             speed = v_kmh[e]
         elif action == "hold":
@@ -141,7 +142,8 @@ def advice_program(advice: tuple[Advice, ...], speed_at, reaction_s: float, leng
 
 
 def advice_frame(advice) -> pd.DataFrame:
-    """Advice as a table (``shown_s`` and ``shown_m`` when it comes from :class:`AdvisedDriving`), for CSV or JSON."""
+    """Advice as a table, for CSV or JSON: ``Advice`` items, or ``(time_s, position_m, Advice)`` items
+    (:meth:`AdvisedDriving.seen`: ``shown_s`` and ``shown_m`` say when and where it was shown)."""
     rows = []
     for item in advice:
         shown_s, shown_m, a = item if isinstance(item, tuple) else (math.nan, math.nan, item)
@@ -174,8 +176,8 @@ class AdvisedDriving:
     Attributes
     ----------
     boards : list of (time_s, position_m, tuple of Advice)
-        The advice on the driver's display from each decision on (:meth:`changes` counts what the
-        driver saw change along a run).
+        The advice on the driver's display from each decision on (:meth:`seen` lists what the
+        driver saw change along a run, :meth:`changes` counts it).
     """
 
     policy: OptimalPolicy
@@ -236,30 +238,22 @@ class AdvisedDriving:
         # is no change the driver acts on before reaching it)
         return (current_advice(shown, position_m),) + tuple(a for a in fresh if a.start_m > position_m)
 
-    def changes(self, run: Trajectory) -> int:
-        """How often the advice the driver saw changed along ``run`` (the closed-loop run it drove)."""
+    def seen(self, run: Trajectory) -> list[tuple[float, float, Advice]]:
+        """What the driver saw along ``run`` (the closed-loop run driven): (time, position, advice) at each change."""
         if not self.boards:
-            return 0
+            return []
         times = np.array([b[0] for b in self.boards])
-        seen = 0
-        last = None
+        out: list[tuple[float, float, Advice]] = []
         for x, t in zip(run.position_m, run.time_s):
             board = self.boards[max(int(np.searchsorted(times, t, side="right")) - 1, 0)][2]
             now = current_advice(board, float(x))
-            if last is not None and not now.same_as(last, math.inf, self.speed_band_kmh):
-                seen += 1
-            last = now
-        return seen
-
-    def shown(self) -> list[tuple[float, float, Advice]]:
-        """Every advice shown (time, position, advice), for :func:`advice_frame`."""
-        out = []
-        for t, x, board in self.boards:
-            for a in board:
-                if a.start_m >= x - 1e-9 or a is current_advice(board, x):
-                    if not out or not a.same_as(out[-1][2], self.switch_band_m, self.speed_band_kmh):
-                        out.append((t, x, a))
+            if not out or not now.same_as(out[-1][2], math.inf, self.speed_band_kmh):
+                out.append((float(t), float(x), now))
         return out
+
+    def changes(self, run: Trajectory) -> int:
+        """How often the advice the driver saw changed along ``run``."""
+        return max(len(self.seen(run)) - 1, 0)
 
 
 def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_band_kmh: float = 3.0) -> tuple:

@@ -80,8 +80,9 @@ def test_advice_followed_late_costs_little_and_changes_rarely(yizhuang, world):
 def test_advice_as_csv_and_json(yizhuang):
     case, policy = yizhuang
     driver = AdvisedDriving(policy, 10.0)
-    closed_loop(case, driver, LoopDisturbance(departure_delay_s=3.0))
-    table = advice_frame(driver.shown())
+    run = closed_loop(case, driver, LoopDisturbance(departure_delay_s=3.0))
+    table = advice_frame(driver.seen(run))
+    assert table.shape[0] == driver.changes(run) + 1
     assert list(table.columns) == ["shown_s", "shown_m", "start_m", "action", "speed_kmh", "text"]
     assert table.shape[0] >= 3 and set(table["action"]) <= {"power", "hold", "coast", "brake"}
     back = pd.read_csv(io.StringIO(table.to_csv(index=False)))
@@ -93,3 +94,16 @@ def test_advice_as_csv_and_json(yizhuang):
 def test_bad_driver_settings(yizhuang, field, value):
     with pytest.raises(FieldError, match=f"'{field}'"):
         AdvisedDriving(yizhuang[1], **{field: value})
+
+
+def test_the_run_with_its_advice_is_drawn(yizhuang, tmp_path):
+    from pymoo_rail.plotting import plot_advised_run, save_figure
+
+    case, policy = yizhuang
+    driver = AdvisedDriving(policy, 10.0)
+    run = closed_loop(case, driver, LoopDisturbance(departure_delay_s=3.0))
+    fig = plot_advised_run(run, driver.seen(run), case, policy.plan)
+    texts = [t.get_text() for t in fig.axes[0].texts]
+    assert len(texts) == len(driver.seen(run)) and texts[0].startswith("power to")
+    path = save_figure(fig, tmp_path / "advice.png")
+    assert path.stat().st_size > 10_000
