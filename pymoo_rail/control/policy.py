@@ -11,7 +11,8 @@ a whole grid of states at once, so a re-plan needs no new solve:
    slope of ``V`` between two neighbouring prices, read at the train's state, says which price
    arrives on time: no forward run is needed to choose it;
 3. one forward run of the DP from the state at that price, then the last switch into the final
-   coast is moved (a few simulator runs) until the run arrives at the planned time;
+   coast is moved (a few simulator runs) until the run arrives at the planned time (where that
+   is not enough, the cost-to-go between the two neighbouring prices is interpolated, by bisection);
 4. the energy's lower bound comes from weak duality, ``E*(T) >= V_lambda(x, v) - lambda T`` for
    every price computed: the re-plan's certificate costs nothing more.
 
@@ -363,19 +364,56 @@ class OptimalPolicy:
         return right
 
     # ------------------------------------------------------------------ the runs
-    def _rollout(self, line: _Line, k: int, node: int, speed_ms: float) -> np.ndarray:
+    def _rollout(self, line: _Line, k: int, node: int, speed_ms: float, share: float = 0.0) -> np.ndarray:
+        """The DP's forward run from the state at lattice price ``k`` (or ``share`` of the way to ``k + 1``).
+
+        Between two lattice prices the cost-to-go is interpolated linearly in the price (the
+        supporting lines of the front at both ends): the run in between when neither end, nor
+        its moved last switch, meets the time.
+        """
         model = model_from(line.model, node, speed_ms)
         value = self._value(line, k, node)[node:]
+        price_w = self._price(k)
+        if share > 0.0:
+            value = (1.0 - share) * value + share * self._value(line, k + 1, node)[node:]
+            price_w = (1.0 - share) * price_w + share * self._price(k + 1)
         n = model.position_m.shape[0]
         modes = np.zeros(n - 1, dtype=np.int64)
         targets = np.zeros(n - 1)
         speeds = np.zeros(n)
-        price = np.full(n - 1, self._price(k) + model.aux_power_w)
-        done = dp.forward_rollout(model, price, value, self.max_targets, self.bias, self.tie_j, modes, targets,
-                                  speeds)[0]
+        price = np.full(n - 1, price_w + model.aux_power_w)
+        done = dp.forward_rollout(model, price, np.ascontiguousarray(value), self.max_targets, self.bias, self.tie_j,
+                                  modes, targets, speeds)[0]
         if done < n - 1:
             raise FieldError("speed_ms", speed_ms, f"leaves no way to the platform from {model.position_m[0]:.1f} m")
         return np.column_stack([model.position_m[1:], modes.astype(float), targets])
+
+    def _on_time_program(self, line: _Line, k: int, node: int, speed_ms: float, model: KernelModel,
+                         remaining_s: float) -> tuple[np.ndarray, float]:
+        """The run at price ``k`` with its last switch moved to the time; if that misses, a price between
+        ``k`` and its neighbour on the other side of the time, by bisection. Returns (program, price)."""
+        program = self.meet_time(model, self._rollout(line, k, node, speed_ms), remaining_s)
+        miss = self._times(model, program[None])[0] - remaining_s
+        if abs(miss) <= ARRIVAL_TOL_S:
+            return program, self._price(k)
+        lo = k if miss > 0 else k - 1  # the time lies between prices lo and lo + 1
+        # the share of the way from lo to lo + 1: 0 runs slower, 1 faster
+        slow, fast = 0.0, 1.0
+        best = (abs(miss), program, self._price(k))
+        for _ in range(8):
+            share = 0.5 * (slow + fast)
+            trial = self.meet_time(model, self._rollout(line, lo, node, speed_ms, share), remaining_s)
+            late = self._times(model, trial[None])[0] - remaining_s
+            price = (1.0 - share) * self._price(lo) + share * self._price(lo + 1)
+            if abs(late) < best[0]:
+                best = (abs(late), trial, price)
+            if abs(late) <= ARRIVAL_TOL_S:
+                break
+            if late > 0:
+                slow = share
+            else:
+                fast = share
+        return best[1], best[2]
 
     @staticmethod
     def _times(model: KernelModel, programs: np.ndarray) -> np.ndarray:
@@ -501,11 +539,11 @@ class OptimalPolicy:
             return self._finish(tr, elapsed, math.inf, math.nan, on_time=t_min <= remaining + ON_TIME_TOL_S,
                                 cpu_s=_time.process_time() - started)
         k = self._choose_price(line, node, v, remaining)
-        program = self.meet_time(model, self._rollout(line, k, node, v), remaining)
+        program, price_w = self._on_time_program(line, k, node, v, model, remaining)
         self.last_program = program
         tr = run_trace(model, program, elapsed)
         # weak duality: E*(T) >= V_lambda(state) - lambda T for every price swept so far
         lower = max(self._cost_to_go(line, j, node, v) - self._price(j) * remaining
                     for j, (first, _) in list(line.values.items()) if first <= node)
         on_time = abs(tr.time_s[-1] - self.planned_time_s) <= ON_TIME_TOL_S
-        return self._finish(tr, elapsed, self._price(k), lower, on_time, _time.process_time() - started)
+        return self._finish(tr, elapsed, price_w, lower, on_time, _time.process_time() - started)
