@@ -69,7 +69,7 @@ def advice_from_run(run: Trajectory, min_duration_s: float = 5.0, speed_band_kmh
     """The regimes of a run as advice, merging any pull or brake shorter than ``min_duration_s`` into the regime before.
 
     A pull or hold is "power to" the speed reached when the speed rises by more than
-    ``speed_band_kmh`` over it, else "hold" its mean speed; the last braking is the stop.
+    ``speed_band_kmh`` over it, else "hold" the speed it starts at; the last braking is the stop.
     """
     check_number("min_duration_s", min_duration_s, nonneg=True, error=FieldError)
     x = np.asarray(run.position_m, dtype=float)
@@ -104,7 +104,7 @@ def advice_from_run(run: Trajectory, min_duration_s: float = 5.0, speed_band_kmh
         if action == "power":
             speed = v_kmh[e]
         elif action == "hold":
-            speed = float(np.mean(v_kmh[s:e + 1]))
+            speed = v_kmh[s]  # the speed to keep (a short brake merged in lowers its mean, not its aim)
         elif action == "brake" and k < len(merged) - 1:
             speed = v_kmh[e]
         else:
