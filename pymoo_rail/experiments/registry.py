@@ -162,8 +162,8 @@ def _kinematic_phases(case: Any = "metro-a", **params):
 
 @_forwards("pymoo_rail.control.tuning", "ControllerTuningProblem")
 def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
-    """``pymoo_rail.control.tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
-    from pymoo_rail.control.tuning import ControllerTuningProblem
+    """``pymoo_rail.problems.controller_tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
+    from pymoo_rail.problems.controller_tuning import ControllerTuningProblem
 
     return ControllerTuningProblem(_case(case, load), **params)
 

@@ -8,7 +8,7 @@ from pathlib import Path
 from pymoo_rail.cli.arguments import HelpFormatter, UsageError, add_command, out_dir, say
 from pymoo_rail.cli.case_options import load_case
 from pymoo_rail.cli.commands.study import add_trust_argument, study_outputs
-from pymoo_rail.constants import OBJECTIVE_COLUMNS
+from pymoo_rail.problems.objectives import objective_columns
 
 ORDER = 90
 
@@ -57,7 +57,7 @@ def _objective_of_column(column: str) -> str:
     """Axis label key of a front column: ``f_energy`` -> energy, ``running_time_s`` -> running_time."""
     if column.startswith("f_"):
         return column[2:]
-    for name, col in OBJECTIVE_COLUMNS.items():
+    for name, col in objective_columns().items():
         if column == col:
             return name
     return column

@@ -14,6 +14,8 @@ def add_parser(sub) -> None:
     """Add ``study`` to the subcommands."""
     p = add_command(
         sub, "study", run, compiles=False, help="run a study file (problems x algorithms x seeds)",
+        interrupted="every run finished so far is stored in the study directory; run the same command again "
+                    "to resume",
         description="Run every run of a study file not yet stored in --out (an interrupted study resumes "
                     "where it stopped), then write the statistics tables (--out/tables: summary, mean (std) "
                     "per indicator, Wilcoxon rank-sum tests against the baseline) and the figures "
@@ -90,7 +92,8 @@ def run(args) -> int:
         raise UsageError("--baseline", f"unknown algorithm {baseline!r} (the study has "
                                        f"{', '.join(a.display for a in study.algorithms)})")
     out = out_dir(args.out or str(Path("out") / study.name))
-    where = f"Dask scheduler {args.scheduler}" if args.scheduler else "a local process pool"
+    where = (f"Dask scheduler {args.scheduler}" if args.scheduler else
+             "this process" if args.workers == 1 else "a local process pool")
     say(f"study {study.name}: {len(study.problems)} problems x {len(study.algorithms)} algorithms x "
         f"{len(study.seeds)} seeds = {len(study.runs())} runs on {where}; results in {out}")
     try:
