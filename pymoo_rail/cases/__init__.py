@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
-from pymoo_rail.cases.formats import FORMATS, format_of
+from pymoo_rail.cases.formats import FORMATS, call_reader, format_of
 from pymoo_rail.cases.generate import KINDS, generate_case
 from pymoo_rail.cases.toml_case import read_case, write_case
 from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
@@ -102,7 +102,8 @@ def load_case(name_or_path: str | Path, load: str | None = None, *,
     if candidate.suffix.lower() in {s for f in FORMATS for s in f.suffixes} or candidate.is_file():
         if not candidate.is_file():
             raise CaseError("path", str(candidate), "no such case file")
-        case = format_of(candidate).read_case(candidate, allow_implausible=allow_implausible, **options)
+        fmt = format_of(candidate)
+        case = call_reader(fmt.read_case, fmt.name, candidate, allow_implausible=allow_implausible, **options)
     elif options:
         raise CaseError("options", sorted(options), f"'{name_or_path}' is a built-in case: it takes no reader "
                                                     "options (they are for files of other formats)")

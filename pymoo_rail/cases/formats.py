@@ -8,6 +8,7 @@ and :func:`~pymoo_rail.journeys.load_journey` dispatch through :func:`format_of`
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +33,19 @@ FORMATS: tuple[CaseFormat, ...] = (
     CaseFormat("toml", (".toml",), toml_case.looks_like, toml_case.read_case),
     CaseFormat("ttobench", (".json",), ttobench.looks_like, ttobench.read_case),
 )
+
+
+def call_reader(reader: Callable, name: str, path: Path, **options):
+    """``reader(path, **options)``; options the reader does not take, or a required one missing,
+    are a :class:`CaseError` naming the format ``name`` and the reader's keywords."""
+    try:
+        inspect.signature(reader).bind(path, **options)
+    except TypeError as err:
+        keywords = [key for key, p in inspect.signature(reader).parameters.items()
+                    if p.kind is inspect.Parameter.KEYWORD_ONLY]
+        raise CaseError("options", sorted(options), f"{err} (the {name} reader takes: {', '.join(keywords)})",
+                        str(path)) from None
+    return reader(path, **options)
 
 
 def format_of(path: str | Path) -> CaseFormat:

@@ -19,6 +19,7 @@ from typing import Sequence
 import numpy as np
 
 from pymoo_rail.cases import list_cases, load_case, ttobench
+from pymoo_rail.cases.formats import call_reader
 from pymoo_rail.cases.toml_case import parse_toml
 from pymoo_rail.cases.ttobench import POINT_MASS_LENGTH_M, TTOBENCH_NOTICE
 from pymoo_rail.cases.ttobench_writer import track_to_json, train_to_json, ttobench_id, write_pair
@@ -287,6 +288,6 @@ def load_journey(source: str | Path, **options) -> Journey | TimedJourney:
         raise CaseError("path", str(source), "no such journey file or built-in case")
     for fmt in JOURNEY_FORMATS:
         if path.suffix.lower() == fmt.suffix and fmt.matches(path):
-            return fmt.read(path, **options)
+            return call_reader(fmt.read, fmt.name, path, **options)
     known = ", ".join(f"{f.name} ({f.suffix})" for f in JOURNEY_FORMATS)
     raise CaseError("path", str(path), f"is in no known journey format (known: {known})", str(path))

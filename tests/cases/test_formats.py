@@ -42,3 +42,11 @@ def test_a_ttobench_track_loads_through_load_case_with_the_readers_options():
 def test_reader_options_on_a_built_in_name_are_refused():
     with pytest.raises(CaseError, match="options"):
         load_case("yizhuang", train=BEIJING_SUBWAY_TRAIN)
+
+
+def test_missing_or_unknown_reader_options_are_named():
+    with pytest.raises(CaseError) as raised:
+        load_case(YIZHUANG_TRACK)  # a TTOBench track needs its train and planned time
+    assert raised.value.field == "options" and "train" in str(raised.value)
+    with pytest.raises(CaseError, match="toml reader"):
+        load_case(case_path("metro-a"), train=BEIJING_SUBWAY_TRAIN)
