@@ -1,9 +1,10 @@
 """The registry of case formats: which reader reads a file, by its suffix or its content.
 
 Each format is one module of :mod:`pymoo_rail.cases` with ``read_case(path, *,
-allow_implausible=None, **options)`` and ``looks_like(head: bytes)``; a new format (railML,
-railjson) is that module plus one line of :data:`FORMATS`. :func:`~pymoo_rail.cases.load_case`
-and :func:`~pymoo_rail.journeys.load_journey` dispatch through :func:`format_of`.
+allow_implausible=None, **options)``, a train reader and ``looks_like(head: bytes)``; a new format (railML,
+railjson) is that module plus one line of :data:`FORMATS`. :func:`~pymoo_rail.cases.load_case`,
+:func:`~pymoo_rail.cases.load_train` and :func:`~pymoo_rail.journeys.load_journey` dispatch
+through :func:`format_of`.
 """
 
 from __future__ import annotations
@@ -14,24 +15,25 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pymoo_rail.cases import toml_case, ttobench
-from pymoo_rail.model import Case, CaseError
+from pymoo_rail.model import Case, CaseError, Train
 
 HEAD_BYTES = 4096  # how much of a file the content sniffers see
 
 
 @dataclass(frozen=True)
 class CaseFormat:
-    """One file format: its name, its suffixes, a sniffer of its content and its case reader."""
+    """One file format: its name, its suffixes, a sniffer of its content, its case and train readers."""
 
     name: str
     suffixes: tuple[str, ...]
     looks_like: Callable[[bytes], bool]
     read_case: Callable[..., Case]
+    read_train: Callable[..., Train]
 
 
 FORMATS: tuple[CaseFormat, ...] = (
-    CaseFormat("toml", (".toml",), toml_case.looks_like, toml_case.read_case),
-    CaseFormat("ttobench", (".json",), ttobench.looks_like, ttobench.read_case),
+    CaseFormat("toml", (".toml",), toml_case.looks_like, toml_case.read_case, toml_case.read_train),
+    CaseFormat("ttobench", (".json",), ttobench.looks_like, ttobench.read_case, ttobench.read_train_file),
 )
 
 

@@ -13,7 +13,7 @@ from typing import Any
 
 import rtoml
 
-from pymoo_rail.model import Case, CaseError, case_from_dict, case_to_dict
+from pymoo_rail.model import Case, CaseError, Train, case_from_dict, case_to_dict, train_from_dict
 
 SUFFIXES = (".toml",)
 
@@ -53,6 +53,19 @@ def read_case(path: str | Path, *, allow_implausible: bool | Sequence[str] | Non
     except OSError as err:
         raise CaseError("path", str(path), f"cannot be read: {err.strerror or err}", str(path)) from None
     return case_from_dict(parse_toml(raw, str(path)), source=str(path), allow_implausible=allow_implausible)
+
+
+def read_train(path: str | Path) -> Train:
+    """The train of a TOML file with a ``[train]`` table: a case file, or a file with the train alone."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as err:
+        raise CaseError("path", str(path), f"cannot be read: {err.strerror or err}", str(path)) from None
+    data = parse_toml(raw, str(path))
+    if "train" not in data:
+        raise CaseError("train", None, "is required: a train file holds a [train] table", str(path))
+    return train_from_dict(data["train"], str(path))
 
 
 def looks_like(head: bytes) -> bool:
