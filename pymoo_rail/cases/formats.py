@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pymoo_rail.cases import toml_case, ttobench
+from pymoo_rail.cases.files import file_bytes
 from pymoo_rail.model import Case, CaseError, Train
 
 HEAD_BYTES = 4096  # how much of a file the content sniffers see
@@ -57,11 +58,7 @@ def format_of(path: str | Path) -> CaseFormat:
     by_suffix = [f for f in FORMATS if path.suffix.lower() in f.suffixes]
     if len(by_suffix) == 1:
         return by_suffix[0]
-    try:
-        with path.open("rb") as fh:
-            head = fh.read(HEAD_BYTES)
-    except OSError as err:
-        raise CaseError("path", str(path), f"cannot be read: {err.strerror or err}", str(path)) from None
+    head = file_bytes(path, HEAD_BYTES)
     for fmt in by_suffix or FORMATS:
         if fmt.looks_like(head):
             return fmt
