@@ -195,7 +195,7 @@ def test_readme_and_docs_command_lines_parse():
     commands = []
     for page in PAGES:
         for _, _, block in snippets(page, "bash"):
-            for line in block.splitlines():
+            for line in block.replace("\\\n", " ").splitlines():  # a continued line is one command
                 line = line.split("#")[0].strip()
                 if line.startswith("pymoo-rail ") or " pymoo-rail " in line:
                     commands.append((page.name, shlex.split(line[line.index("pymoo-rail "):].split("&&")[0])[1:]))

@@ -90,7 +90,7 @@ def test_a_restriction_ahead_is_kept_and_the_run_is_still_on_time(metro, policy)
     plan = policy.plan
     i = plan.position_m.shape[0] // 5
     rest = policy.replan(plan.position_m[i], plan.speed_ms[i], plan.time_s[i] - 2.0, restriction=restriction)
-    inside = (rest.position_m >= 600.0) & (rest.position_m <= 700.0 + metro.train.length_m)
+    inside = (rest.position_m >= 600.0) & (rest.position_m < 700.0 + metro.train.length_m)
     assert rest.speed_ms[inside].max() * 3.6 <= 50.0 + 1e-6
     assert plan.speed_ms[(plan.position_m >= 600.0) & (plan.position_m <= 700.0)].max() * 3.6 > 50.0
     assert abs(rest.running_time_s - PLANNED_S) <= 0.3
@@ -108,7 +108,8 @@ def test_merged_tables_give_the_cost_to_go_of_fresh_tables(policy):
     values = []
     for tables in (merged, fresh):
         value = np.empty((n, solver.n_speeds))
-        dp.backward_sweep(np.full(n - 1, policy.lambda_w), *tables, value, np.zeros(n, dtype=np.int64))
+        dp.backward_sweep(np.full(n - 1, policy.lambda_w), *tables, value, np.zeros(n, dtype=np.int64),
+                          np.zeros(solver.n_speeds))
         values.append(value)
     np.testing.assert_array_equal(values[0], values[1])
 
