@@ -271,7 +271,6 @@ class OptimalPolicy:
         if key in self._lines:
             self._lines[key] = self._lines.pop(key)  # most recently used last
             return self._lines[key]
-        self._forget_lines()
         base_key = (mass, None)
         if base_key not in self._lines:  # a measured mass changes every cell: new model and tables
             case = replace(self.case, train=replace(self.case.train, mass_t=mass))
@@ -281,11 +280,13 @@ class OptimalPolicy:
                                           self._terminal(solver.simulator.model))
         base = self._lines[base_key]
         if restriction is None:
+            self._forget_lines()
             return base
         model = restricted_model(base.model, restriction, float(self.case.train.length_m))
         tables = merged_tables(base.model, base.tables, model, self.n_speeds, self.max_targets, self.bias)
         self._lines[key] = line = _Line(model, tables, base.terminal_j)
         line.last_k = base.last_k
+        self._forget_lines()
         return line
 
     def envelope_ms(self, position_m: float, restriction: SpeedRestriction | None = None,
