@@ -15,6 +15,7 @@ the same physics and energy accounting as any optimiser's result.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -659,7 +660,8 @@ def optimal_profile(case: Case, running_time_s: float, **settings) -> Trajectory
     return OptimalSolver(case, **settings).profile(running_time_s)
 
 
-def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
+def optimal_front(case: Case, running_times, *, progress: Callable[[int, int], None] | None = None,
+                  **settings) -> pd.DataFrame:
     """Minimum net energy at each running time: the energy / running-time front of the case.
 
     Parameters
@@ -667,6 +669,8 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
     case : Case
     running_times : sequence of float
         Requested running times (s), each at least :func:`min_running_time`.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each running time is solved (for a progress bar).
     **settings
         As for :func:`optimal_profile`.
 
@@ -699,4 +703,6 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
                      "lambda_kwh_per_s": slope,
                      "energy_at_request_kwh": e.net_kwh + slope * (tr.running_time_s - float(t)),
                      "energy_bound_kwh": tr.summary.get("energy_bound_kwh", math.nan)})
+        if progress is not None:
+            progress(len(rows), len(times))
     return pd.DataFrame(rows)

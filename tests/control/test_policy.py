@@ -90,7 +90,7 @@ def test_a_restriction_ahead_is_kept_and_the_run_is_still_on_time(metro, policy)
     plan = policy.plan
     i = plan.position_m.shape[0] // 5
     rest = policy.replan(plan.position_m[i], plan.speed_ms[i], plan.time_s[i] - 2.0, restriction=restriction)
-    inside = (rest.position_m >= 600.0) & (rest.position_m <= 700.0 + metro.train.length_m)
+    inside = (rest.position_m >= 600.0) & (rest.position_m < 700.0 + metro.train.length_m)
     assert rest.speed_ms[inside].max() * 3.6 <= 50.0 + 1e-6
     assert plan.speed_ms[(plan.position_m >= 600.0) & (plan.position_m <= 700.0)].max() * 3.6 > 50.0
     assert abs(rest.running_time_s - PLANNED_S) <= 0.3
@@ -156,3 +156,12 @@ def test_restriction_from_text():
 def test_generated_positions_off_the_line_are_refused(policy, position_m):
     with pytest.raises(FieldError, match="'position_m'"):
         policy.replan(position_m, 10.0, 10.0)
+
+
+def test_line_variants_are_kept_within_bounds(metro, policy):
+    from pymoo_rail.control.policy import MAX_LINES_KEPT
+
+    for k in range(MAX_LINES_KEPT + 2):
+        policy.replan(300.0, 15.0, 25.0, mass_t=metro.train.mass_t * (1.0 + 0.01 * (k + 1)))
+    assert len(policy._lines) <= MAX_LINES_KEPT
+    assert (metro.train.mass_t, None) in policy._lines  # the case's own line stays
