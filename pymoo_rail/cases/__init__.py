@@ -77,7 +77,12 @@ def __getattr__(name: str):
         from pymoo_rail.cases import ttobench
 
         return getattr(ttobench, name)
+    if name in ("load_train", "railjson_case"):  # OSRD railjson and any-format trains: cases/railjson.py
+        from pymoo_rail.cases import railjson
+
+        return getattr(railjson, name)
     raise AttributeError(f"module 'pymoo_rail.cases' has no attribute {name!r}")
 
 
-__all__ = ["load_case", "list_cases", "case_path", "with_load", "LOADS_T", "from_ttobench", "to_ttobench"]
+__all__ = ["load_case", "list_cases", "case_path", "with_load", "LOADS_T", "from_ttobench", "to_ttobench",
+           "load_train", "railjson_case"]
