@@ -175,6 +175,12 @@ def railjson_case(infra: RailjsonInfra | PathLike | Mapping, rolling_stock: Rail
         if power_recovery and voltages is not None else (0.0, 0.0)
     line = path_line(infra, steps, category=category, voltages=voltages, neutral_sections=voltages is not None,
                      routes=routes, default_limit_kmh=train.max_speed_kmh, power_recovery_s=recovery)
+    if line.neutral_sections and line.neutral_sections[0][0] == 0.0:
+        powered = "any electrification" if voltages is None else f"electrification {', '.join(voltages)}"
+        raise CaseError("mode", mode or stock.default_mode,
+                        f"gives no traction where the path starts (no {powered} or a neutral section over "
+                        f"[0, {line.neutral_sections[0][1]:g}] m): choose another traction mode of the rolling "
+                        f"stock (modes: {', '.join(stock.modes)})", infra.source)
     train = replace(train, braking=ForceCurve(max_force_kn=braking_force_kn(stock, line)))
     label = Path(infra.source).stem if not infra.source.startswith("<") else "railjson"
     return Case(name=name or f"{label}: {where}", train=train, line=line, planned_time_s=planned_time_s,

@@ -244,7 +244,11 @@ class RailjsonInfra:
             entry = step.begin_m if forward else step.end_m
             for goal in goal_on.get(step.track, ()):
                 ahead = goal - entry if forward else entry - goal
-                if ahead > 0 and (best is None or cost + ahead < best[0]):
+                if ahead < 0 or (ahead == 0 and len(steps) == 1) or (best is not None and cost + ahead >= best[0]):
+                    continue
+                if ahead == 0:  # the goal is where the previous track ends
+                    best = (cost, steps[:-1])
+                else:
                     cut = PathStep(step.track, step.begin_m, goal, step.direction) if forward else \
                         PathStep(step.track, goal, step.end_m, step.direction)
                     best = (cost + ahead, steps[:-1] + (cut,))
