@@ -16,8 +16,8 @@ Settings (dimension, iterations) as in the seed: (10, 500), (20, 1000), (30, 100
 Equal budgets: every algorithm stops on ``("n_eval", 30 * (iterations + 1))``, i.e. the
 initial 30 evaluations plus 30 per iteration. PSO and DE spend exactly 30 per generation;
 ABC spends 30 per cycle plus one per scout, so it runs slightly fewer cycles than the
-nominal number. pymoo checks termination after a whole generation/cycle, so a run may
-overshoot by less than one generation; the report gives the mean evaluations used.
+nominal number. pymoo checks termination after every iteration (a generation, or one phase of
+an ABC cycle), so a run may overshoot by less than one iteration; the report gives the mean evaluations used.
 
 Usage::
 

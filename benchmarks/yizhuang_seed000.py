@@ -12,8 +12,8 @@ limit 50, case ``yizhuang`` (Tongjinan Rd -> Jinghai Rd, 2265 m, planned 150 s).
 * Partitions: ``gradient_limit`` (non-equal, fig. 4-4: 8 sections on yizhuang) and ``equal``
   with N sections (fig. 4-3; the seed does not give N, so N = 10 and 20 by default, ``--n-equal``).
   The seed's table 5-6 compares the partitions with MOABC; ABC is run on both too.
-* Budget ``n_gen = 101``: the initial colony plus 100 cycles (40 evaluations per cycle plus one
-  per scout), the same for every algorithm and partition.
+* Budget ``n_gen = 201``: the initial colony plus 100 cycles of two pymoo iterations (employed,
+  onlooker; 40 evaluations per cycle plus one per scout), the same for every algorithm and partition.
 
 Runs go through ``pymoo_rail.experiments.run_study`` (one JSON record per run, written as it
 finishes; a restart runs only the missing ones). Run it as::
@@ -45,7 +45,7 @@ from pymoo_rail.constants import J_PER_KWH
 CASE = "yizhuang"
 POP = 40  # colony: 20 employed + 20 onlookers (seed 000 5.2)
 LIMIT = 50
-N_GEN = 101  # initial colony + 100 cycles
+N_GEN = 1 + 2 * 100  # initial colony + 100 cycles of two iterations (employed, onlooker)
 TOLERANCE_S = 1.0
 N_EQUAL = (10, 20)
 NON_EQUAL = "non-equal"
@@ -473,7 +473,7 @@ def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, r
          f"* Case `yizhuang` as committed (AW0 194.295 t, Davis W0 in kN, efficiency 1, no rotary mass, no "
          f"auxiliary power, no regeneration), planned {planned:g} s.",
          f"* Seed settings (5.2, 5.3): colony {POP} (20 employed, 20 onlookers), limit {LIMIT}, "
-         f"100 cycles (`n_gen = {N_GEN}`: initial colony + 100 cycles; about "
+         f"100 cycles (`n_gen = {N_GEN}`: initial colony + 100 cycles of two pymoo iterations; about "
          f"{int(ch['n_eval'].mean())} evaluations per run). MOABC archive {ARCHIVE} (the seed gives no size). "
          f"Seeds 1-{len(seeds)} (`--seeds`), the same for every algorithm and partition.",
          f"* ABC: constrained form `SpeedProfileProblem(case, objectives=('energy',), "

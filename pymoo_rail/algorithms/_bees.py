@@ -153,17 +153,27 @@ def roulette(probabilities: np.ndarray, n: int, random_state: np.random.Generato
     return random_state.choice(len(probabilities), size=n, replace=True, p=probabilities)
 
 
-EMPLOYED, ONLOOKER, SCOUT = "employed", "onlooker", "scout"
+EMPLOYED, ONLOOKER = "employed", "onlooker"
 
 
 class BeeColony(Algorithm):
-    """The employed - onlooker - scout cycle as one pymoo iteration.
+    """The employed - onlooker - scout cycle, one phase per pymoo iteration.
 
-    ``_advance`` returns False between the phases, so each phase is one ask/tell and nothing is
-    evaluated inside the algorithm. Subclasses provide ``_infill`` for the current ``_phase``,
-    ``_greedy(infills)`` (keep better candidates, count trials), ``_onlooker_probabilities``,
-    ``_candidates`` and ``_initialize_advance`` (which calls :meth:`_start_colony`), and may
-    override ``_observe(infills)`` to see every evaluated candidate (MOABC's archive).
+    pymoo counts one iteration (``n_gen``) per ``ask``/``tell`` round, and the onlookers of
+    Liu (2019) (4.5.3 step 5, after step 4) choose their food sources from the colony the
+    employed bees have just improved, so the two phases cannot share one evaluation. A bee
+    cycle is therefore two pymoo iterations: the employed phase, then the onlooker phase.
+    The scouts of a cycle (sources abandoned after the onlooker phase) fly with the next
+    employed phase: their random points are the first rows of its infill, the employed bees
+    of those sources move from the new points, and the greedy choice meets the scouts'
+    values from the same evaluation. So ``n_gen = 1 + 2 * cycles`` (the initial colony is
+    the first iteration), whatever the number of scouts, and a hand-written ask/tell loop
+    with ``n`` rounds gets the same budget as ``minimize(..., ("n_gen", n))``.
+
+    Subclasses provide ``_greedy(candidates)`` (keep better candidates, count trials),
+    ``_onlooker_probabilities``, ``_candidates(X_sources, parents)`` and
+    ``_initialize_advance`` (which calls :meth:`_start_colony`), and may override
+    ``_observe(infills)`` to see every evaluated batch (MOABC's archive).
 
     Parameters
     ----------
@@ -189,9 +199,10 @@ class BeeColony(Algorithm):
         self.trials: np.ndarray | None = None
         self.n_scouts = 0
         self.n_scouts_total = 0
+        self.n_cycles = 0
         self._phase = EMPLOYED
         self._parents: np.ndarray | None = None
-        self._scouts: np.ndarray | None = None
+        self._scouts = np.zeros(0, dtype=int)
         self._xl: np.ndarray | None = None
         self._xu: np.ndarray | None = None
         self._limit: int | None = None
@@ -208,7 +219,7 @@ class BeeColony(Algorithm):
         return {"n_scouts_total": int(self.n_scouts_total)}
 
     def _observe(self, infills) -> None:
-        """Called with every evaluated batch before it is used."""
+        """Called with every evaluated batch (scouts included) before it is used."""
 
     def _keep_better(self, infills: Population, off_F, off_CV, pop_F, pop_CV, better) -> None:
         """Greedy selection of both colonies: candidate ``c`` replaces source ``self._parents[c]`` when
@@ -229,60 +240,61 @@ class BeeColony(Algorithm):
         self.trials = np.zeros(self.n_sources, dtype=int)
         self.n_scouts = 0
         self.n_scouts_total = 0
+        self.n_cycles = 0
         self._phase = EMPLOYED
+        self._scouts = np.zeros(0, dtype=int)
 
     def _infill(self):
-        if self._phase == SCOUT:
-            self._parents = self._scouts
-            return self.sampling.do(self.problem, len(self._scouts), random_state=self.random_state)
+        X_sources = np.array([ind.X for ind in self.pop])
         if self._phase == EMPLOYED:
+            scouts = Population.empty()
+            if len(self._scouts) > 0:
+                # the abandoned sources' new random points, evaluated with this phase
+                scouts = self.sampling.do(self.problem, len(self._scouts), random_state=self.random_state)
+                X_sources[self._scouts] = scouts.get("X")
             self._parents = np.arange(self.n_sources)
-        else:
-            self._parents = roulette(self._onlooker_probabilities(), self.n_sources, self.random_state)
-        return Population.new(X=self._candidates(self._parents))
+            moved = Population.new(X=self._candidates(X_sources, self._parents))
+            return Population.merge(scouts, moved)
+        self._parents = roulette(self._onlooker_probabilities(), self.n_sources, self.random_state)
+        return Population.new(X=self._candidates(X_sources, self._parents))
 
     def _onlooker_probabilities(self) -> np.ndarray:
         """Probability of each food source to be chosen by an onlooker."""
         raise NotImplementedError
 
-    def _candidates(self, parents: np.ndarray) -> np.ndarray:
-        """One neighbour of each source in ``parents``."""
+    def _candidates(self, X_sources: np.ndarray, parents: np.ndarray) -> np.ndarray:
+        """One neighbour of each source in ``parents``; ``X_sources`` holds every source's position."""
+        raise NotImplementedError
+
+    def _greedy(self, candidates: Population) -> None:
+        """Keep the candidates better than their sources (``self._parents``); count trials."""
         raise NotImplementedError
 
     def _advance(self, infills=None, **kwargs) -> bool:
         if infills is None:
             raise ValueError(f"{type(self).__name__} uses ask/tell: tell() needs the evaluated infills")
         self._observe(infills)
-
-        if self._phase == SCOUT:
-            self.pop[self._scouts] = infills
-            self.trials[self._scouts] = 0
-            self.n_scouts_total += len(self._scouts)
-            self._end_cycle(len(self._scouts))
+        self.n_scouts = 0
+        if self._phase == EMPLOYED:
+            n_scouts = len(self._scouts)
+            if n_scouts > 0:
+                self.pop[self._scouts] = infills[:n_scouts]
+                self.trials[self._scouts] = 0
+                self.n_scouts = n_scouts
+                self.n_scouts_total += n_scouts
+            self._greedy(infills[n_scouts:])
+            self._phase = ONLOOKER
             return True
 
         self._greedy(infills)
-
-        if self._phase == EMPLOYED:
-            self._phase = ONLOOKER
-            return False
-
-        self._scouts = np.flatnonzero(self.trials > self._limit)
-        if len(self._scouts) > 0:
-            self._phase = SCOUT
-            return False
-        self._end_cycle(0)
-        return True
-
-    def _end_cycle(self, n_scouts: int) -> None:
-        self.n_scouts = n_scouts
+        self._scouts = np.flatnonzero(self.trials > self._limit)  # they fly with the next phase
+        self.n_cycles += 1
         self._phase = EMPLOYED
-        self._parents = None
-        self._scouts = None
+        return True
 
 
 class ScoutColumn:
-    """Mixin for a pymoo output: adds the number of scouts sent in the last cycle."""
+    """Mixin for a pymoo output: adds the number of scouts that flew in the last iteration."""
 
     def __init__(self) -> None:
         super().__init__()

@@ -1,9 +1,9 @@
 """Artificial Bee Colony (ABC) for single-objective problems.
 
 Karaboga's canonical ABC as described in Liu (2019), sections 3.2-3.3, written as a pymoo
-``Algorithm`` in ask/tell form: one pymoo iteration is one full cycle (employed, onlooker
-and, when needed, scout phase); ``_advance`` returns ``False`` between the phases so every
-phase is one ``ask``/``tell`` pair and nothing is evaluated inside the algorithm.
+``Algorithm`` in ask/tell form: one pymoo iteration (one ``ask``/``tell`` round, as pymoo counts
+``n_gen``) is one phase, so a cycle (employed, onlooker, and the scouts flying with the next
+employed phase) is two iterations and nothing is evaluated inside the algorithm.
 """
 
 from __future__ import annotations
@@ -88,8 +88,11 @@ class ABC(BeeColony):
 
     Notes
     -----
-    One pymoo iteration is one full cycle and costs ``pop_size`` evaluations plus one per
-    scout. The cycle is:
+    One pymoo iteration is one ``ask``/``tell`` round, as pymoo counts ``n_gen``: the employed
+    phase (``SN`` evaluations plus one per scout) or the onlooker phase (``SN`` evaluations).
+    A cycle is two iterations, so ``maxCycle`` cycles are ``("n_gen", 1 + 2 * maxCycle)``
+    (the onlookers choose from the colony the employed bees have just improved, so the two
+    phases cannot share one evaluation). The cycle is:
 
     * Employed bees: for every food source ``i`` one random variable ``j`` moves,
       ``v_ij = x_ij + phi (x_ij - x_kj)``, ``phi ~ U[-1, 1]``, ``k != i`` uniform; the result
@@ -103,8 +106,10 @@ class ABC(BeeColony):
       constraints; ``onlooker_fitness="inverse"`` selects the seed's eq. 3-3) and move
       like employed bees. Several onlookers on the same source are
       applied one after another in draw order.
-    * Scout bees: every source whose trial counter exceeds ``limit`` is replaced by a
-      random point (Liu (2019) step 7-8 abandons each such source, not only the worst).
+    * Scout bees: every source whose trial counter exceeds ``limit`` after the onlooker phase
+      is replaced by a random point (Liu (2019) step 7-8 abandons each such source, not only
+      the worst); the random points are evaluated with the next employed phase, whose bees
+      start from them.
 
     The phases work on the colony as it was when the phase was asked for (a batch, not a
     bee-by-bee sequence), so one phase is one ``ask``/``tell``. The best solution ever seen
@@ -144,16 +149,17 @@ class ABC(BeeColony):
         F, CV = self.pop.get("F")[:, 0], self.pop.get("CV")[:, 0]
         return ONLOOKER_FITNESS[self.onlooker_fitness](F, CV)
 
-    def _candidates(self, parents: np.ndarray) -> np.ndarray:
-        X = self.pop.get("X")
+    def _candidates(self, X_sources: np.ndarray, parents: np.ndarray) -> np.ndarray:
         partners = random_partners(self.n_sources, self.random_state)[parents]
-        return one_variable_move(X[parents], X[partners], self._xl, self._xu, self.random_state)
+        return one_variable_move(
+            X_sources[parents], X_sources[partners], self._xl, self._xu, self.random_state
+        )
 
-    def _greedy(self, infills: Population) -> None:
+    def _greedy(self, candidates: Population) -> None:
         """Replace sources by strictly better candidates, in draw order; count trials."""
-        off_F, off_CV = infills.get("F")[:, 0], infills.get("CV")[:, 0]
+        off_F, off_CV = candidates.get("F")[:, 0], candidates.get("CV")[:, 0]
         pop_F, pop_CV = self.pop.get("F")[:, 0], self.pop.get("CV")[:, 0]
-        self._keep_better(infills, off_F, off_CV, pop_F, pop_CV, feasibility_first_better)
+        self._keep_better(candidates, off_F, off_CV, pop_F, pop_CV, feasibility_first_better)
 
     def _set_optimum(self) -> None:
         # keep the best ever seen: scouts may abandon the current best source

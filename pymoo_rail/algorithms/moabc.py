@@ -3,7 +3,7 @@
 Pareto-dominance greedy choice, onlooker fitness ``dom(i) / N``, an external archive of
 non-dominated solutions truncated by crowding distance, and a neighbour search guided by
 a random archive member. Same ask/tell structure as :class:`pymoo_rail.algorithms.ABC`:
-one pymoo iteration is one full cycle.
+one pymoo iteration is one phase (employed or onlooker), a bee cycle is two iterations.
 """
 
 from __future__ import annotations
@@ -154,6 +154,12 @@ class MOABC(BeeColony):
 
     Notes
     -----
+    * Budget: one pymoo iteration is one ``ask``/``tell`` round, as pymoo counts ``n_gen``:
+      the employed phase (``SN`` candidates plus the scouts' new points) or the onlooker
+      phase (``SN`` candidates). Liu (2019), 4.5.3 step 5, has the onlookers choose from the
+      colony the employed bees have just improved, so the two phases cannot share one
+      evaluation: ``maxCycle`` cycles are ``("n_gen", 1 + 2 * maxCycle)``, and the counter
+      ``n_cycles`` holds the cycles completed.
     * Greedy choice: a candidate replaces its food source only if it constraint-dominates
       it (less violation, or equal violation and Pareto-dominance). Otherwise the source
       stays and its trial counter grows by one (also when the two are mutually
@@ -217,8 +223,8 @@ class MOABC(BeeColony):
         _, F, CV = population_arrays(self.pop)
         return dominance_probabilities(F, CV)
 
-    def _candidates(self, parents: np.ndarray) -> np.ndarray:
-        X = population_arrays(self.pop)[0][parents]
+    def _candidates(self, X_sources: np.ndarray, parents: np.ndarray) -> np.ndarray:
+        X = X_sources[parents]
         guides = self.random_state.integers(0, len(self.pareto_archive), size=len(X))
         return self._move(X, self.archive_X[guides])
 
@@ -240,12 +246,14 @@ class MOABC(BeeColony):
         self._infill_arrays = population_arrays(infills)  # read once, used by _greedy too
         self._update_archive(infills, self._infill_arrays)  # every evaluated candidate may enter the archive
 
-    def _greedy(self, infills: Population) -> None:
+    def _greedy(self, candidates: Population) -> None:
         """Replace a source by a candidate that constraint-dominates it; count trials."""
+        # the candidates are the last rows of the evaluated batch (scouts come first);
         # Python floats: a scalar comparison per pair is cheaper on lists than on array rows
-        _, off_F, off_CV = (a.tolist() for a in self._infill_arrays)
+        first = len(self._infill_arrays[0]) - len(candidates)
+        _, off_F, off_CV = (a[first:].tolist() for a in self._infill_arrays)
         _, pop_F, pop_CV = (a.tolist() for a in population_arrays(self.pop))
-        self._keep_better(infills, off_F, off_CV, pop_F, pop_CV, constraint_dominates)
+        self._keep_better(candidates, off_F, off_CV, pop_F, pop_CV, constraint_dominates)
 
     def _update_archive(self, infills: Population, arrays: tuple) -> None:
         X_new, F_new, CV_new = arrays

@@ -12,6 +12,7 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
+from pymoo_rail.cases.generate import KINDS, generate_case
 from pymoo_rail.model import Case, CaseError, read_case
 
 _HERE = Path(__file__).resolve().parent
@@ -37,17 +38,35 @@ def with_load(case: Case, load: str) -> Case:
     return replace(case, name=f"{case.name}-{load}", train=train)
 
 
+# Sections of the TTOBench Yizhuang line offered by name (the benchmark suite's cases, docs/suite.md):
+# departure and arrival stop, planned time in s. TTOBench has no timetable: the planned times are 10 %
+# above this model's minimum running time, rounded up to 5 s.
+TTOBENCH_SECTIONS: dict[str, tuple[str, str, float]] = {
+    "ttobench-songjiazhuang-xiaocun": ("Songjiazhuang", "Xiaocun", 170.0),
+    "ttobench-xiaohongmen-jiugong": ("Xiaohongmen", "Jiugong", 145.0),
+    "ttobench-wanyuan-rongjing": ("Wanyuan St", "Rongjing East St", 90.0),
+}
+
+
 def list_cases() -> list[str]:
-    """Names of the built-in cases."""
-    return sorted(p.stem for p in _HERE.glob("*.toml"))
+    """Names of the built-in cases: the case files and the TTOBench sections (``TTOBENCH_SECTIONS``)."""
+    return sorted([p.stem for p in _HERE.glob("*.toml")] + list(TTOBENCH_SECTIONS))
 
 
 def case_path(name: str) -> Path:
-    """The file of a built-in case."""
+    """The file of a built-in case (a TTOBench section is read from the shipped TTOBench files)."""
     path = _HERE / f"{name}.toml"
     if not path.is_file():
-        raise CaseError("case", name, f"no such built-in case (built-in: {', '.join(list_cases())})")
+        raise CaseError("case", name, f"no such built-in case file (built-in: {', '.join(list_cases())})")
     return path
+
+
+def _ttobench_section(name: str) -> Case:
+    from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
+
+    first, last, planned_time_s = TTOBENCH_SECTIONS[name]
+    return from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, first, last, planned_time_s,
+                         stop_names=YIZHUANG_STOP_NAMES, name=name)
 
 
 def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
@@ -56,7 +75,8 @@ def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
     Parameters
     ----------
     name_or_path : str or Path
-        A built-in name from :func:`list_cases` or the path of a TOML case file.
+        A built-in name from :func:`list_cases` (a case file, or a section of the TTOBench Yizhuang
+        line such as ``"ttobench-wanyuan-rongjing"``) or the path of a TOML case file.
     load : str, optional
         A passenger load state of the case (``LOADS_T``), e.g. ``load_case("yizhuang", load="AW3")``:
         the train mass of that load, the rest of the case unchanged.
@@ -66,6 +86,8 @@ def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
         if not candidate.is_file():
             raise CaseError("path", str(candidate), "no such case file")
         case = read_case(candidate)
+    elif str(name_or_path) in TTOBENCH_SECTIONS:
+        case = _ttobench_section(str(name_or_path))
     else:
         case = read_case(case_path(str(name_or_path)))
     return case if load is None else with_load(case, load)
@@ -84,5 +106,5 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'pymoo_rail.cases' has no attribute {name!r}")
 
 
-__all__ = ["load_case", "list_cases", "case_path", "with_load", "LOADS_T", "from_ttobench", "to_ttobench",
-           "load_train", "railjson_case"]
+__all__ = ["load_case", "generate_case", "KINDS", "list_cases", "case_path", "with_load", "LOADS_T",
+           "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench", "load_train", "railjson_case"]

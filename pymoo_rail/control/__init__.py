@@ -22,6 +22,7 @@ from pymoo_rail.control.controllers import (
     symmetric_rules,
 )
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S, Tracker, track, tracked_summaries
+from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction
 from pymoo_rail.control.disturbances import (  # noqa: E402 (needs Tracker)
     DEFAULT_RANGES,
     Disturbance,
@@ -33,4 +34,4 @@ from pymoo_rail.control.disturbances import (  # noqa: E402 (needs Tracker)
 __all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMMETRIC_RULES",
            "symmetric_rules", "make_controller", "TERMS", "Tracker", "track",
            "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
-           "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES"]
+           "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES", "OptimalPolicy", "SpeedRestriction"]

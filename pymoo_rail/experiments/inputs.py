@@ -1,13 +1,19 @@
-"""The fingerprint of what a run's result depends on beyond its spec.
+"""The fingerprint of what a run's result depends on beyond its spec, and the inputs it is computed from.
 
 A run id (:attr:`RunSpec.run_id`) hashes the spec: problem and algorithm names and parameters,
 seed and budget. The result also depends on things a spec only names:
 
 - the case a rail problem loads (``case = "yizhuang"`` or a file path): its *content*, as
-  loaded (so editing a comment changes nothing, editing a mass does);
+  loaded (so editing a comment changes nothing, editing a mass does). The case is loaded once,
+  when the study starts (:func:`resolve_run`); its digest goes into the fingerprint and the
+  loaded case itself is handed to the run, so a file edited while the study runs can never give
+  a record computed on one content and labelled with another;
 - any other file a problem or algorithm parameter names (its bytes);
-- the module of a ``"package.module:factory"`` spec (its source bytes);
-- the versions of pymoo-rail and pymoo, whose code computes the result.
+- the module of a ``"package.module:factory"`` spec (its source bytes; looked up only when the
+  study is trusted, since finding a module imports its parent packages);
+- the code that computes the result: a digest of the package's own source and data files
+  (:func:`package_digest`, computed once per process), and the versions of pymoo-rail, pymoo,
+  numpy and numba.
 
 :func:`run_inputs` returns these as a flat dict of strings stored with each record;
 :func:`changed_inputs` says, in words, what differs between a stored and a current fingerprint.
@@ -15,27 +21,53 @@ seed and budget. The result also depends on things a spec only names:
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import importlib.util
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 from pymoo_rail.experiments.spec import AlgorithmSpec, ProblemSpec, RunSpec, canonical_json
+
+# fingerprint keys that describe the code rather than the data of a run (see ``code_only``)
+CODE_KEYS = ("pymoo-rail code", "pymoo-rail version", "pymoo version", "numpy version", "numba version")
+# package files whose content computes a result: its code, built-in cases and shipped fronts
+_PACKAGE_SUFFIXES = (".py", ".toml", ".csv", ".json")
 
 
 def _digest(data: bytes) -> str:
     return "sha256:" + hashlib.sha256(data).hexdigest()[:32]
 
 
-def _case_digest(value: str) -> str:
+@dataclass(frozen=True)
+class RunInputs:
+    """What a run is computed from beyond its spec: the fingerprint, and the cases it names, loaded once.
+
+    Attributes
+    ----------
+    fingerprint : dict of str
+        Stored with the record (see the module docstring).
+    cases : mapping
+        The ``case`` value of the problem spec -> the :class:`~pymoo_rail.model.Case` whose
+        content the fingerprint holds (empty when the spec names no case, or it did not load:
+        the run then reports the loader's error).
+    """
+
+    fingerprint: Mapping[str, str]
+    cases: Mapping[str, Any] = field(default_factory=dict)
+
+
+def _load_case_once(value: str) -> tuple[str, Any]:
+    """The digest of a case's content and the case itself (None when it does not load)."""
     from pymoo_rail.cases import load_case
     from pymoo_rail.model import case_to_dict
 
     try:
         case = load_case(value)
     except Exception as err:  # noqa: BLE001 - the run itself will report the error
-        return f"unreadable: {type(err).__name__}"
-    return _digest(canonical_json(case_to_dict(case)).encode())
+        return f"unreadable: {type(err).__name__}", None
+    return _digest(canonical_json(case_to_dict(case)).encode()), case
 
 
 def _module_digest(path: str) -> str | None:
@@ -49,10 +81,14 @@ def _module_digest(path: str) -> str | None:
     return _digest(Path(found.origin).read_bytes())
 
 
-def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
-    """Digests of the case, files and module a problem or algorithm spec refers to."""
+def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
+    """Digests of the case, files and module a problem or algorithm spec refers to, with the case loaded.
+
+    Call it only for a trusted spec when the spec names an import path (see the module docstring).
+    """
     kind = "problem" if isinstance(spec, ProblemSpec) else "algorithm"
     out: dict[str, str] = {}
+    cases: dict[str, Any] = {}
     if ":" in spec.name:
         digest = _module_digest(spec.name)
         if digest is not None:
@@ -61,51 +97,100 @@ def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
         if not isinstance(value, str):
             continue
         if key == "case":
-            out[f"{kind}.case ({value})"] = _case_digest(value)
+            out[f"{kind}.case ({value})"], case = _load_case_once(value)
+            if case is not None:
+                cases[value] = case
         elif len(value) < 4096 and Path(value).is_file():
             out[f"{kind}.{key} file {value}"] = _digest(Path(value).read_bytes())
-    return out
+    return RunInputs(out, cases)
+
+
+def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
+    """Digests of the case, files and module a problem or algorithm spec refers to."""
+    return dict(resolve_spec(spec).fingerprint)
+
+
+@functools.lru_cache(maxsize=1)
+def package_digest() -> str:
+    """A digest of pymoo-rail's own source and data files (path and bytes of each, in path order).
+
+    Computed once per process: a change to the code with the same version string still changes
+    every fingerprint, so no record computed by other code is taken as current.
+    """
+    import pymoo_rail
+
+    root = Path(pymoo_rail.__file__).resolve().parent
+    sha = hashlib.sha256()
+    for path in sorted(p for p in root.rglob("*") if p.suffix in _PACKAGE_SUFFIXES and p.is_file()
+                       and "__pycache__" not in p.parts):
+        sha.update(path.relative_to(root).as_posix().encode() + b"\0")
+        sha.update(hashlib.sha256(path.read_bytes()).digest())
+    return "sha256:" + sha.hexdigest()[:32]
 
 
 def versions_input() -> dict[str, str]:
-    """Versions of the code that computes a result."""
+    """The code that computes a result: the package's source digest and the library versions."""
+    import numba
+    import numpy
     import pymoo
 
     import pymoo_rail
 
-    return {"pymoo-rail version": pymoo_rail.__version__, "pymoo version": pymoo.__version__}
+    return {"pymoo-rail code": package_digest(), "pymoo-rail version": pymoo_rail.__version__,
+            "pymoo version": pymoo.__version__, "numpy version": numpy.__version__,
+            "numba version": numba.__version__}
 
 
-def run_inputs(run: RunSpec, cache: dict[Any, dict[str, str]] | None = None) -> dict[str, str]:
-    """The fingerprint of ``run``'s inputs (see the module docstring).
+def resolve_run(run: RunSpec, cache: dict[Any, RunInputs] | None = None) -> RunInputs:
+    """The fingerprint of ``run``'s inputs and the cases they were computed from (see the module docstring).
 
-    ``cache`` (a dict kept by the caller) avoids loading the same case once per seed.
+    ``cache`` (a dict kept by the caller) loads each case once per study, so every seed of a
+    problem runs on the same loaded case.
     """
     cache = {} if cache is None else cache
-    out = dict(versions_input())
+    fingerprint = dict(versions_input())
+    cases: dict[str, Any] = {}
     for spec in (run.problem, run.algorithm):
         key = canonical_json(spec.identity())  # holds the kind: {"problem": ...} or {"algorithm": ...}
         if key not in cache:
-            cache[key] = spec_inputs(spec)
-        out.update(cache[key])
-    return out
+            cache[key] = resolve_spec(spec)
+        fingerprint.update(cache[key].fingerprint)
+        cases.update(cache[key].cases)
+    return RunInputs(fingerprint, cases)
 
 
-def changed_inputs(stored: dict[str, str] | None, current: dict[str, str]) -> list[str]:
+def run_inputs(run: RunSpec, cache: dict[Any, RunInputs] | None = None) -> dict[str, str]:
+    """The fingerprint of ``run``'s inputs (see the module docstring and :func:`resolve_run`)."""
+    return dict(resolve_run(run, cache).fingerprint)
+
+
+def code_only(keys: list[str]) -> bool:
+    """True when every changed fingerprint key describes the code (``CODE_KEYS``), not the data."""
+    return bool(keys) and all(key in CODE_KEYS for key in keys)
+
+
+def changed_keys(stored: Mapping[str, str] | None, current: Mapping[str, str]) -> list[str]:
+    """The fingerprint keys whose values differ (every current key when nothing is stored)."""
+    if stored is None:
+        return sorted(current)
+    return [key for key in sorted(set(stored) | set(current)) if stored.get(key) != current.get(key)]
+
+
+def changed_inputs(stored: Mapping[str, str] | None, current: Mapping[str, str]) -> list[str]:
     """What differs between a stored fingerprint and the current one, in words (empty: nothing)."""
     if stored is None:
         return ["the record has no input fingerprint (written by an older pymoo-rail)"]
     reasons = []
-    for key in sorted(set(stored) | set(current)):
+    for key in changed_keys(stored, current):
         before, now = stored.get(key), current.get(key)
-        if before == now:
-            continue
         if before is None:
             reasons.append(f"{key} is new")
         elif now is None:
             reasons.append(f"{key} is no longer used")
         elif "version" in key:
             reasons.append(f"{key} changed from {before} to {now}")
+        elif key == "pymoo-rail code":
+            reasons.append("the pymoo-rail code changed since the run was stored (same version string)")
         else:
             reasons.append(f"{key} changed since the run was stored")
     return reasons

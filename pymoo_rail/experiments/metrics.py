@@ -12,7 +12,8 @@ Conventions (written down because papers differ):
 - single objective: ``f_best`` and, where the optimum is known, ``error = f_best - f_opt``.
 
 An indicator that does not apply (no known front, a single point) is left out of the record,
-and shows as a missing value (NaN) in the results table: never a number that means nothing.
+never a number that means nothing; the record says why under ``unavailable``
+(:func:`unavailable_indicators`), and the tables show that reason instead of a blank.
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ def spacing_indicator():
     return Spacing()
 
 
+FRONT_INDICATORS = ("igd", "gd", "gd_vv", "hv")
+
+
 def true_front(problem) -> np.ndarray | None:
     """The problem's known Pareto front (dense where pymoo allows), or None.
 
@@ -46,21 +50,40 @@ def true_front(problem) -> np.ndarray | None:
     numpy.ndarray or None
         The front, shape (n, n_obj), or ``None`` when the problem knows none.
     """
+    return true_front_and_reason(problem)[0]
+
+
+def true_front_and_reason(problem) -> tuple[np.ndarray | None, str]:
+    """:func:`true_front` and, when there is none, why (the problem's own words where it gives them)."""
     try:
         try:
             pf = problem.pareto_front(n_pareto_points=1000, use_cache=False)
         except TypeError:  # a front without a size argument
             pf = problem.pareto_front()
-    except NotImplementedError:  # no known front (pymoo_rail.problems.reference.NoExactFrontError)
-        return None
+    except NotImplementedError as err:  # no known front (pymoo_rail.problems.reference.NoExactFrontError)
+        return None, f"no true front: {err}" if str(err) else "no true front: the problem knows none"
     if pf is None:
-        return None
+        return None, f"no true front: {type(problem).__name__} knows none"
     pf = np.atleast_2d(np.asarray(pf, dtype=float))
     if pf.size == 0 or not np.all(np.isfinite(pf)):
-        return None
+        return None, f"no true front: {type(problem).__name__} gives an empty or non-finite one"
     if pf.shape[1] != problem.n_obj:
         pf = pf.reshape(-1, problem.n_obj)
-    return pf
+    return pf, ""
+
+
+def unavailable_indicators(n_obj: int, n_feasible: int, front_reason: str) -> dict[str, str]:
+    """Why each indicator a record leaves out is missing (``front_reason``: from :func:`true_front_and_reason`)."""
+    out: dict[str, str] = {}
+    if n_feasible == 0:
+        names = ("f_best", "error") if n_obj == 1 else (*FRONT_INDICATORS, "spacing")
+        return {name: "no feasible solution in the final front" for name in names}
+    if front_reason:
+        for name in (("error",) if n_obj == 1 else FRONT_INDICATORS):
+            out[name] = front_reason
+    if n_obj > 1 and n_feasible < 2:
+        out["spacing"] = "needs at least 2 feasible points"
+    return out
 
 
 def normalised_hv(F: np.ndarray, ideal: np.ndarray, nadir: np.ndarray) -> float:

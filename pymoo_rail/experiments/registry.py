@@ -6,22 +6,47 @@ importable callable works as ``"package.module:attribute"``, called with the spe
 arguments, so users extend a study without touching this module and without registering
 anything at run time (a run-time registry would not reach remote workers).
 
+An import path runs code the study file names, so it is refused unless the caller says the file
+is trusted (``trusted=True``, ``--trust`` on the command line): a study file or a results folder
+received from someone else cannot run anything by default (:func:`check_trust`). Parameters are
+checked against the signature of what they are passed to (:func:`check_parameters`), so a
+misspelt keyword is an error, not a silently ignored default.
+
 Rail problems and algorithms are imported inside their factories, so this module works, and
 lists them, before or without those parts of the package.
 """
 
 from __future__ import annotations
 
+import difflib
 import importlib
+import inspect
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, Iterator, Mapping
 
-from pymoo_rail.experiments.spec import AlgorithmSpec, ProblemSpec, StudyError
+from pymoo_rail.experiments.spec import AlgorithmSpec, ProblemSpec, Study, StudyError
+
+TRUST_HINT = ("an import path runs the code it names: pass trusted=True (command line: --trust) only for a "
+              "study file or results folder you trust")
+
+
+class UntrustedCodeError(StudyError):
+    """A study or results folder names code to import (``"module:callable"``) and the caller did not trust it."""
+
+
+def _forwards(module: str, *attributes: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Mark a factory whose ``**params`` go to ``module.attribute`` (whose signatures then check them)."""
+    def mark(factory: Callable[..., Any]) -> Callable[..., Any]:
+        factory.forwards_to = tuple((module, attribute) for attribute in attributes)
+        return factory
+
+    return mark
 
 # --------------------------------------------------------------------------------- problems
 
 
-def _pymoo_problem(name: str) -> Callable[..., Any]:
+def _pymoo_problem(name: str, module: str) -> Callable[..., Any]:
+    @_forwards(module, name.upper())
     def factory(**params):
         from pymoo.problems import get_problem
 
@@ -82,6 +107,7 @@ def _controller(spec: Any):
         raise StudyError("problem speed_profile tracking", spec, str(err)) from None
 
 
+@_forwards("pymoo_rail.problems", "SpeedProfileProblem")
 def _speed_profile(case: Any = "yizhuang", load: str | None = None, tracking: Any = None, **params):
     """``pymoo_rail.problems.SpeedProfileProblem`` on a case (built-in name or file path; ``load``:
     a passenger load state such as ``"AW3"``; ``tracking``: a controller as a table,
@@ -93,6 +119,7 @@ def _speed_profile(case: Any = "yizhuang", load: str | None = None, tracking: An
     return SpeedProfileProblem(_case(case, load), **_tuples(params))
 
 
+@_forwards("pymoo_rail.problems", "CooperativeTrainsProblem")
 def _cooperative_trains(case: Any = "cooperative-pair", **params):
     """``pymoo_rail.problems.CooperativeTrainsProblem`` (Chen et al. (2017))."""
     from pymoo_rail.problems import CooperativeTrainsProblem
@@ -100,6 +127,7 @@ def _cooperative_trains(case: Any = "cooperative-pair", **params):
     return CooperativeTrainsProblem(_case(case), **_tuples(params))
 
 
+@_forwards("pymoo_rail.problems", "CooperativeTrainsProblem")
 def _cooperative_scaled(case: Any = "cooperative-pair", phi: float = 1.0, **params):
     """``CooperativeTrainsProblem`` on a case with every gradient times ``phi`` (Chen et al. 2017, fig. 6)."""
     from pymoo_rail.problems import CooperativeTrainsProblem
@@ -108,6 +136,7 @@ def _cooperative_scaled(case: Any = "cooperative-pair", phi: float = 1.0, **para
     return CooperativeTrainsProblem(scale_gradients(_case(case), phi), **_tuples(params))
 
 
+@_forwards("pymoo_rail.problems.cooperative_seed", "CooperativeSeedProblem")
 def _cooperative_seed(case: Any = "cooperative-pair", **params):
     """``pymoo_rail.problems.cooperative_seed.CooperativeSeedProblem`` (the paper's encoding on the kernel)."""
     from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem
@@ -115,6 +144,7 @@ def _cooperative_seed(case: Any = "cooperative-pair", **params):
     return CooperativeSeedProblem(_case(case), **_tuples(params))
 
 
+@_forwards("pymoo_rail.problems", "TimetableProblem")
 def _timetable(case: Any = "cooperative-pair", **params):
     """``pymoo_rail.problems.TimetableProblem``: several trains sharing braking energy."""
     from pymoo_rail.problems import TimetableProblem
@@ -122,6 +152,7 @@ def _timetable(case: Any = "cooperative-pair", **params):
     return TimetableProblem(_case(case), **_tuples(params))
 
 
+@_forwards("pymoo_rail.problems", "KinematicPhasesProblem")
 def _kinematic_phases(case: Any = "metro-a", **params):
     """``pymoo_rail.problems.KinematicPhasesProblem`` (the four-phase model of Meng et al. 2017)."""
     from pymoo_rail.problems import KinematicPhasesProblem
@@ -129,6 +160,7 @@ def _kinematic_phases(case: Any = "metro-a", **params):
     return KinematicPhasesProblem(_case(case), **_tuples(params))
 
 
+@_forwards("pymoo_rail.control.tuning", "ControllerTuningProblem")
 def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
     """``pymoo_rail.control.tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
     from pymoo_rail.control.tuning import ControllerTuningProblem
@@ -136,6 +168,7 @@ def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params)
     return ControllerTuningProblem(_case(case, load), **params)
 
 
+@_forwards("pymoo_rail.problems", "SpeedProfileProblem")
 def _rail_suite(suite_problem: str, **params):
     """A problem of the rail benchmark suite by name (``pymoo_rail.suite.get_problem``)."""
     from pymoo_rail.suite import get_problem
@@ -147,8 +180,8 @@ def _rail_suite(suite_problem: str, **params):
 
 
 PROBLEMS: dict[str, Callable[..., Any]] = {
-    **{f"zdt{i}": _pymoo_problem(f"zdt{i}") for i in range(1, 7)},
-    **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}") for i in range(1, 8)},
+    **{f"zdt{i}": _pymoo_problem(f"zdt{i}", "pymoo.problems.multi.zdt") for i in range(1, 7)},
+    **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}", "pymoo.problems.many.dtlz") for i in range(1, 8)},
     "sphere": _sphere,
     "griewank": _griewank,
     "rosenbrock": _rosenbrock,
@@ -174,18 +207,21 @@ def _ref_dirs(n_obj: int, n_points: int):
     return get_reference_directions("energy", n_obj, n_points, seed=1)
 
 
+@_forwards("pymoo.algorithms.moo.nsga2", "NSGA2")
 def _nsga2(problem, **params):
     from pymoo.algorithms.moo.nsga2 import NSGA2
 
     return NSGA2(**params)
 
 
+@_forwards("pymoo.algorithms.moo.nsga3", "NSGA3")
 def _nsga3(problem, pop_size: int = 100, **params):
     from pymoo.algorithms.moo.nsga3 import NSGA3
 
     return NSGA3(ref_dirs=_ref_dirs(problem.n_obj, pop_size), pop_size=pop_size, **params)
 
 
+@_forwards("pymoo.algorithms.moo.moead", "MOEAD")
 def _moead(problem, pop_size: int = 100, n_neighbors: int = 20, **params):
     """MOEA/D with ``pop_size`` uniform weight vectors (the population is one per vector)."""
     from pymoo.algorithms.moo.moead import MOEAD
@@ -194,30 +230,35 @@ def _moead(problem, pop_size: int = 100, n_neighbors: int = 20, **params):
     return MOEAD(ref_dirs=ref_dirs, n_neighbors=min(n_neighbors, len(ref_dirs)), **params)
 
 
+@_forwards("pymoo.algorithms.moo.sms", "SMSEMOA")
 def _smsemoa(problem, **params):
     from pymoo.algorithms.moo.sms import SMSEMOA
 
     return SMSEMOA(**params)
 
 
+@_forwards("pymoo.algorithms.moo.age", "AGEMOEA")
 def _agemoea(problem, **params):
     from pymoo.algorithms.moo.age import AGEMOEA
 
     return AGEMOEA(**params)
 
 
+@_forwards("pymoo.algorithms.soo.nonconvex.de", "DE", "Variant")  # DE hands its keywords to its variant too
 def _de(problem, **params):
     from pymoo.algorithms.soo.nonconvex.de import DE
 
     return DE(**params)
 
 
+@_forwards("pymoo.algorithms.soo.nonconvex.pso", "PSO")
 def _pso(problem, **params):
     from pymoo.algorithms.soo.nonconvex.pso import PSO
 
     return PSO(**params)
 
 
+@_forwards("pymoo.algorithms.soo.nonconvex.ga", "GA")
 def _ga(problem, **params):
     from pymoo.algorithms.soo.nonconvex.ga import GA
 
@@ -237,11 +278,13 @@ def _rail_algorithm(name: str, module: str) -> Any:
                                             f"installation ({err})") from None
 
 
+@_forwards("pymoo_rail.algorithms", "ABC")
 def _abc(problem, **params):
     """``pymoo_rail.algorithms.ABC`` (Liu (2019), 3.2-3.3)."""
     return _rail_algorithm("ABC", "abc")(**params)
 
 
+@_forwards("pymoo_rail.algorithms", "MOABC")
 def _moabc(problem, **params):
     """``pymoo_rail.algorithms.MOABC`` (Liu (2019), 4.5.2)."""
     return _rail_algorithm("MOABC", "moabc")(**params)
@@ -256,6 +299,7 @@ def _fixed_genes(problem):
     return mask if mask.any() else None
 
 
+@_forwards("pymoo_rail.algorithms", "GoldenRatioNSGA2")
 def _grnsga2(problem, **params):
     """``pymoo_rail.algorithms.GoldenRatioNSGA2`` (Tang et al. (2020), 3.1); on a rail problem the genes of
     neutral sections are passed as ``fixed_genes`` unless given."""
@@ -321,8 +365,8 @@ OPERATORS: dict[str, dict[str, tuple[str, str]]] = {
 }
 
 
-def _operator(kind: str, value: Any, where: str) -> Any:
-    """A pymoo operator from ``"name"`` or ``{operator = "name", ...keyword arguments}``."""
+def _operator_name(kind: str, value: Any, where: str) -> tuple[str, dict]:
+    """The name and keyword arguments of an operator entry (``"name"`` or ``{operator = "name", ...}``)."""
     if isinstance(value, str):
         name, params = value, {}
     elif isinstance(value, dict):
@@ -334,8 +378,14 @@ def _operator(kind: str, value: Any, where: str) -> Any:
         raise StudyError(where, value, f"must be a {kind} name or a table {{operator = \"name\", ...}}")
     if not isinstance(name, str):
         raise StudyError(f"{where}.operator", name, "must be a name")
+    return name, params
+
+
+def _operator(kind: str, value: Any, where: str, trusted: bool) -> Any:
+    """A pymoo operator from ``"name"`` or ``{operator = "name", ...keyword arguments}``."""
+    name, params = _operator_name(kind, value, where)
     if ":" in name:
-        factory = _import_path(name, f"{where}.operator")
+        factory = _import_path(name, f"{where}.operator", trusted)
     else:
         key = name.strip().lower().replace("-", "_")
         if key not in OPERATORS[kind]:
@@ -343,19 +393,138 @@ def _operator(kind: str, value: Any, where: str) -> Any:
                              f"unknown {kind} (built-in: {', '.join(OPERATORS[kind])}; or 'module:Class')")
         module, attribute = OPERATORS[kind][key]
         factory = getattr(importlib.import_module(module), attribute)
+    _check_keywords(factory, params, where, f"{kind} '{name}'")
     try:
         return factory(**params)
     except TypeError as err:
         raise StudyError(where, value, f"bad parameters: {err}") from None
 
 
-def _with_operators(params: dict, where: str) -> dict:
+def _with_operators(params: dict, where: str, trusted: bool) -> dict:
     """``params`` with its crossover / mutation / sampling tables made into pymoo operators."""
     out = dict(params)
     for kind in OPERATORS:
         if kind in out:
-            out[kind] = _operator(kind, out[kind], f"{where}.{kind}")
+            out[kind] = _operator(kind, out[kind], f"{where}.{kind}", trusted)
     return out
+
+
+# ------------------------------------------------------------------------- trust and checks
+
+
+def import_paths(study: Study) -> Iterator[tuple[str, str]]:
+    """``(field, value)`` of every import path a study names: problems, algorithms, operators."""
+    for i, p in enumerate(study.problems):
+        if ":" in p.name:
+            yield f"problems[{i}].problem", p.name
+    for i, a in enumerate(study.algorithms):
+        if ":" in a.name:
+            yield f"algorithms[{i}].algorithm", a.name
+        for kind in OPERATORS:
+            value = a.params.get(kind)
+            name = value.get("operator") if isinstance(value, dict) else value
+            if isinstance(name, str) and ":" in name:
+                yield f"algorithms[{i}].{kind}.operator", name
+
+
+def check_trust(study: Study, trusted: bool) -> None:
+    """Raise :class:`UntrustedCodeError` naming the first import path of ``study`` unless ``trusted``.
+
+    Nothing is imported: the check reads names only, so it is safe on a received study file.
+    """
+    if trusted:
+        return
+    for where, value in import_paths(study):
+        raise UntrustedCodeError(where, value, TRUST_HINT)
+
+
+# pymoo's base classes take **kwargs and drop what they do not know: a keyword that reaches them
+# unused is a mistake, not an extension point
+_DROPPING_BASES = {("pymoo.core.algorithm", "Algorithm"), ("pymoo.core.problem", "Problem")}
+
+
+def accepted_parameters(target: Callable[..., Any]) -> frozenset[str] | None:
+    """The keyword arguments ``target`` (a class or function) uses, or None when it cannot be told.
+
+    A class is followed up its bases while each ``__init__`` passes ``**kwargs`` on; pymoo's
+    ``Algorithm`` and ``Problem``, which drop unknown keywords, end the chain. A registry factory
+    marked with the class its ``**params`` go to adds that class's names. None: the target hands
+    ``**kwargs`` to code that cannot be inspected (then nothing is checked).
+    """
+    names: set[str] = set()
+    if inspect.isclass(target):
+        for klass in target.__mro__:
+            if klass is object or "__init__" not in vars(klass):
+                continue
+            open_end = _add_parameters(names, klass.__init__)
+            if (klass.__module__, klass.__qualname__) in _DROPPING_BASES or not open_end:
+                return frozenset(names - {"self"})
+        return None
+    try:
+        open_end = _add_parameters(names, target)
+    except (TypeError, ValueError):
+        return None
+    if not open_end:
+        return frozenset(names)
+    forwards = getattr(target, "forwards_to", None)
+    if forwards is None:
+        return None
+    for module, attribute in forwards:
+        try:
+            inner = accepted_parameters(getattr(importlib.import_module(module), attribute))
+        except (ImportError, AttributeError):
+            return None
+        if inner is None:
+            return None
+        names |= inner
+    return frozenset(names)
+
+
+def _add_parameters(names: set[str], function: Callable[..., Any]) -> bool:
+    """Add the keyword names of ``function`` to ``names``; True when it also takes ``**kwargs``."""
+    open_end = False
+    for parameter in inspect.signature(function).parameters.values():
+        if parameter.kind is inspect.Parameter.VAR_KEYWORD:
+            open_end = True
+        elif parameter.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY):
+            names.add(parameter.name)
+    return open_end
+
+
+def _check_keywords(target: Callable[..., Any], params: Mapping[str, Any], where: str, what: str,
+                    internal: tuple[str, ...] = ()) -> None:
+    accepted = accepted_parameters(target)
+    if accepted is None:
+        return
+    accepted = accepted - set(internal)
+    for key in params:
+        if key not in accepted:
+            close = difflib.get_close_matches(key, accepted, n=1)
+            hint = f"did you mean '{close[0]}'? " if close else ""
+            raise StudyError(f"{where}.{key}", params[key],
+                             f"unknown parameter of {what} ({hint}accepted: {', '.join(sorted(accepted))})")
+
+
+def check_parameters(spec: ProblemSpec | AlgorithmSpec, where: str, trusted: bool = False) -> None:
+    """Raise :class:`StudyError` naming ``where.<key>`` for a parameter the named factory does not take.
+
+    Checked against the signature of the factory and of the class it passes its keywords to
+    (:func:`accepted_parameters`), so ``pop_sise = 40`` or ``n_vars = 8`` fail before any run.
+    """
+    kind = "problem" if isinstance(spec, ProblemSpec) else "algorithm"
+    factory = _factory(spec, kind, trusted)
+    # the registry's own positional argument (the problem an algorithm is built for) is not a parameter
+    internal = ("problem",) if kind == "algorithm" and ":" not in spec.name else ()
+    _check_keywords(factory, spec.params, where, f"{kind} '{spec.name}'", internal)
+    if kind == "algorithm":
+        for key in OPERATORS:
+            if key in spec.params:
+                name, params = _operator_name(key, spec.params[key], f"{where}.{key}")
+                if ":" not in name:
+                    module, attribute = OPERATORS[key].get(name.strip().lower().replace("-", "_"), (None, None))
+                    if module is not None:
+                        _check_keywords(getattr(importlib.import_module(module), attribute), params,
+                                        f"{where}.{key}", f"{key} '{name}'")
 
 
 # ------------------------------------------------------------------------------ resolving
@@ -371,7 +540,9 @@ def canonical_name(name: str) -> str:
     return ALIASES.get(key.replace("_", "-"), key)
 
 
-def _import_path(path: str, kind: str) -> Callable[..., Any]:
+def _import_path(path: str, kind: str, trusted: bool) -> Callable[..., Any]:
+    if not trusted:
+        raise UntrustedCodeError(kind, path, TRUST_HINT)
     module_name, _, attribute = path.partition(":")
     try:
         module = importlib.import_module(module_name)
@@ -397,7 +568,7 @@ def check_problem_name(name: str) -> None:
     """Raise :class:`StudyError` for a name that is neither built in nor an import path."""
     if ":" not in name and canonical_name(name) not in PROBLEMS:
         raise StudyError("problem", name, f"unknown problem (built-in: {', '.join(problem_names())}; "
-                                          "or give 'package.module:factory')")
+                                          "or give 'package.module:factory' with trusted=True)")
 
 
 def check_algorithm_name(name: str) -> None:
@@ -406,11 +577,21 @@ def check_algorithm_name(name: str) -> None:
     """
     if ":" not in name and canonical_name(name) not in ALGORITHMS:
         raise StudyError("algorithm", name, f"unknown algorithm (built-in: {', '.join(algorithm_names())}; "
-                                            "or give 'package.module:factory')")
+                                            "or give 'package.module:factory' with trusted=True)")
 
 
-def _call(factory: Callable[..., Any], kind: str, spec, *args) -> Any:
-    params = _with_operators(spec.params, f"{kind} '{spec.display}'") if kind == "algorithm" else spec.params
+def _factory(spec: ProblemSpec | AlgorithmSpec, kind: str, trusted: bool) -> Callable[..., Any]:
+    """The callable a spec names: a registry factory, or an import path when ``trusted``."""
+    if ":" in spec.name:
+        return _import_path(spec.name, kind, trusted)
+    if kind == "problem":
+        check_problem_name(spec.name)
+        return PROBLEMS[canonical_name(spec.name)]
+    check_algorithm_name(spec.name)
+    return ALGORITHMS[canonical_name(spec.name)].factory
+
+
+def _call(factory: Callable[..., Any], kind: str, spec, params: Mapping[str, Any], *args) -> Any:
     try:
         return factory(*args, **params)
     except TypeError as err:
@@ -418,24 +599,42 @@ def _call(factory: Callable[..., Any], kind: str, spec, *args) -> Any:
         raise StudyError(f"{kind} '{spec.display}'", spec.params, f"bad parameters: {err}") from None
 
 
-def build_problem(spec: ProblemSpec):
-    """The pymoo problem a spec names."""
-    if ":" in spec.name:
-        return _call(_import_path(spec.name, "problem"), "problem", spec)
-    check_problem_name(spec.name)
-    return _call(PROBLEMS[canonical_name(spec.name)], "problem", spec)
+def build_problem(spec: ProblemSpec, trusted: bool = False, cases: Mapping[str, Any] | None = None):
+    """The pymoo problem a spec names.
+
+    Parameters
+    ----------
+    spec : ProblemSpec
+    trusted : bool
+        Allow an import path (``"module:factory"``), which runs the code it names.
+    cases : mapping, optional
+        Cases already loaded, by the spec's ``case`` value: a built-in problem then uses exactly
+        the case its fingerprint was computed from (:func:`pymoo_rail.experiments.inputs.resolve_run`),
+        not the file as it is when the run starts. An import path gets its parameters as written
+        (its ``case`` stays the string it reads itself).
+    """
+    factory = _factory(spec, "problem", trusted)
+    check_parameters(spec, f"problem '{spec.display}'", trusted)
+    params = dict(spec.params)
+    if cases and ":" not in spec.name and isinstance(params.get("case"), str) and params["case"] in cases:
+        params["case"] = cases[params["case"]]
+    return _call(factory, "problem", spec, params)
 
 
-def build_algorithm(spec: AlgorithmSpec, problem):
-    """The pymoo algorithm a spec names, set up for ``problem``'s number of objectives."""
+def build_algorithm(spec: AlgorithmSpec, problem, trusted: bool = False):
+    """The pymoo algorithm a spec names, set up for ``problem``'s number of objectives.
+
+    ``trusted`` allows import paths for the algorithm and its operators (see :func:`build_problem`).
+    """
+    factory = _factory(spec, "algorithm", trusted)
+    check_parameters(spec, f"algorithm '{spec.display}'", trusted)
+    params = _with_operators(spec.params, f"algorithm '{spec.display}'", trusted)
     if ":" in spec.name:
-        return _call(_import_path(spec.name, "algorithm"), "algorithm", spec)
-    check_algorithm_name(spec.name)
-    name = canonical_name(spec.name)
-    entry = ALGORITHMS[name]
+        return _call(factory, "algorithm", spec, params)
+    entry = ALGORITHMS[canonical_name(spec.name)]
     n_obj = problem.n_obj
     if entry.objectives == "single" and n_obj != 1:
         raise StudyError("algorithm", spec.name, f"is single-objective; the problem has {n_obj} objectives")
     if entry.objectives == "multi" and n_obj < 2:
         raise StudyError("algorithm", spec.name, "is multi-objective; the problem has 1 objective")
-    return _call(entry.factory, "algorithm", spec, problem)
+    return _call(factory, "algorithm", spec, params, problem)

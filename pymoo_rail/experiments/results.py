@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pymoo_rail.experiments.inputs import changed_inputs, run_inputs
+from pymoo_rail.experiments.inputs import changed_inputs, changed_keys, code_only, run_inputs
 from pymoo_rail.experiments.spec import Study
 from pymoo_rail.experiments.store import STUDY_FILE, ResultStore
 
@@ -27,7 +27,8 @@ def _study_of(directory: Path, study: Study | None) -> Study | None:
     return None
 
 
-def load_records(directory: str | Path, study: Study | None = None, all_runs: bool = False) -> list[dict]:
+def load_records(directory: str | Path, study: Study | None = None, all_runs: bool = False,
+                 trusted: bool = False) -> list[dict]:
     """The stored records of a study directory.
 
     Parameters
@@ -37,29 +38,53 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
         Keep the runs of this study and label them with its current labels. By default the
         directory's ``study.toml`` is used; records of runs the study no longer contains
         (e.g. after its parameters were edited) are left out unless ``all_runs``; so are records
-        whose inputs changed since they were stored (an edited case file, another package
-        version), with a warning that says which: run the study again to redo them.
+        whose data inputs changed since they were stored (an edited case file), with a warning
+        that says which: run the study again to redo them. Records computed by other code (another
+        pymoo-rail source or library version) are kept, with one warning that says how many.
     all_runs : bool
-        Return every record in the directory, with the labels stored in it.
+        Return every record in the directory, with the labels stored in it (nothing is rebuilt
+        or looked up).
+    trusted : bool
+        Allow a study that names code to import (``"module:callable"``): checking its records
+        looks the module up, which imports its packages. Without it such a study is an
+        :class:`~pymoo_rail.experiments.registry.UntrustedCodeError` naming the entry; nothing
+        the folder names is imported.
+
+    Raises
+    ------
+    RecordError
+        A record that fails its checks (names the file), including one of an older format.
     """
+    from pymoo_rail.experiments.registry import check_trust
+
     directory = Path(directory)
     study = None if all_runs else _study_of(directory, study)
     store = ResultStore(directory)
     if study is None:
         return list(store.records())
+    check_trust(study, trusted)
     runs = {r.run_id: r for r in study.runs()}
     records = []
+    other_code: list[str] = []
     cache: dict = {}
     for record in store.records(set(runs)):
         run = runs[record["run_id"]]
-        reasons = changed_inputs(record.get("inputs"), run_inputs(run, cache))
-        if reasons:
-            warnings.warn(f"{store.path(run.run_id)} ({run.describe()}) left out: {'; '.join(reasons)}; "
+        current = run_inputs(run, cache)
+        keys = changed_keys(record.get("inputs"), current)
+        if keys and code_only(keys):
+            other_code.append(f"{run.describe()}: {'; '.join(changed_inputs(record.get('inputs'), current))}")
+        elif keys:
+            warnings.warn(f"{store.path(run.run_id)} ({run.describe()}) left out: "
+                          f"{'; '.join(changed_inputs(record.get('inputs'), current))}; "
                           "run the study again to redo it", stacklevel=2)
             continue
         record["problem_label"] = run.problem.display
         record["algorithm_label"] = run.algorithm.display
         records.append(record)
+    if other_code:
+        warnings.warn(f"{len(other_code)} of the records in {directory} were computed by other code (e.g. "
+                      f"{other_code[0]}); they are shown as stored: run the study again to recompute them",
+                      stacklevel=2)
     return records
 
 
@@ -71,7 +96,8 @@ def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
     With ``fronts``, the columns ``F`` and ``X`` hold the final front as arrays, ``extras`` a
     dict of per-member arrays (rail problems: ``energy_kwh``, ``running_time_s``,
     ``stop_error_m``) and ``history`` the per-generation dict of lists.
-    Indicators that do not apply to a run are missing (NaN).
+    Indicators that do not apply to a run are missing (NaN); ``unavailable`` holds why, per
+    indicator (``{"igd": "no true front: ..."}``), as the run recorded it.
     """
     rows = []
     for r in records:
@@ -82,6 +108,7 @@ def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
                "cpu_time_s": r.get("cpu_time_s", np.nan),  # records before cpu_time_s existed
                "feasible": r["feasible"], "problem_spec": r["problem"], "algorithm_spec": r["algorithm"]}
         row.update(r["indicators"])
+        row["unavailable"] = dict(r.get("unavailable", {}))
         row.update({k: v for k, v in r.get("counters", {}).items() if k not in row})
         if fronts:
             n_obj, n_var = r["n_obj"], r["n_var"]
@@ -98,13 +125,15 @@ def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
 
 
 def load_results(directory: str | Path, study: Study | None = None, fronts: bool = True,
-                 all_runs: bool = False) -> pd.DataFrame:
+                 all_runs: bool = False, trusted: bool = False) -> pd.DataFrame:
     """The runs stored in a study directory as a DataFrame (see :func:`records_frame`).
+
+    ``study``, ``all_runs`` and ``trusted`` are those of :func:`load_records`.
 
     >>> results = load_results("out/zdt")                                    # doctest: +SKIP
     >>> results.groupby(["problem", "algorithm"])["igd"].median()            # doctest: +SKIP
     """
-    return records_frame(load_records(directory, study, all_runs), fronts=fronts)
+    return records_frame(load_records(directory, study, all_runs, trusted), fronts=fronts)
 
 
 def indicator_columns(results: pd.DataFrame) -> list[str]:

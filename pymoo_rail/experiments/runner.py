@@ -28,16 +28,18 @@ from concurrent.futures.process import BrokenProcessPool
 from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 
-from pymoo_rail.experiments.metrics import convergence_point, front_indicators, true_front
-from pymoo_rail.experiments.registry import build_algorithm, build_problem
-from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
 from pymoo_rail.experiments.fronts import distinct_front
-from pymoo_rail.experiments.inputs import changed_inputs, run_inputs
-from pymoo_rail.experiments.store import CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, RecordError, ResultStore
+from pymoo_rail.experiments.inputs import RunInputs, changed_inputs, resolve_run
+from pymoo_rail.experiments.metrics import (convergence_point, front_indicators, true_front_and_reason,
+                                            unavailable_indicators)
+from pymoo_rail.experiments.registry import build_algorithm, build_problem, check_parameters, check_trust
+from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
+from pymoo_rail.experiments.store import (CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, LegacyRecordError,
+                                          RecordError, ResultStore, writing)
 
 # per-individual outputs a rail problem puts next to F (DESIGN.md section 3); kept with the front
 EXTRA_KEYS = ("energy_kwh", "running_time_s", "stop_error_m")
@@ -109,23 +111,34 @@ def run_counters(algorithm) -> dict[str, float]:
     return counters
 
 
-def execute_run(run: RunSpec, inputs: dict[str, str] | None = None) -> dict[str, Any]:
+def _as_inputs(inputs: RunInputs | Mapping[str, str] | None, run: RunSpec) -> RunInputs:
+    if inputs is None:
+        return resolve_run(run)
+    if isinstance(inputs, RunInputs):
+        return inputs
+    return RunInputs(dict(inputs))  # a bare fingerprint: the run loads its case itself
+
+
+def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = None,
+                trusted: bool = False) -> dict[str, Any]:
     """Run one study run and return its record (a JSON-ready dict).
 
-    ``inputs`` is the fingerprint of the run's inputs (:func:`.inputs.run_inputs`, computed here
-    when not given); it is stored with the record so a later start can tell a stale record.
+    ``inputs`` (:func:`.inputs.resolve_run`, computed here when not given) holds the fingerprint
+    of the run's inputs, stored with the record so a later start can tell a stale record, and the
+    cases the fingerprint was computed from, which the run uses instead of reading the files again.
+    ``trusted`` allows specs that name code to import (``"module:callable"``).
     The record holds the final front (``F``, ``X``, constraint violation and, for rail problems,
-    energy, running time and stop error of each member), its indicators, the evaluations used,
-    the wall and CPU time (CPU time of this process, all its threads), the algorithm's
-    :func:`run_counters`, the per-generation history and the versions of pymoo and pymoo-rail.
+    energy, running time and stop error of each member), its indicators and why any is missing
+    (``unavailable``), the evaluations used, the wall and CPU time (CPU time of this process, all
+    its threads), the algorithm's :func:`run_counters`, the per-generation history and the versions
+    of pymoo and pymoo-rail.
     """
     from pymoo.optimize import minimize
 
-    if inputs is None:
-        inputs = run_inputs(run)
-    problem = build_problem(run.problem)
-    algorithm = build_algorithm(run.algorithm, problem)
-    pf = true_front(problem)
+    inputs = _as_inputs(inputs, run)
+    problem = build_problem(run.problem, trusted, inputs.cases)
+    algorithm = build_algorithm(run.algorithm, problem, trusted)
+    pf, front_reason = true_front_and_reason(problem)
     history = _History(pf) if run.history else None
     start, start_cpu = time.perf_counter(), time.process_time()
     res = minimize(problem, algorithm, run.budget.termination, seed=run.seed, verbose=False,
@@ -139,6 +152,8 @@ def execute_run(run: RunSpec, inputs: dict[str, str] | None = None) -> dict[str,
     CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1) if len(opt) else np.empty(0)
     feasible = CV <= 0.0
     indicators = front_indicators(F[feasible], pf)
+    unavailable = {k: v for k, v in unavailable_indicators(int(problem.n_obj), int(feasible.sum()),
+                                                           front_reason).items() if k not in indicators}
     return {
         "format": RECORD_FORMAT,
         "run_id": run.run_id,
@@ -156,21 +171,23 @@ def execute_run(run: RunSpec, inputs: dict[str, str] | None = None) -> dict[str,
         "cpu_time_s": cpu_time_s,
         "feasible": bool(feasible.any()),
         "indicators": indicators,
+        "unavailable": unavailable,
         "counters": run_counters(res.algorithm),
         "front": {"F": F.tolist(), "X": X.tolist(), "CV": CV.tolist(),
                   "extras": _extras(problem, opt, X) if len(X) else {}},
         "history": history.columns() if history is not None else None,
         "versions": versions(),
-        "inputs": dict(inputs),
+        "inputs": dict(inputs.fingerprint),
         "host": socket.gethostname(),
         "finished_at": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
     }
 
 
-def execute_run_safely(run: RunSpec, inputs: dict[str, str] | None = None) -> tuple[str, dict[str, Any]]:
+def execute_run_safely(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = None,
+                       trusted: bool = False) -> tuple[str, dict[str, Any]]:
     """:func:`execute_run` that returns an error as data (with its traceback) instead of raising."""
     try:
-        return "ok", execute_run(run, inputs)
+        return "ok", execute_run(run, inputs, trusted)
     except Exception as err:  # noqa: BLE001 - reported per run; the study goes on
         return "error", {"run_id": run.run_id, "run": run.describe(), "error": f"{type(err).__name__}: {err}",
                          "traceback": traceback.format_exc(),
@@ -182,13 +199,14 @@ _WRITE_LOCK = threading.Lock()
 PARENT_POLL_S = 0.5
 
 
-def execute_and_store(run: RunSpec, directory: str, inputs: dict[str, str]) -> tuple[str, dict[str, Any]]:
+def execute_and_store(run: RunSpec, directory: str, inputs: RunInputs | Mapping[str, str],
+                      trusted: bool = False) -> tuple[str, dict[str, Any]]:
     """:func:`execute_run_safely`, then store the record (or the failure) in ``directory`` at once.
 
     Returns ``("ok", {"run_id": ...})`` or ``("error", failure)``: the record itself never has to
     travel back to the driver, so a run finished here is kept even if the driver is gone.
     """
-    status, payload = execute_run_safely(run, inputs)
+    status, payload = execute_run_safely(run, inputs, trusted)
     store = ResultStore(directory)
     with _WRITE_LOCK:
         if status == "ok":
@@ -258,23 +276,35 @@ class StudyReport:
         return text
 
 
-def _check_study(study: Study) -> None:
-    """Build every problem and every (algorithm, problem) pair once: fail before any work starts."""
-    for p in study.problems:
+def check_study(study: Study, trusted: bool = False, cases: Mapping[str, Any] | None = None) -> None:
+    """Check a study before any run starts: trust, every parameter name, every problem and
+    (algorithm, problem) pair built once.
+
+    Raises :class:`StudyError` naming the entry (``problems[0]``, ``algorithms[1].pop_sise``) and
+    the value; :class:`~.registry.UntrustedCodeError` for an import path without ``trusted``.
+    ``cases``: cases already loaded, by the specs' ``case`` values (see :func:`.registry.build_problem`).
+    """
+    check_trust(study, trusted)
+    for i, p in enumerate(study.problems):
+        check_parameters(p, f"problems[{i}]", trusted)
+    for i, a in enumerate(study.algorithms):
+        check_parameters(a, f"algorithms[{i}]", trusted)
+    for i, p in enumerate(study.problems):
         try:
-            problem = build_problem(p)
+            problem = build_problem(p, trusted, cases)
         except StudyError:
             raise
         except Exception as err:
-            raise StudyError(f"problem '{p.display}'", p.to_dict(), f"cannot be built: {err}") from err
-        for a in study.algorithms:
+            raise StudyError(f"problems[{i}] ('{p.display}')", p.to_dict(), f"cannot be built: {err}") from err
+        for j, a in enumerate(study.algorithms):
             try:
-                build_algorithm(a, problem)
+                build_algorithm(a, problem, trusted)
             except StudyError as err:
-                raise StudyError(f"algorithm '{a.display}'", a.to_dict(),
+                raise StudyError(f"algorithms[{j}] ('{a.display}')", a.to_dict(),
                                  f"cannot run on problem '{p.display}': {err.reason}") from None
             except Exception as err:
-                raise StudyError(f"algorithm '{a.display}'", a.to_dict(), f"cannot be built: {err}") from err
+                raise StudyError(f"algorithms[{j}] ('{a.display}')", a.to_dict(), f"cannot be built: {err}") \
+                    from err
 
 
 def _dask_executor(stack: ExitStack, scheduler: Any, workers: int) -> Executor:
@@ -307,7 +337,8 @@ def pending_runs(study: Study, done_ids: set[str], seed_major: bool = False) -> 
 
 
 def run_study(study: Study, directory: str | Path, workers: int | None = None, scheduler: Any = None,
-              progress: bool = True, check: bool = True, seed_major: bool = False) -> StudyReport:
+              progress: bool = True, check: bool = True, seed_major: bool = False,
+              trusted: bool = False) -> StudyReport:
     """Run every run of ``study`` that is not yet stored in ``directory``.
 
     Parameters
@@ -330,6 +361,10 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
         Start the runs seed by seed (every problem and algorithm of the first seed, then of the
         second, ...) instead of problem by problem, so a study stopped early still compares
         every algorithm on every problem over the same seeds. Results do not depend on it.
+    trusted : bool
+        Allow problems, algorithms and operators given as ``"module:callable"``: importing them
+        runs their code, so say so only for a study you trust. Without it such a study is a
+        :class:`~.registry.UntrustedCodeError` naming the entry, before anything is imported.
 
     Returns
     -------
@@ -341,72 +376,87 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
     Notes
     -----
     A stored run is skipped only if its record passes its checks and its input fingerprint
-    (case content, files and module the specs name, package versions) equals the current one;
+    (case content, files and module the specs name, the package's code, library versions) equals
+    the current one; a record of an older format is always redone;
     otherwise the record is set aside (``corrupt/`` or ``stale/``), the reason is printed, and
     the run is redone. Each run is claimed with a file lock first, so several processes can work
     on one directory and each run is computed once. See ``docs/experiments.md``.
     """
-    from tqdm import tqdm
-
     from pymoo_rail.experiments.study_file import write_study
 
-    if workers is None:
-        workers = os.cpu_count() or 1
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise StudyError("workers", workers, "must be a positive integer")
-    if check:
-        _check_study(study)
-
-    store = ResultStore(directory)
-    store.prepare()
-    write_study(study, store.directory / STUDY_FILE)
+    workers = _worker_count(workers)
+    check_trust(study, trusted)  # before anything the study names is looked up
     runs = study.runs()
     cache: dict = {}
-    inputs = {run.run_id: run_inputs(run, cache) for run in runs}
-    pending = pending_runs(study, {r.run_id for r in runs if _stored_state(store, r, inputs[r.run_id])[0] == "stored"},
-                           seed_major)
+    inputs = {run.run_id: resolve_run(run, cache) for run in runs}  # each case read once, here
+    if check:
+        check_study(study, trusted, {k: v for i in inputs.values() for k, v in i.cases.items()})
+    store = ResultStore(directory)
+    store.prepare()
+    with writing(store.directory / STUDY_FILE):
+        write_study(study, store.directory / STUDY_FILE)
+    stored = {r.run_id for r in runs if _stored_state(store, r, inputs[r.run_id].fingerprint)[0] == "stored"}
+    pending = pending_runs(study, stored, seed_major)
     report = StudyReport(store.directory, len(runs), len(runs) - len(pending), 0)
-    if not pending:
-        return report
+    if pending:
+        with ExitStack() as stack:
+            bar = stack.enter_context(_progress_bar(study, report, progress))
+            executor = _executor(stack, scheduler, workers, len(pending))
+            _Dispatch(store, executor, report, bar, inputs, trusted, local=scheduler is None,
+                      progress=progress).run(pending, window=2 * workers)
+    return report
 
-    with ExitStack() as stack:
-        bar = stack.enter_context(tqdm(total=len(runs), initial=report.n_skipped, desc=f"study {study.name}",
-                                       unit="run", disable=not progress, dynamic_ncols=True))
-        local = scheduler is None
-        if local and workers == 1:
-            executor: Executor = _InProcess()
-        elif local:
-            executor = stack.enter_context(ProcessPoolExecutor(
-                max_workers=min(workers, len(pending)), mp_context=multiprocessing.get_context("spawn"),
-                initializer=_worker_init, initargs=(os.getpid(),)))
-        else:
-            executor = _dask_executor(stack, scheduler, workers)
 
-        def say(message: str) -> None:
-            report.redone.append(message)
-            if progress:
-                bar.write(f"REDO {message}")
-            else:
-                print(f"pymoo-rail study: REDO {message}", file=sys.stderr)
+def _worker_count(workers: Any) -> int:
+    if workers is None:
+        return os.cpu_count() or 1
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise StudyError("workers", workers, "must be a positive integer")
+    return workers
 
-        def submit(run: RunSpec) -> Future:
-            if local:  # the worker stores its own record
-                return executor.submit(execute_and_store, run, str(store.directory), inputs[run.run_id])
-            return executor.submit(execute_run_safely, run, inputs[run.run_id])
 
-        def finish(run: RunSpec, status: str, payload: dict) -> None:
-            if status == "ok":
-                if not local:
-                    store.write(payload)
-                report.n_finished += 1
-            else:
-                if not local:
-                    store.write_failure(run.run_id, payload)
-                report.failures.append(payload)
-                bar.write(f"FAILED {payload['run']}: {payload['error']}")
-            bar.update(1)
+def _progress_bar(study: Study, report: StudyReport, progress: bool):
+    from tqdm import tqdm
 
-        window = 2 * workers  # runs in flight: enough to keep every worker busy
+    return tqdm(total=report.n_runs, initial=report.n_skipped, desc=f"study {study.name}", unit="run",
+                disable=not progress, dynamic_ncols=True)
+
+
+def _executor(stack: ExitStack, scheduler: Any, workers: int, n_pending: int) -> Executor:
+    """In this process (one worker), a spawned process pool, or Dask (see :func:`run_study`)."""
+    if scheduler is not None:
+        return _dask_executor(stack, scheduler, workers)
+    if workers == 1:
+        return _InProcess()
+    return stack.enter_context(ProcessPoolExecutor(
+        max_workers=min(workers, n_pending), mp_context=multiprocessing.get_context("spawn"),
+        initializer=_worker_init, initargs=(os.getpid(),)))
+
+
+_POOL_DIED = ("a worker process of the local pool died, so the study stopped (finished runs are stored; "
+              "run again to resume). If it died at start-up: the pool starts fresh interpreters that "
+              "import your main script, so call run_study under `if __name__ == \"__main__\":` and not "
+              "from standard input; or use workers=1 or a Dask scheduler.")
+
+
+@dataclass
+class _Dispatch:
+    """The driver's loop: claim each pending run, recheck its record, submit it, store what comes back.
+
+    At most ``window`` runs are in flight; a run another process holds is waited for once this
+    process's own runs are done.
+    """
+
+    store: ResultStore
+    executor: Executor
+    report: StudyReport
+    bar: Any
+    inputs: Mapping[str, RunInputs]
+    trusted: bool
+    local: bool  # pool or in-process: the worker stores its own record
+    progress: bool
+
+    def run(self, pending: list[RunSpec], window: int) -> None:
         queue = deque((run, False) for run in pending)
         busy: list[RunSpec] = []  # claimed by another process: waited for once our own work is done
         in_flight: dict[Future, tuple[RunSpec, Any]] = {}
@@ -417,54 +467,85 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
                     busy.clear()
                 while queue and len(in_flight) < window:
                     run, blocking = queue.popleft()
-                    lock = store.claim(run.run_id, wait=blocking)
-                    if lock is None:
+                    claimed = self.claim(run, blocking)
+                    if claimed == "busy":
                         busy.append(run)
-                        continue
-                    state, reason = _stored_state(store, run, inputs[run.run_id])
-                    if state == "stored":  # another process finished it while we were busy
-                        lock.release()
-                        report.n_elsewhere += 1
-                        bar.update(1)
-                        continue
-                    if state == "corrupt":
-                        moved = store.set_aside(run.run_id, CORRUPT_DIR)
-                        say(f"{run.describe()}: {reason}; moved to {moved}")
-                    elif state == "stale":
-                        moved = store.set_aside(run.run_id, STALE_DIR)
-                        say(f"{run.describe()}: {reason}; the old record is in {moved}")
-                    in_flight[submit(run)] = (run, lock)
-                if not in_flight:
-                    continue
-                done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
-                for future in done:
-                    run, lock = in_flight.pop(future)
-                    try:
-                        finish(run, *future.result())
-                    finally:
-                        lock.release()
+                    elif claimed is not None:
+                        in_flight[self.submit(run)] = (run, claimed)
+                if in_flight:
+                    self.collect(in_flight)
         except BrokenProcessPool as err:
-            raise RuntimeError(
-                "a worker process of the local pool died, so the study stopped (finished runs are stored; "
-                "run again to resume). If it died at start-up: the pool starts fresh interpreters that "
-                "import your main script, so call run_study under `if __name__ == \"__main__\":` and not "
-                "from standard input; or use workers=1 or a Dask scheduler.") from err
+            raise RuntimeError(_POOL_DIED) from err
         except BaseException:
-            for f in in_flight:
-                f.cancel()
-            if isinstance(executor, ProcessPoolExecutor):
-                executor.shutdown(wait=False, cancel_futures=True)
+            for future in in_flight:
+                future.cancel()
+            if isinstance(self.executor, ProcessPoolExecutor):
+                self.executor.shutdown(wait=False, cancel_futures=True)
             raise
         finally:
             for _, lock in in_flight.values():
                 lock.release()
-    return report
+
+    def claim(self, run: RunSpec, blocking: bool) -> Any:
+        """The run's lock when it is to be computed here; ``"busy"`` (another process holds it) or
+        None (another process stored it meanwhile)."""
+        lock = self.store.claim(run.run_id, wait=blocking)
+        if lock is None:
+            return "busy"
+        state, reason = _stored_state(self.store, run, self.inputs[run.run_id].fingerprint)
+        if state == "stored":  # another process finished it while we were busy
+            lock.release()
+            self.report.n_elsewhere += 1
+            self.bar.update(1)
+            return None
+        if state in ("corrupt", "stale"):
+            moved = self.store.set_aside(run.run_id, CORRUPT_DIR if state == "corrupt" else STALE_DIR)
+            self.say(f"{run.describe()}: {reason}; " + (f"moved to {moved}" if state == "corrupt"
+                                                         else f"the old record is in {moved}"))
+        return lock
+
+    def submit(self, run: RunSpec) -> Future:
+        if self.local:  # the worker stores its own record
+            return self.executor.submit(execute_and_store, run, str(self.store.directory),
+                                        self.inputs[run.run_id], self.trusted)
+        return self.executor.submit(execute_run_safely, run, self.inputs[run.run_id], self.trusted)
+
+    def collect(self, in_flight: dict[Future, tuple[RunSpec, Any]]) -> None:
+        """Wait for at least one run in flight to end, store it (Dask) and count it."""
+        done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
+        for future in done:
+            run, lock = in_flight.pop(future)
+            try:
+                self.finish(run, *future.result())
+            finally:
+                lock.release()
+
+    def finish(self, run: RunSpec, status: str, payload: dict) -> None:
+        if status == "ok":
+            if not self.local:
+                self.store.write(payload)
+            self.report.n_finished += 1
+        else:
+            if not self.local:
+                self.store.write_failure(run.run_id, payload)
+            self.report.failures.append(payload)
+            self.bar.write(f"FAILED {payload['run']}: {payload['error']}")
+        self.bar.update(1)
+
+    def say(self, message: str) -> None:
+        self.report.redone.append(message)
+        if self.progress:
+            self.bar.write(f"REDO {message}")
+        else:
+            print(f"pymoo-rail study: REDO {message}", file=sys.stderr)
 
 
-def _stored_state(store: ResultStore, run: RunSpec, inputs: dict[str, str]) -> tuple[str, str]:
+def _stored_state(store: ResultStore, run: RunSpec, inputs: Mapping[str, str]) -> tuple[str, str]:
     """``("stored", "")``, ``("missing", "")``, ``("corrupt", why)`` or ``("stale", why)`` for one run."""
     try:
         record = store.load(run.run_id)
+    except LegacyRecordError as err:
+        return "stale", f"record {err.path} cannot be used ({err.reason})"
     except RecordError as err:
         return "corrupt", f"record {err.path} cannot be used ({err.reason})"
     if record is None:

@@ -247,6 +247,19 @@ def _seeds(seeds: Any, source: str | None = None) -> tuple[int, ...]:
     return values
 
 
+def check_name(name: Any, source: str | None = None) -> str:
+    """A study's name as given, after checking it is a name and not a path (it names ``out/<name>``)."""
+    if not isinstance(name, str) or not name.strip():
+        raise StudyError("name", name, "must be a non-empty string", source)
+    bad = [c for c in name if c in "/\\:" or ord(c) < 32 or ord(c) == 127]
+    if bad or name.strip() in (".", "..") or name.startswith(".") or name != name.strip():
+        raise StudyError("name", name, "must be a name, not a path: no '/', '\\', ':' or control characters, "
+                                       "no leading '.' or surrounding spaces (it names the output folder "
+                                       "out/<name>); use --out or the directory argument to choose where "
+                                       "results go", source)
+    return name
+
+
 def _unique_labels(kind: str, specs: tuple[_Spec, ...], source: str | None) -> None:
     seen: dict[str, _Spec] = {}
     for spec in specs:
@@ -290,8 +303,7 @@ class Study:
     baseline: str | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name.strip():
-            raise StudyError("name", self.name, "must be a non-empty string")
+        check_name(self.name)
         problems = tuple(p if isinstance(p, ProblemSpec) else ProblemSpec.from_dict(p, f"problems[{i}]")
                          for i, p in enumerate(self.problems))
         algorithms = tuple(a if isinstance(a, AlgorithmSpec) else AlgorithmSpec.from_dict(a, f"algorithms[{i}]")

@@ -128,7 +128,9 @@ def indicator_table(results: pd.DataFrame, indicator: str, baseline: str | None 
     """The table papers print: problems x algorithms, cells ``mean (std)``.
 
     With a baseline, each other cell ends in the rank-sum verdict ``+``, ``-`` or ``=``. The best
-    mean per problem is marked with ``*`` (Markdown bold in :func:`write_tables`).
+    mean per problem is marked with ``*`` (Markdown bold in :func:`write_tables`). A cell whose
+    runs have no value of the indicator says why (``n/a: no true front: ...``, the reason the runs
+    recorded): no problem or algorithm is dropped from the table.
     """
     _check_indicators(results, [indicator])
     lower = lower_is_better(indicator)
@@ -136,11 +138,13 @@ def indicator_table(results: pd.DataFrame, indicator: str, baseline: str | None 
     table = {}
     for problem_name, group in results.groupby("problem", sort=True):
         stats = group.groupby("algorithm")[indicator].agg(["mean", "std", "count"])
+        row = {name: "n/a: " + missing_reason(group[group["algorithm"] == name], indicator)
+               for name in stats.index[stats["count"] == 0]}
         stats = stats[stats["count"] > 0]
+        table[problem_name] = row
         if stats.empty:
             continue
         best = stats["mean"].idxmin() if lower else stats["mean"].idxmax()
-        row = {}
         for algorithm_name, s in stats.iterrows():
             std = f"{s['std']:.{digits}g}" if s["count"] > 1 else "-"
             cell = f"{s['mean']:.{digits}g} ({std})"
@@ -151,7 +155,6 @@ def indicator_table(results: pd.DataFrame, indicator: str, baseline: str | None 
             if algorithm_name == best:
                 cell = "*" + cell
             row[algorithm_name] = cell
-        table[problem_name] = row
     frame = pd.DataFrame.from_dict(table, orient="index")
     frame.index.name = "problem"
     columns = sorted(frame.columns)
@@ -159,6 +162,18 @@ def indicator_table(results: pd.DataFrame, indicator: str, baseline: str | None 
         columns.remove(baseline)
         columns.insert(0, baseline)
     return frame[columns].fillna("")
+
+
+def missing_reason(runs: pd.DataFrame, indicator: str) -> str:
+    """Why ``runs`` (rows of a results frame) have no value of ``indicator``, in the runs' own words."""
+    reasons: list[str] = []
+    for notes in runs.get("unavailable", pd.Series(dtype=object)):
+        reason = notes.get(indicator) if isinstance(notes, dict) else None
+        if reason and reason not in reasons:
+            reasons.append(reason)
+    if not reasons:
+        return "not computed for these runs (records written before the reason was stored)"
+    return "; ".join(reasons)
 
 
 def verdict_counts(tests: pd.DataFrame) -> pd.DataFrame:
@@ -348,7 +363,7 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
             sections.append(f"## {name}\n\n" + to_markdown(part, bold_marker=None))
     emit("summary.md", "# Summary over seeds (std: sample standard deviation)\n\n" + "\n".join(sections))
     for name in indicators:
-        if results[name].notna().any():
+        if results[name].notna().any():  # an indicator no run has is not a table of "n/a"
             table = indicator_table(results, name, baseline, alpha)
             emit(f"{name}.csv", table.to_csv())
             title = f"{name}: mean (std) over seeds" + (
@@ -363,7 +378,7 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
     return written
 
 
-__all__ = ["summarize", "rank_sum", "rank_sum_tests", "indicator_table", "verdict_counts", "reference_fronts",
+__all__ = ["summarize", "rank_sum", "rank_sum_tests", "indicator_table", "missing_reason", "verdict_counts", "reference_fronts",
            "add_reference_indicators", "add_energy_gap", "to_markdown", "write_tables", "nondominated",
            "gd_van_veldhuizen"]
 

@@ -22,16 +22,22 @@ Guarantees (``docs/experiments.md`` says how each is tested):
   whose inputs changed, saying which.
 - A run is computed only by the process holding its claim (an OS file lock from ``filelock``,
   released by the system when the holder dies), so two studies on one directory compute each
-  run once.
+  run once. A lock file that is not a regular file (a planted symbolic link) is refused.
+- A record of an older format (no checksum) is never served: reading it raises
+  :class:`LegacyRecordError` and the runner sets it aside and redoes the run.
+- A write that fails for want of space (or of permission) is a :class:`StoreError` naming the
+  file and saying that the records already written are kept.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import errno
 import hashlib
 import json
 import os
 from pathlib import Path
+from contextlib import contextmanager
 from typing import Iterator
 
 from filelock import FileLock, Timeout
@@ -50,7 +56,8 @@ STUDY_FILE = "study.toml"
 REQUIRED_FIELDS = ("format", "run_id", "problem", "algorithm", "seed", "budget", "n_var", "n_obj", "front",
                    "indicators")
 
-__all__ = ["ResultStore", "RecordError", "record_checksum", "atomic_write_text", "RECORD_FORMAT"]
+__all__ = ["ResultStore", "RecordError", "LegacyRecordError", "StoreError", "record_checksum",
+           "atomic_write_text", "RECORD_FORMAT"]
 
 
 class RecordError(ValueError):
@@ -60,6 +67,47 @@ class RecordError(ValueError):
         self.path = Path(path)
         self.reason = reason
         super().__init__(f"{self.path}: {reason}")
+
+
+class LegacyRecordError(RecordError):
+    """A record of an older format (``LEGACY_FORMATS``): it carries no checksum, so it is never served."""
+
+
+class StoreError(OSError):
+    """A study directory that cannot be written or locked; the message names the file and what to do.
+
+    An ``OSError`` (its ``errno`` is the system's), so callers that catch ``OSError`` still do.
+    """
+
+    def __init__(self, path: str | Path, reason: str, code: int | None = None):
+        super().__init__(f"{path}: {reason}")
+        self.path = Path(path)
+        self.reason = reason
+        self.errno = code
+
+    def __reduce__(self):  # pool workers send it back to the study process
+        return type(self), (str(self.path), self.reason, self.errno)
+
+
+# errors a write can meet that no retry fixes: the study stops, saying so
+_FULL = {errno.ENOSPC: "no space left on the device", errno.EDQUOT: "disk quota exceeded",
+         errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied",
+         errno.EPERM: "operation not permitted"}
+
+
+@contextmanager
+def writing(path: str | Path) -> Iterator[None]:
+    """Turn a failed write of ``path`` for want of space or permission into a :class:`StoreError`."""
+    try:
+        yield
+    except StoreError:
+        raise
+    except OSError as err:
+        if err.errno not in _FULL:
+            raise
+        raise StoreError(path, f"cannot write ({_FULL[err.errno]}): the study stopped; every run finished "
+                               "before is kept in runs/, and running the study again resumes once the "
+                               "problem is fixed", err.errno) from err
 
 
 def record_checksum(record: dict) -> str:
@@ -85,7 +133,8 @@ class ResultStore:
     def prepare(self) -> None:
         """Create the directories; remove temporary files whose writing process has ended."""
         for folder in (self.runs_dir, self.failed_dir, self.locks_dir):
-            folder.mkdir(parents=True, exist_ok=True)
+            with writing(folder):
+                folder.mkdir(parents=True, exist_ok=True)
         for folder in (self.directory, self.runs_dir, self.failed_dir):
             for temp in folder.glob(TEMP_PREFIX + "*"):
                 if is_abandoned_temp(temp):
@@ -108,7 +157,8 @@ class ResultStore:
     def write(self, record: dict) -> Path:
         """Store a finished run (adding its checksum); clears an earlier failure of the same run."""
         record = {**record, "checksum": record_checksum(record)}
-        path = atomic_write_text(self.path(record["run_id"]), json.dumps(record))
+        with writing(self.path(record["run_id"])):
+            path = atomic_write_text(self.path(record["run_id"]), json.dumps(record))
         failure = self.failed_dir / f"{record['run_id']}.json"
         try:
             failure.unlink()
@@ -118,7 +168,9 @@ class ResultStore:
 
     def write_failure(self, run_id: str, failure: dict) -> Path:
         """Store the error of a failed run (atomically) and return its file."""
-        return atomic_write_text(self.failed_dir / f"{run_id}.json", json.dumps(failure, indent=1))
+        path = self.failed_dir / f"{run_id}.json"
+        with writing(path):
+            return atomic_write_text(path, json.dumps(failure, indent=1))
 
     def set_aside(self, run_id: str, folder: str) -> Path | None:
         """Move the record of ``run_id`` into ``folder`` (``corrupt`` or ``stale``), time-stamped.
@@ -126,10 +178,11 @@ class ResultStore:
         Returns the new path, or None when there was no record.
         """
         target_dir = self.directory / folder
-        target_dir.mkdir(parents=True, exist_ok=True)
         target = target_dir / f"{run_id}.json.{_stamp()}"
         try:
-            os.replace(self.path(run_id), target)
+            with writing(target):
+                target_dir.mkdir(parents=True, exist_ok=True)
+                os.replace(self.path(run_id), target)
         except FileNotFoundError:
             return None
         return target
@@ -142,12 +195,23 @@ class ResultStore:
         holds it and ``wait`` is false. The operating system releases the lock of a process
         that dies, so a killed study never blocks the next one.
         """
-        self.locks_dir.mkdir(parents=True, exist_ok=True)
-        lock = FileLock(self.locks_dir / f"{run_id}.lock", thread_local=False)
+        path = self.locks_dir / f"{run_id}.lock"
+        with writing(path):
+            self.locks_dir.mkdir(parents=True, exist_ok=True)
+        if self.locks_dir.is_symlink() or path.is_symlink() or (path.exists() and not path.is_file()):
+            raise StoreError(path, "the lock file is not a regular file (a symbolic link or another kind of "
+                                   "file was put in its place): remove it and start the study again")
+        lock = FileLock(path, thread_local=False)
         try:
-            lock.acquire(timeout=-1 if wait else 0)
+            with writing(path):
+                lock.acquire(timeout=-1 if wait else 0)
         except Timeout:
             return None
+        except StoreError:
+            raise
+        except OSError as err:
+            raise StoreError(path, f"cannot take the lock of run {run_id} ({err.strerror or err}): check the "
+                                   "file and the folder's permissions", err.errno) from err
         return lock
 
     # ------------------------------------------------------------------ reading
@@ -168,18 +232,20 @@ class ResultStore:
         if not isinstance(record, dict):
             raise RecordError(path, f"holds a {type(record).__name__}, not a run record")
         fmt = record.get("format")
-        if fmt != RECORD_FORMAT and fmt not in LEGACY_FORMATS:
+        if fmt in LEGACY_FORMATS:
+            raise LegacyRecordError(path, f"field 'format' = {fmt!r}: an older record without a checksum, "
+                                          "never served; run the study again to redo the run")
+        if fmt != RECORD_FORMAT:
             raise RecordError(path, f"field 'format' = {fmt!r}: not a {RECORD_FORMAT} record")
         missing = [k for k in REQUIRED_FIELDS if k not in record]
         if missing:
             raise RecordError(path, f"field '{missing[0]}' is missing: the record is incomplete")
         if record["run_id"] != path.stem:
             raise RecordError(path, f"field 'run_id' = {record['run_id']!r} does not match the file name")
-        if fmt == RECORD_FORMAT:
-            expected = record_checksum(record)
-            if record.get("checksum") != expected:
-                raise RecordError(path, f"field 'checksum' = {record.get('checksum')!r} does not match the "
-                                        f"content ({expected}): the record was altered or damaged")
+        expected = record_checksum(record)
+        if record.get("checksum") != expected:
+            raise RecordError(path, f"field 'checksum' = {record.get('checksum')!r} does not match the "
+                                    f"content ({expected}): the record was altered or damaged")
         return record
 
     def load(self, run_id: str) -> dict | None:
@@ -220,6 +286,8 @@ class ResultStore:
                 continue
             try:
                 yield self.check(p)
+            except LegacyRecordError:
+                raise
             except RecordError as err:
                 raise RecordError(err.path, f"{err.reason}; run the study again to set it aside and redo "
                                             "the run") from None

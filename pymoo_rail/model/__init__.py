@@ -1,6 +1,6 @@
 """Train, line and case data (railway units in the files, SI inside the kernels)."""
 
-from pymoo_rail.model.case import Case, Leg
+from pymoo_rail.model.case import END_SPEED_TOL_MS, Case, Leg
 from pymoo_rail.model.curves import DavisResistance, ForceCurve
 from pymoo_rail.model.errors import CaseError, InfeasibleCaseError
 from pymoo_rail.model.grid import TrackGrid, build_grid
@@ -10,4 +10,4 @@ from pymoo_rail.model.train import GRAVITY_MS2, Train
 
 __all__ = ["Case", "Leg", "Train", "Line", "ForceCurve", "DavisResistance", "CaseError", "InfeasibleCaseError",
            "TrackGrid", "build_grid", "read_case", "write_case", "case_from_dict", "case_to_dict", "case_keys",
-           "GRAVITY_MS2"]
+           "GRAVITY_MS2", "END_SPEED_TOL_MS"]

@@ -10,6 +10,10 @@ from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
+END_SPEED_TOL_MS = 0.01
+"""A simulated run meets the end speed asked for when it arrives within this of it (m/s), or of its
+window (``Case.end_speed_window_ms``); the exact solver lands on it exactly (docs/case-format.md)."""
+
 
 @dataclass(frozen=True)
 class Leg:
@@ -32,6 +36,11 @@ class Case:
     line (default 0: from standstill to a stop at the platform); a run may start and end moving,
     e.g. at a timing point of a journey or in a benchmark that fixes boundary speeds. Case files
     give them in km/h (``run.initial_speed_kmh``, ``run.final_speed_kmh``).
+
+    The final speed is the speed asked for at the end, not a ceiling: a run arriving slower does not
+    meet the case. ``final_speed_window_ms`` = ``(lo, hi)`` allows any arrival speed in between instead
+    (``run.final_speed_window_kmh``); its upper end is then ``final_speed_ms`` (where the braking
+    envelope ends). See :meth:`end_speed_window_ms` and :data:`END_SPEED_TOL_MS`.
     """
 
     name: str
@@ -45,6 +54,7 @@ class Case:
     legs: tuple[Leg, ...] = ()
     initial_speed_ms: float = 0.0
     final_speed_ms: float = 0.0
+    final_speed_window_ms: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -81,9 +91,36 @@ class Case:
             cap = min(limit_kmh, self.train.max_speed_kmh)
             if kmh > cap + 1e-9:
                 raise CaseError(name, kmh, f"is above the speed limit there ({cap:g} km/h)")
+        window = self.final_speed_window_ms
+        if window is not None:
+            name = "run.final_speed_window_kmh"
+            if (isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2
+                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                               for v in window)):
+                raise CaseError(name, window, "must be two finite speeds [lo, hi]")
+            lo, hi = float(window[0]), float(window[1])
+            if not 0.0 <= lo <= hi:
+                raise CaseError(name, [lo * KMH_PER_MS, hi * KMH_PER_MS], "needs 0 <= lo <= hi")
+            if abs(hi - self.final_speed_ms) > 1e-9:
+                raise CaseError(name, [lo * KMH_PER_MS, hi * KMH_PER_MS],
+                                f"its upper end must be run.final_speed_kmh = {self.final_speed_ms * KMH_PER_MS:g} "
+                                "(the braking envelope ends there)")
+            object.__setattr__(self, "final_speed_window_ms", (lo, hi))
         if self.legs and (self.initial_speed_ms or self.final_speed_ms):
             raise CaseError("run.legs", len(self.legs), "a case with legs starts and ends each leg at rest: "
                                                         "boundary speeds are not supported with legs")
+
+    @property
+    def final_speed_window_kmh(self) -> tuple[float, float] | None:
+        """``final_speed_window_ms`` in km/h, as in the case file (None without a window)."""
+        w = self.final_speed_window_ms
+        return None if w is None else (w[0] * KMH_PER_MS, w[1] * KMH_PER_MS)
+
+    def end_speed_window_ms(self) -> tuple[float, float]:
+        """The arrival speeds the case asks for (m/s): its window, or the final speed itself (lo = hi)."""
+        if self.final_speed_window_ms is not None:
+            return self.final_speed_window_ms
+        return self.final_speed_ms, self.final_speed_ms
 
     def leg(self, index: int) -> Case:
         """Leg ``index`` of a multi-section case as a single-run case."""

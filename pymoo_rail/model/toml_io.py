@@ -19,7 +19,8 @@ from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
 _TOP = {"name", "source", "description", "run", "train", "line"}
-_RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs", "initial_speed_kmh", "final_speed_kmh"}
+_RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs", "initial_speed_kmh", "final_speed_kmh",
+        "final_speed_window_kmh"}
 _LEG = {"start_m", "end_m", "planned_time_s", "dwell_s"}
 _TRAIN = {"name", "mass_t", "rotary_factor", "length_m", "max_speed_kmh", "max_accel_ms2", "max_decel_ms2",
           "traction_efficiency", "regen_efficiency", "regen_min_speed_kmh", "aux_power_kw",
@@ -92,6 +93,25 @@ def _speed_ms(run: dict, key: str) -> float:
     return check_number(f"run.{key}", run.get(key, 0.0), nonneg=True) / KMH_PER_MS
 
 
+def _end_window_ms(run: dict) -> tuple[float, float] | None:
+    """``run.final_speed_window_kmh`` in m/s (None when absent); a bad value names the field."""
+    if "final_speed_window_kmh" not in run:
+        return None
+    window = run["final_speed_window_kmh"]
+    if not isinstance(window, list) or len(window) != 2:
+        raise CaseError("run.final_speed_window_kmh", window, "must be two speeds [lo, hi] in km/h")
+    return tuple(check_number(f"run.final_speed_window_kmh[{k}]", v, nonneg=True) / KMH_PER_MS
+                 for k, v in enumerate(window))
+
+
+def _final_speed_ms(run: dict) -> float:
+    """``run.final_speed_kmh`` in m/s; with a window and no final speed, the window's upper end."""
+    window = _end_window_ms(run)
+    if window is not None and "final_speed_kmh" not in run:
+        return window[1]
+    return _speed_ms(run, "final_speed_kmh")
+
+
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     """Build a :class:`Case` from the parsed TOML structure; every error names the field."""
     data = _table(data, "", _TOP, {"name", "run", "train", "line"}, source)
@@ -132,7 +152,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
                     train=train, line=line_obj, planned_time_s=run["planned_time_s"],
                     dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs,
                     initial_speed_ms=_speed_ms(run, "initial_speed_kmh"),
-                    final_speed_ms=_speed_ms(run, "final_speed_kmh"))
+                    final_speed_ms=_final_speed_ms(run), final_speed_window_ms=_end_window_ms(run))
     except CaseError as err:
         if err.source is None:
             raise CaseError(err.field, err.value, err.reason, source) from None
@@ -204,6 +224,8 @@ def case_to_dict(case: Case) -> dict:
         run["initial_speed_kmh"] = case.initial_speed_ms * KMH_PER_MS
     if case.final_speed_ms:
         run["final_speed_kmh"] = case.final_speed_ms * KMH_PER_MS
+    if case.final_speed_window_ms is not None:
+        run["final_speed_window_kmh"] = [v * KMH_PER_MS for v in case.final_speed_window_ms]
     if case.legs:
         run["legs"] = [{"start_m": g.start_m, "end_m": g.end_m, "planned_time_s": g.planned_time_s,
                         "dwell_s": g.dwell_s} for g in case.legs]

@@ -54,6 +54,9 @@ PENALTY_J = 1.0e20
 # then brakes fully and records an excess of ~1e-9 m/s, or the single-precision tables round
 # the envelope up): counted as the top node.
 _TOP_RTOL = 1e-6
+# An arrival below the end speed asked for costs this many times the traction energy of the missing
+# kinetic energy (:func:`terminal_cost`)
+END_PRICE_FACTOR = 100.0
 
 
 @njit(cache=True)
@@ -405,7 +408,7 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
 
 @njit(cache=True)
 def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
-                   floor_k):
+                   floor_k, terminal_j):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
@@ -413,12 +416,16 @@ def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, t
     ``fixed_u1`` and ``tgt_u1`` hold node positions (:func:`value_position`), one row per kind of
     cell, ``cell_type`` (n_cells,) the row of each cell (:func:`transitions`). ``floor_k`` (n_nodes,)
     is the lowest speed node allowed at each position (0 everywhere but at a timing point's minimum
-    speed): the nodes below it cost ``PENALTY_J``, so no run passes there slower.
+    speed and at the end, where the case's end speed sets it): the nodes below it cost
+    ``PENALTY_J``, so no run passes there slower. ``terminal_j`` (n_speeds,) is the cost-to-go at
+    the end of the line (:func:`terminal_cost`).
     """
     n, n_speeds = value.shape
-    # at the end of the line: the envelope there is the final speed (0 at a platform: one state);
-    # the simulator lands on it, a slower arrival (coasting in) is a run like any other
-    value[n - 1, :] = 0.0
+    # at the end of the line the top node is the final speed (the envelope ends there; 0 at a
+    # platform: one state); ``terminal_j`` prices an arrival below the speeds the case asks for
+    # (:func:`terminal_cost`)
+    for j in range(n_speeds):
+        value[n - 1, j] = terminal_j[j] if j >= floor_k[n - 1] else PENALTY_J
     for i in range(n - 2, -1, -1):
         v_next = value[i + 1]
         t = cell_type[i]
@@ -487,13 +494,34 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     return n - 1, energy, time, tie_cost
 
 
+def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.ndarray:
+    """Cost-to-go at the end of the line (n_speeds,): what arriving below ``end_lo_ms`` costs.
+
+    The top node is the final speed (the braking envelope ends there). Arriving slower than the
+    case asks for (``end_lo_ms``: the final speed itself, or its window's lower end) costs
+    ``END_PRICE_FACTOR x m_eff / eta_traction`` per (m/s)^2 of ``u`` missing: far more than the
+    traction energy the missing kinetic energy would have cost, so the optimum arrives at the speed
+    asked for wherever it can. A price linear in ``u`` rather than an infinite wall: the cost-to-go
+    is interpolated linearly in ``u``, so it is exact between the nodes, and the states from which
+    the end speed is barely reachable are not cut off by a node spacing every cell (a wall at the
+    nodes below the floor made those states infeasible back over the whole final approach).
+    """
+    top_u = model.envelope_ms[-1] ** 2
+    k_max = n_speeds - 1
+    lo_u = min(end_lo_ms ** 2, top_u)
+    price = END_PRICE_FACTOR * model.effective_mass_kg / model.traction_efficiency
+    u = np.array([node_u(top_u, k, k_max, bias) for k in range(n_speeds)])
+    return price * np.maximum(lo_u - u, 0.0)
+
+
 def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray,
-          floor_k: np.ndarray | None = None):
+          floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
     stretch between them its own price. ``floor_k`` (n_nodes,), optional, is the lowest speed node
-    allowed at each position (:func:`speed_floor_nodes`): a journey's minimum speeds.
+    allowed at each position (:func:`speed_floor_nodes`): a journey's minimum speeds. ``terminal_j``
+    (n_speeds,), optional, the cost-to-go at the end (:func:`terminal_cost`; default 0: any arrival).
 
     ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
     cost-to-go. Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s,
@@ -505,7 +533,9 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     prices = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,)))
     if floor_k is None:
         floor_k = np.zeros(n, dtype=np.int64)
-    backward_sweep(prices, *tables, value, floor_k)
+    if terminal_j is None:
+        terminal_j = np.zeros(value.shape[1])
+    backward_sweep(prices, *tables, value, floor_k, terminal_j)
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)

@@ -20,7 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.optimal import dp
@@ -154,6 +154,9 @@ class OptimalSolver:
         self._history: list[_Solve] = []  # every solve so far: time depends on lambda alone
         self.price_shape: np.ndarray | None = None
         self.set_price_shape(price_shape)
+        # the arrival speeds the case asks for: (lo, hi), lo = hi = the final speed unless it gives a window
+        self.end_speed_ms = case.end_speed_window_ms()
+        self._terminal_j = dp.terminal_cost(self.simulator.model, self.n_speeds, self.top_bias, self.end_speed_ms[0])
         self.speed_floor_ms: np.ndarray | None = None
         self._floor_k: np.ndarray | None = None
         self.set_speed_floor(speed_floor_ms)
@@ -180,15 +183,15 @@ class OptimalSolver:
         The DP rounds each floor up to its next speed node, so every run found holds it; a floor
         above the braking envelope leaves no run. Earlier solves no longer guide the search.
         """
-        floor_k = None
+        n_nodes = self.simulator.grid.n_nodes
         if speed_floor_ms is not None:
             floor = np.asarray(speed_floor_ms, dtype=float)
-            n_nodes = self.simulator.grid.n_nodes
             if floor.shape != (n_nodes,) or not np.all(np.isfinite(floor) & (floor >= 0)):
                 raise ValueError(f"speed_floor_ms: needs {n_nodes} finite values >= 0, one per grid node")
             speed_floor_ms = floor if np.any(floor > 0) else None
-            if speed_floor_ms is not None:
-                floor_k = dp.speed_floor_nodes(self.simulator.model, floor, self.n_speeds, self.top_bias)
+        floor_k = None
+        if speed_floor_ms is not None:
+            floor_k = dp.speed_floor_nodes(self.simulator.model, speed_floor_ms, self.n_speeds, self.top_bias)
         self.speed_floor_ms = speed_floor_ms
         self._floor_k = floor_k
         self._history = []
@@ -196,7 +199,9 @@ class OptimalSolver:
             self._coarse.set_speed_floor(speed_floor_ms)
 
     def holds_speed_floor(self, speed_ms: np.ndarray) -> bool:
-        """Whether a run's node speeds hold the speed floor (always true without one)."""
+        """Whether a run's node speeds hold the speed floor and it arrives at the end speed asked for."""
+        if speed_ms.shape[0] < self.simulator.grid.n_nodes or speed_ms[-1] < self.end_speed_ms[0] - 1e-9:
+            return False
         if self.speed_floor_ms is None:
             return True
         return bool(np.all(speed_ms[: self.speed_floor_ms.shape[0]] >= self.speed_floor_ms - 1e-9))
@@ -219,7 +224,7 @@ class OptimalSolver:
         self.n_solves += 1
         prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, self.tie_j,
-                       self._value, self._floor_k)
+                       self._value, self._floor_k, self._terminal_j)
         solution = self._record(lambda_w, run)
         self._history.append(solution)
         return solution
@@ -230,6 +235,10 @@ class OptimalSolver:
             x = self.simulator.grid.position_m[done]
             raise InfeasibleCaseError("line", self.case.name,
                                       f"the solver finds no way to the platform beyond {x:.1f} m", self.case.name)
+        if speeds[-1] < self.end_speed_ms[0] - 1e-9:
+            raise InfeasibleCaseError("run.final_speed_kmh", self.end_speed_ms[0] * KMH_PER_MS,
+                                      f"the solver's run arrives at {speeds[-1] * KMH_PER_MS:.3f} km/h: the end speed "
+                                      "asked for is out of reach", self.case.name)
         program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
         model = self.simulator.model
         value_j = float(dp.interp_value(self._value[0], model.envelope_ms[0] ** 2, model.initial_speed_ms ** 2,
@@ -497,6 +506,16 @@ class OptimalSolver:
         return (parts["grid_kwh"] + parts["floor_kwh"]
                 + max(parts["moved_kwh"], parts["kept_regimes_kwh"], parts["untied_kwh"]))
 
+    def transition_tables(self) -> tuple:
+        """The DP's transitions of this solver's model (:func:`pymoo_rail.optimal.dp.transitions`), built once.
+
+        They do not depend on the price of time: a caller sweeping its own prices
+        (``dp.backward_sweep``, e.g. :class:`pymoo_rail.control.OptimalPolicy`) reuses them.
+        """
+        if self._tables is None:
+            self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
+        return self._tables
+
     def solves(self) -> list[_Solve]:
         """Every run this solver found at a price of time so far (``lambda_w``, ``time_s``, ``energy_j`` ...)."""
         return list(self._history)
@@ -541,7 +560,7 @@ class OptimalSolver:
         lam = solution.lambda_w
         prices = lam if self.price_shape is None else lam * self.price_shape
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, 0.0,
-                       self._value, self._floor_k)
+                       self._value, self._floor_k, self._terminal_j)
         _, _, _, done, energy, time, _ = run
         if done < self.simulator.grid.n_nodes - 1:
             return 0.0

@@ -22,6 +22,28 @@ def _as_front(F, name: str = "F") -> np.ndarray:
     return F
 
 
+def is_disconnected(front: np.ndarray, jump: float = 5.0, flat: float = 1e-3) -> bool:
+    """Whether a sampled two-objective front has gaps (like ZDT3's), so a line would bridge them.
+
+    Objectives are scaled to their range and the points sorted by the first. A gap is a step more
+    than ``jump`` times the median step long that is flat: its shorter side is below ``flat`` times
+    its longer one. A flat stretch is weakly dominated, so no Pareto front runs along it; a steep
+    connected stretch (ZDT1 near ``f1 = 0``, a rail front near its minimum time) changes both
+    objectives and is not a gap.
+    """
+    F = np.asarray(front, dtype=float)
+    if F.ndim != 2 or F.shape[1] != 2 or len(F) < 4:
+        return False
+    span = np.ptp(F, axis=0)
+    if np.any(span <= 0):
+        return False
+    steps = np.abs(np.diff((F / span)[np.argsort(F[:, 0], kind="stable")], axis=0))
+    length = np.hypot(steps[:, 0], steps[:, 1])
+    long = length > jump * np.median(length)
+    flat_step = steps.min(axis=1) < flat * steps.max(axis=1)
+    return bool(np.any(long & flat_step))
+
+
 def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | None = None,
                 reference=None, reference_label: str = "optimal front", highlight=None,
                 highlight_label: str = "chosen", title: str | None = None, ax=None):
@@ -34,7 +56,8 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
     objectives : sequence of str, optional
         Objective names (``"energy"``, ``"time_error"``, ...) for labelled axes with units.
     reference : (k, m) array or DataFrame, optional
-        The true or optimal front, drawn as a line (2 objectives) or small points (3).
+        The true or optimal front, drawn as a line (2 objectives) or small points (3 or more, a
+        dense front, or a front with gaps such as ZDT3's: see :func:`is_disconnected`).
     highlight : (m,) array, optional
         One point to mark, e.g. the solution chosen for the speed profile.
     ax : matplotlib Axes, optional
@@ -81,12 +104,13 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
     fig = ax.figure
 
     if ref is not None:
-        if n_obj == 2 and len(ref) < 200:
+        if n_obj == 2 and len(ref) < 200 and not is_disconnected(ref):
             order = np.argsort(ref[:, 0])
             ax.plot(ref[order, 0], ref[order, 1], "-", marker=".", ms=4, color="0.35", lw=1.2,
                     label=reference_label, zorder=1)
-        elif n_obj == 2:  # dense true front: dots, so disconnected fronts (ZDT3) show their gaps
-            ax.scatter(ref[:, 0], ref[:, 1], s=1.5, color="0.35", label=reference_label, zorder=1)
+        elif n_obj == 2:  # dense or disconnected true front: dots, so gaps (ZDT3) are not bridged
+            ax.scatter(ref[:, 0], ref[:, 1], s=1.5 if len(ref) >= 200 else 6, color="0.35",
+                       label=reference_label, zorder=1)
         else:
             ax.scatter(*ref.T, s=2, color="0.6", label=reference_label)
     markers = "os^Dvp<>h*"

@@ -129,6 +129,15 @@ def _gradient_panel(ax, line) -> None:
     ax.set_ylim(h.min() - 0.1 * span, h.max() + 0.6 * span)
 
 
+def _end_speed_marker(ax, case):
+    """The arrival speed the case asks for at the end of the line: a point, or a bar for a window."""
+    lo, hi = (v * KMH_PER_MS for v in case.end_speed_window_ms())
+    x = case.line.length_m
+    h = ax.errorbar([x], [0.5 * (lo + hi)], yerr=[[0.5 * (hi - lo)], [0.5 * (hi - lo)]], fmt="D", color="k",
+                    ms=5, capsize=4, zorder=4, label="end speed asked for" if lo == hi else "end speed window")
+    return h
+
+
 def plot_speed_profile(run, case=None, label: str | None = None, others: Sequence = (), other_labels=None,
                        title: str | None = None, show_line_limits: bool = True, other_linestyle: str = "-"):
     """Speed against distance, coloured by regime, over the line.
@@ -175,6 +184,8 @@ def plot_speed_profile(run, case=None, label: str | None = None, others: Sequenc
         (h,) = ax.plot(o.position_m, o.speed_kmh, color="0.4", lw=1.0, ls=other_linestyle, label=other_label,
                        zorder=2)
         extra.append(h)
+    if case is not None and case.end_speed_window_ms()[1] > 0.0:
+        extra.append(_end_speed_marker(ax, case))
     _regime_line(ax, trace.position_m, trace.speed_kmh, trace.regime)
     top = max(np.nanmax(trace.speed_kmh), np.nanmax(trace.limit_kmh) if trace.limit_kmh is not None else 0.0)
     ax.set_ylim(0.0, 1.15 * top + 1.0)

@@ -210,11 +210,18 @@ class CertifiedFront:
             below[inside] = e[inside] < optimum - bound - 1e-9
         return inside, below
 
-    def dense(self, n_points: int = 100, window_s: tuple[float, float] | None = None) -> pd.DataFrame:
-        """The front at ``n_points`` running times (nodes included) in ``window_s``, with each point's bound."""
+    def dense(self, n_points: int = 100, window_s: tuple[float, float] | None = None,
+              with_nodes: bool = True) -> pd.DataFrame:
+        """The front at ``n_points`` evenly spaced running times in ``window_s``, with each point's bound.
+
+        ``with_nodes`` adds the front's nodes inside the window (its vertices: then there are more than
+        ``n_points`` rows); without them there are exactly ``n_points`` (at least 2).
+        """
         lo, hi = self.clip(window_s)
-        t = np.union1d(np.linspace(lo, hi, max(int(n_points), 2)), self.table["running_time_s"].to_numpy())
-        t = t[(t >= lo) & (t <= hi)]
+        t = np.linspace(lo, hi, max(int(n_points), 2))
+        if with_nodes:
+            t = np.union1d(t, self.table["running_time_s"].to_numpy())
+            t = t[(t >= lo) & (t <= hi)]
         energy, bound = self.energy_at(t)
         return pd.DataFrame({"running_time_s": t, "energy_kwh": energy, "energy_bound_kwh": bound})
 
@@ -384,9 +391,12 @@ def certified_front(case: Case, dx_m: float | None = None, n_times: int | None =
     return front
 
 
-def mirrored(front: CertifiedFront, objectives: tuple[str, ...], n_points: int = 100,
+def mirrored(front: CertifiedFront, objectives: tuple[str, ...], n_points: int | None = None,
              window_s: tuple[float, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The front in a problem's objective space and the energy bound of each point.
+
+    ``n_points=None`` gives the front's nodes (its vertices) plus 100 evenly spaced points; a number
+    gives at most that many evenly spaced points (fewer where some are dominated or outside the front).
 
     ``objectives`` is ``("energy", "running_time")`` or ``("energy", "time_error")`` in any order.
     Time error ``e = |T - T_plan|`` mirrors the front about the planned time: the least energy at
@@ -403,7 +413,9 @@ def mirrored(front: CertifiedFront, objectives: tuple[str, ...], n_points: int =
         e_min = max(lo - plan, 0.0)  # a plan faster than the front's first node: errors start there
         nodes = front.table["running_time_s"].to_numpy()
         nodes = nodes[(nodes >= lo) & (nodes <= hi)]
-        err = np.union1d(np.linspace(e_min, e_max, max(int(n_points), 2)), np.abs(nodes - plan))
+        err = np.linspace(e_min, e_max, max(int(n_points or 100), 2))
+        if n_points is None:
+            err = np.union1d(err, np.abs(nodes - plan))
         energy = np.full(err.shape, np.inf)
         bound = np.zeros(err.shape)
         for side in (plan + err, plan - err):
@@ -416,7 +428,7 @@ def mirrored(front: CertifiedFront, objectives: tuple[str, ...], n_points: int =
         columns = {"energy": energy[ok], "time_error": err[ok]}
         bound = bound[ok]
     else:
-        dense = front.dense(n_points, window_s)
+        dense = front.dense(n_points or 100, window_s, with_nodes=n_points is None)
         columns = {"energy": dense["energy_kwh"].to_numpy(), "running_time": dense["running_time_s"].to_numpy()}
         bound = dense["energy_bound_kwh"].to_numpy()
     F = np.column_stack([columns[name] for name in objectives])

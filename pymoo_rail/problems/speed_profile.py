@@ -14,6 +14,7 @@ from pymoo_rail.problems.encodings import ENCODINGS, BrakingOnset, SpeedCodes, S
 from pymoo_rail.problems.paced_codes import PacedCodes
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
+from pymoo_rail.sim.checks import end_speed_violation_ms
 
 # "jerk" is the name Meng et al. (2017) give their comfort figure, sum |a_i - a_(i-1)| (m/s^2): a total
 # variation of acceleration, not a rate of change (m/s^3). "accel_variation" says what it is; "jerk"
@@ -197,7 +198,9 @@ class SpeedProfileProblem(Problem):
     Notes
     -----
     Every form carries the constraints "stop at the platform" and "never above a limit" (the
-    kernel already brakes onto the limits, so the latter is a guard). Infeasible decisions come
+    kernel already brakes onto the limits, so the latter is a guard), and on a case with a moving
+    end "arrive at the end speed asked for" (``run.final_speed_kmh`` or its window, within
+    ``END_SPEED_TOL_MS``: ``pymoo_rail.sim.checks.end_speed_violation_ms``). Infeasible decisions come
     back as constraint violation.
 
     Decision vectors must be finite and inside ``[xl, xu]``: ``evaluate`` raises a
@@ -279,7 +282,11 @@ class SpeedProfileProblem(Problem):
             self.weights, self.scales = weighted_sum_settings(weights, scales, objectives, default)
 
         n_obj = 1 if self.weights is not None else len(objectives)
-        n_ieq = 1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None) + (self.time_window_s is not None)
+        # a moving end (run.final_speed_kmh > 0): the arrival speed is asked for, not a ceiling (a run
+        # coasting in slower violates it); at rest the stop constraint already holds it
+        self.end_speed_constraint = case.end_speed_window_ms()[1] > 0.0
+        n_ieq = (1 + (stop_tolerance_m is not None) + (time_tolerance_s is not None) + (self.time_window_s is not None)
+                 + self.end_speed_constraint)
         super().__init__(n_var=self.encoding.n_var, n_obj=n_obj, n_ieq_constr=n_ieq,
                          xl=self.encoding.xl.copy(), xu=self.encoding.xu.copy(), vtype=self.encoding.vtype, **kwargs)
 
@@ -318,6 +325,8 @@ class SpeedProfileProblem(Problem):
         constraints = [s[:, k.OUT_LIMIT_EXCESS_MS] - 1e-6]
         if self.stop_tolerance_m is not None:
             constraints.append(s[:, k.OUT_STOP_ERROR_M] - self.stop_tolerance_m)
+        if self.end_speed_constraint:
+            constraints.append(end_speed_violation_ms(s[:, k.OUT_FINAL_SPEED_MS], self.case))
         if self.time_tolerance_s is not None:
             constraints.append(np.abs(s[:, k.OUT_RUNNING_TIME_S] - self.case.planned_time_s) - self.time_tolerance_s)
         if self.time_window_s is not None:
@@ -394,14 +403,23 @@ class SpeedProfileProblem(Problem):
                     "front covers the planner's times: pass time_window_s='default' (or a (lo, hi) inside it)")
         return ""
 
-    def _calc_pareto_front(self, n_pareto_points: int = 100, *args, **kwargs):
-        """pymoo's hook: the certified front in this problem's objective space (or the constrained optimum)."""
+    def _calc_pareto_front(self, n_pareto_points: int | None = None, *args, **kwargs):
+        """pymoo's hook: the certified front in this problem's objective space (or the constrained optimum).
+
+        ``pareto_front()`` gives the front's nodes (its vertices) plus 100 evenly spaced points;
+        ``pareto_front(n_pareto_points=n)`` at most ``n`` evenly spaced points (fewer where some are
+        dominated). pymoo caches the first answer: pass ``use_cache=False`` to ask again with another ``n``.
+        """
         from pymoo_rail.problems import reference
 
         front = self.certified_front()
         if len(self.objectives) == 1:
             energy, _, _ = reference.constrained_optimum(front, self.time_tolerance_s, window_s=self.time_window_s)
             return np.array([[energy]])
+        if n_pareto_points is not None and (isinstance(n_pareto_points, bool)
+                                            or not isinstance(n_pareto_points, (int, np.integer))
+                                            or n_pareto_points < 2):
+            raise ValueError(f"n_pareto_points must be an integer >= 2 or None, got {n_pareto_points!r}")
         F, _ = reference.mirrored(front, self.objectives, n_pareto_points, self.time_window_s)
         return F
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pymoo_rail.constants import KMH_PER_MS
-from pymoo_rail.model import Case, Line, Train
+from pymoo_rail.model import END_SPEED_TOL_MS, Case, Line, Train
 from pymoo_rail.sim.trajectory import Trajectory
 
 
@@ -34,6 +34,9 @@ class RunCheck:
         Distance between the stopping point and the platform mark (m).
     running_time_s, energy_kwh : float
         Running time (s) and net energy (kWh) of the run.
+    end_speed_excess_ms : float
+        How far the arrival speed lies outside the end speed the case asks for, beyond
+        ``END_SPEED_TOL_MS`` (:func:`end_speed_violation_ms`; <= 0 when met).
     """
 
     neutral_traction_j: float
@@ -43,13 +46,28 @@ class RunCheck:
     stop_error_m: float
     running_time_s: float
     energy_kwh: float
+    end_speed_excess_ms: float = 0.0
 
     def passes(self, stop_tolerance_m: float = 0.25, speed_tolerance_ms: float = 1e-6) -> bool:
         """True when the run pulls nowhere in a neutral section, stays under every limit
-        (within ``speed_tolerance_ms``) and stops within ``stop_tolerance_m`` of the mark."""
+        (within ``speed_tolerance_ms``), stops within ``stop_tolerance_m`` of the mark and arrives at
+        the end speed asked for (within ``END_SPEED_TOL_MS``)."""
         return (self.neutral_traction_j == 0.0 and self.neutral_max_force_n <= 0.0
                 and self.limit_excess_ms <= speed_tolerance_ms and self.independent_excess_ms <= speed_tolerance_ms
-                and self.stop_error_m <= stop_tolerance_m)
+                and self.stop_error_m <= stop_tolerance_m and self.end_speed_excess_ms <= 0.0)
+
+
+def end_speed_violation_ms(final_speed_ms, case: Case) -> np.ndarray:
+    """How far arrival speeds lie outside the case's end speed, beyond ``END_SPEED_TOL_MS`` (m/s).
+
+    The case asks for its final speed exactly (``run.final_speed_kmh``), or for any speed in its
+    window (``run.final_speed_window_kmh``); a run meets it within ``END_SPEED_TOL_MS``. The one
+    rule every encoding's runs are held to (``SpeedProfileProblem``'s end-speed constraint), and the
+    one :func:`check_run` applies. Returns ``max(lo - v, v - hi) - END_SPEED_TOL_MS``: <= 0 when met.
+    """
+    lo, hi = case.end_speed_window_ms()
+    v = np.asarray(final_speed_ms, dtype=float)
+    return np.maximum(lo - v, v - hi) - END_SPEED_TOL_MS
 
 
 def limit_under_train_ms(position_m: np.ndarray, line: Line, train: Train) -> np.ndarray:
@@ -108,7 +126,8 @@ def check_run(trajectory: Trajectory, case: Case) -> RunCheck:
         limit_excess_ms=float(trajectory.summary["limit_excess_ms"]),
         independent_excess_ms=float(excess.max()),
         stop_error_m=float(trajectory.stop_error_m),
-        running_time_s=float(trajectory.running_time_s), energy_kwh=float(trajectory.energy.net_kwh))
+        running_time_s=float(trajectory.running_time_s), energy_kwh=float(trajectory.energy.net_kwh),
+        end_speed_excess_ms=float(end_speed_violation_ms(trajectory.speed_ms[-1], case)) if trajectory.reached else 0.0)
 
 
-__all__ = ["RunCheck", "check_run", "limit_under_train_ms"]
+__all__ = ["RunCheck", "check_run", "limit_under_train_ms", "end_speed_violation_ms"]

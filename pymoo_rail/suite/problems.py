@@ -30,38 +30,23 @@ SECTIONS_PER_LINE = 12
 
 @dataclass(frozen=True)
 class SuiteCase:
-    """One case of the suite: a built-in case, or a section of a real TTOBench line.
+    """One case of the suite: a built-in case (a case file, or a section of the TTOBench Yizhuang line).
 
     Attributes
     ----------
     name : str
-        Suite name of the case (the problems are ``<name>-bi`` and ``<name>-single``).
-    builtin : str, optional
-        Built-in case name (:func:`pymoo_rail.cases.load_case`).
-    ttobench_stops : (str, str), optional
-        Departure and arrival stop of the TTOBench Yizhuang line with the Beijing subway train.
-    planned_time_s : float, optional
-        Planned time of a TTOBench section (TTOBench has no timetable).
+        Suite name of the case, a built-in case name (:func:`pymoo_rail.cases.load_case` loads it;
+        the problems are ``<name>-bi`` and ``<name>-single``).
     summary : str
         One line on what the case is, for ``list_problems`` and the docs.
     """
 
     name: str
     summary: str
-    builtin: str | None = None
-    ttobench_stops: tuple[str, str] | None = None
-    planned_time_s: float | None = None
 
     def load(self) -> Case:
         """The case itself."""
-        if self.builtin is not None:
-            return load_case(self.builtin)
-        from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
-
-        a, b = self.ttobench_stops
-        case = from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, a, b, self.planned_time_s,
-                             stop_names=YIZHUANG_STOP_NAMES, name=self.name)
-        return case
+        return load_case(self.name)
 
 
 _TTOBENCH_PLAN = ("planned time reconstructed: 10 % above the minimum running time of this model, "
@@ -69,25 +54,20 @@ _TTOBENCH_PLAN = ("planned time reconstructed: 10 % above the minimum running ti
 
 CASES: tuple[SuiteCase, ...] = (
     SuiteCase("yizhuang", "Beijing Yizhuang line, Tongjinan Rd -> Jinghai Rd, 2265 m, 150 s "
-              "(Liu 2019, seed data of the ABC thesis)", builtin="yizhuang"),
-    SuiteCase("yizhuang-ttobench", "the same run with TTOBench's line and Beijing subway train, 150 s",
-              builtin="yizhuang-ttobench"),
-    SuiteCase("metro-a", "A-type metro, 1000 m, -5 / +10 permille, 70 s (Meng et al. 2017)", builtin="metro-a"),
+              "(Liu 2019, seed data of the ABC thesis)"),
+    SuiteCase("yizhuang-ttobench", "the same run with TTOBench's line and Beijing subway train, 150 s"),
+    SuiteCase("metro-a", "A-type metro, 1000 m, -5 / +10 permille, 70 s (Meng et al. 2017)"),
     SuiteCase("ttobench-songjiazhuang-xiaocun", "TTOBench Yizhuang line, Songjiazhuang -> Xiaocun, 2631 m, "
-              "+10.4 / -8 permille, 170 s; " + _TTOBENCH_PLAN,
-              ttobench_stops=("Songjiazhuang", "Xiaocun"), planned_time_s=170.0),
+              "+10.4 / -8 permille, 170 s; " + _TTOBENCH_PLAN),
     SuiteCase("ttobench-xiaohongmen-jiugong", "TTOBench Yizhuang line, Xiaohongmen -> Jiugong, 2366 m, "
-              "-20.4 / -24 permille descents, 145 s; " + _TTOBENCH_PLAN,
-              ttobench_stops=("Xiaohongmen", "Jiugong"), planned_time_s=145.0),
+              "-20.4 / -24 permille descents, 145 s; " + _TTOBENCH_PLAN),
     SuiteCase("ttobench-wanyuan-rongjing", "TTOBench Yizhuang line, Wanyuan St -> Rongjing East St, 1280 m, 90 s; "
-              + _TTOBENCH_PLAN, ttobench_stops=("Wanyuan St", "Rongjing East St"), planned_time_s=90.0),
+              + _TTOBENCH_PLAN),
     SuiteCase("ttobench-ref", "48.5 km TTOBench reference, level, 100 km/h on 25-35 km, 391 t intercity, 1541 s "
-              "(reconstructed from the public TTOBench reference)", builtin="ttobench-ref"),
-    SuiteCase("ttobench-ref-uphill", "the reference with a +5 permille climb on 25-35 km", builtin="ttobench-ref-uphill"),
-    SuiteCase("ttobench-ref-downhill", "the reference with a -5 permille descent on 25-35 km",
-              builtin="ttobench-ref-downhill"),
-    SuiteCase("ttobench-ref-limit120", "the reference with 120 km/h (not 100) on 25-35 km",
-              builtin="ttobench-ref-limit120"),
+              "(reconstructed from the public TTOBench reference)"),
+    SuiteCase("ttobench-ref-uphill", "the reference with a +5 permille climb on 25-35 km"),
+    SuiteCase("ttobench-ref-downhill", "the reference with a -5 permille descent on 25-35 km"),
+    SuiteCase("ttobench-ref-limit120", "the reference with 120 km/h (not 100) on 25-35 km"),
 )
 
 SINGLE_ENCODING = "paced_speed_codes"

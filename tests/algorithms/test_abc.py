@@ -57,7 +57,8 @@ def run_ask_tell(problem, algorithm, termination, seed):
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_sphere_10d_reaches_1e_12_within_500_cycles(seed):
-    res = minimize(Sphere(10), ABC(pop_size=40), ("n_gen", 500), seed=seed)
+    # a cycle is two pymoo iterations (employed, onlooker) after the initial colony
+    res = minimize(Sphere(10), ABC(pop_size=40), ("n_gen", 1 + 2 * 500), seed=seed)
     assert res.F[0] < 1e-12
 
 
@@ -65,7 +66,7 @@ def test_sphere_10d_reaches_1e_12_within_500_cycles(seed):
 def test_negative_objective_values_work(fitness):
     # the onlooker fitness must not assume f >= 0 (seed eq. 3-3 needs a special case)
     algorithm = ABC(pop_size=20, onlooker_fitness=fitness)
-    res = minimize(Sphere(5, shift=-100.0), algorithm, ("n_gen", 300), seed=1)
+    res = minimize(Sphere(5, shift=-100.0), algorithm, ("n_gen", 1 + 2 * 300), seed=1)
     assert res.F[0] == pytest.approx(-100.0, abs=1e-8)
 
 
@@ -126,7 +127,7 @@ def test_pickle_mid_run_continues_identically(n_tells):
 
 
 def test_constraints_feasible_and_near_constrained_optimum():
-    res = minimize(ConstrainedSphere(), ABC(pop_size=20), ("n_gen", 300), seed=1)
+    res = minimize(ConstrainedSphere(), ABC(pop_size=20), ("n_gen", 1 + 2 * 300), seed=1)
     assert res.CV[0] <= 0.0
     assert res.F[0] == pytest.approx(5.0, abs=1e-6)
     np.testing.assert_allclose(res.X, [1.0, -2.0, 0.0], atol=1e-3)
@@ -139,18 +140,41 @@ def test_save_history():
     assert all(b1 <= b0 for b0, b1 in zip(best, best[1:]))  # best-so-far never gets worse
 
 
-def test_n_gen_termination_counts_cycles():
+def test_n_gen_counts_ask_tell_rounds_like_pymoo():
     res = minimize(Sphere(3), ABC(pop_size=10, limit=1000), ("n_gen", 20), seed=1)
-    # initial colony of 10 + 19 cycles of 5 employed + 5 onlooker evaluations, no scouts
-    assert len(res.algorithm.history) == 0 and res.algorithm.n_gen == 21  # pymoo counts on
-    assert res.algorithm.evaluator.n_eval == 10 + 19 * 10
+    # initial colony of 10, then 19 phases (employed, onlooker, ...) of 5 evaluations, no scouts
+    assert res.algorithm.evaluator.n_eval == 10 + 19 * 5
+    assert res.algorithm.n_cycles == 9  # 9 employed + onlooker pairs, then one employed phase
+    # a hand-written loop of 20 ask/tell rounds gets the same budget and the same result
+    looped = run_ask_tell(Sphere(3), ABC(pop_size=10, limit=1000), ("n_gen", 20), seed=1)
+    asked = ABC(pop_size=10, limit=1000)
+    asked.setup(Sphere(3), seed=1)
+    for _ in range(20):
+        pop = asked.ask()
+        asked.evaluator.eval(asked.problem, pop)
+        asked.tell(infills=pop)
+    assert asked.evaluator.n_eval == res.algorithm.evaluator.n_eval
+    np.testing.assert_array_equal(asked.result().X, res.X)
+    np.testing.assert_array_equal(looped.X, res.X)
+
+
+def test_scouts_fly_with_the_next_employed_phase():
+    """Scouts do not add rounds: every cycle is two iterations, scouts add evaluations."""
+    sizes = []
+    res = minimize(Sphere(3), ABC(pop_size=10, limit=1), ("n_gen", 41), seed=1,
+                   callback=lambda algorithm: sizes.append((algorithm.n_iter, algorithm.n_scouts)))
+    algorithm = res.algorithm
+    assert algorithm.n_scouts_total > 0 and algorithm.n_cycles == 20
+    assert algorithm.evaluator.n_eval == 10 + 40 * 5 + algorithm.n_scouts_total
+    # scouts only ever fly with an employed phase (even iterations: 2, 4, ...)
+    assert all(n_iter % 2 == 0 for n_iter, n in sizes if n > 0)
 
 
 def test_n_eval_termination():
     res = minimize(Sphere(3), ABC(pop_size=10), ("n_eval", 503), seed=1)
     n_eval = res.algorithm.evaluator.n_eval
-    # termination is checked after each full cycle (10 evaluations plus scouts)
-    assert 503 <= n_eval < 503 + 10 + 5
+    # termination is checked after each phase (5 evaluations plus at most 5 scouts)
+    assert 503 <= n_eval < 503 + 5 + 5
 
 
 def test_time_termination():

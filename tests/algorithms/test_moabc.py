@@ -61,7 +61,7 @@ def test_archive_bounded_and_mutually_nondominated():
     minimize(
         ZDT1(n_var=10),
         MOABC(pop_size=20, archive_size=15),
-        ("n_gen", 60),
+        ("n_gen", 1 + 2 * 60),  # 60 cycles of two iterations
         seed=3,
         callback=check,
     )
@@ -151,12 +151,28 @@ def test_each_move_runs_within_bounds(move):
 def test_terminations_and_history():
     problem = ZDT1(n_var=5)
     res = minimize(problem, MOABC(pop_size=10), ("n_eval", 205), seed=1)
-    assert 205 <= res.algorithm.evaluator.n_eval < 205 + 10 + 5
+    # checked after every phase: 5 candidates plus at most 5 scouts
+    assert 205 <= res.algorithm.evaluator.n_eval < 205 + 5 + 5
     res = minimize(problem, MOABC(pop_size=10), TimeBasedTermination(0.3), seed=1)
     assert len(res.F) > 0
     res = minimize(problem, MOABC(pop_size=10), ("n_gen", 8), seed=1, save_history=True)
     assert len(res.history) == 8
     assert all(len(h.opt) > 0 for h in res.history)
+
+
+def test_one_iteration_per_ask_tell_round():
+    """n_gen counts ask/tell rounds as pymoo does: scouts fly with the next employed phase."""
+    res = minimize(ZDT1(n_var=5), MOABC(pop_size=10, limit=1), ("n_gen", 31), seed=1)
+    algorithm = res.algorithm
+    assert algorithm.n_cycles == 15 and algorithm.n_scouts_total > 0
+    assert algorithm.evaluator.n_eval == 10 + 30 * 5 + algorithm.n_scouts_total
+    asked = MOABC(pop_size=10, limit=1)
+    asked.setup(ZDT1(n_var=5), seed=1)
+    for _ in range(31):
+        pop = asked.ask()
+        asked.evaluator.eval(asked.problem, pop)
+        asked.tell(infills=pop)
+    np.testing.assert_array_equal(asked.result().F, res.F)
 
 
 def test_scouts_happen_when_limit_is_small(capsys):

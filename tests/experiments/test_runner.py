@@ -205,7 +205,7 @@ def test_check_refuses_a_bad_study_before_any_work(tmp_path):
     from pymoo_rail.experiments import StudyError
 
     study = Study("bad", problems=[problem("zdt1")], algorithms=[algorithm("de")], seeds=1, budget={"n_gen": 2})
-    with pytest.raises(StudyError, match="algorithm 'de'.*single-objective"):
+    with pytest.raises(StudyError, match=r"algorithms\[0\] \('de'\).*single-objective"):
         run_study(study, tmp_path, workers=1, progress=False)
     assert not (tmp_path / "runs").exists() or not list((tmp_path / "runs").iterdir())
 
@@ -264,7 +264,8 @@ def test_pool_workers_compile_after_running_a_cached_parallel_kernel(tmp_path):
         "    parallel_spheres(np.zeros((2, 3)))\n"
         "    study = Study('jitted', problems=[problem('tests.experiments.studies:jitted_sphere')],\n"
         "                  algorithms=[algorithm('nsga2', pop_size=8)], seeds=[1, 2], budget={'n_gen': 3})\n"
-        f"    report = run_study(study, {str(tmp_path / 'study')!r}, workers=2, progress=False, check=False)\n"
+        f"    report = run_study(study, {str(tmp_path / 'study')!r}, workers=2, progress=False, check=False,\n"
+        "                       trusted=True)\n"
         "    print(report.n_finished, report.failures)\n"
     )
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_NUM_THREADS"}

@@ -36,22 +36,22 @@ def test_an_edited_case_file_is_rerun_and_the_message_says_why(tmp_path, capsys)
     study = Study("case", problems=[problem(f"{STUDIES}:case_sphere", case=str(case_file))],
                   algorithms=[algorithm("nsga2", pop_size=8)], seeds=2, budget={"n_gen": 3})
     out = tmp_path / "out"
-    first = run_study(study, out, workers=1, progress=False)
+    first = run_study(study, out, workers=1, progress=False, trusted=True)
     assert first.n_finished == 2
-    before = load_results(out)
+    before = load_results(out, trusted=True)
 
     # a comment changes nothing the result depends on: still stored
     case_file.write_text("# a note\n" + original, encoding="utf-8")
-    assert run_study(study, out, workers=1, progress=False).n_skipped == 2
+    assert run_study(study, out, workers=1, progress=False, trusted=True).n_skipped == 2
 
     # the mass (332 t) does: the same study file now recomputes both runs, and says so
     assert "mass_t = 332.0" in original
     case_file.write_text(original.replace("mass_t = 332.0", "mass_t = 300.0"), encoding="utf-8")
-    again = run_study(study, out, workers=1, progress=False)
+    again = run_study(study, out, workers=1, progress=False, trusted=True)
     assert (again.n_skipped, again.n_finished) == (0, 2)
     assert len(again.redone) == 2 and all("problem.case" in note and "changed" in note for note in again.redone)
     assert "REDO" in capsys.readouterr().err
-    after = load_results(out)
+    after = load_results(out, trusted=True)
     assert len(after) == 2 and len(list((out / "stale").iterdir())) == 2
     # each stored front was computed from the case as it was then: f1 = |x - mass / 1000|^2
     for frame, centre in ((before, 0.332), (after, 0.300)):
@@ -119,7 +119,7 @@ def _script(directory: Path, workers: int, n_seeds: int, delay_s: float) -> str:
         f"    study = Study('shared', problems=[problem('{STUDIES}:slow_zdt1', n_var=4, delay_s={delay_s})],\n"
         "                  algorithms=[algorithm('nsga2', pop_size=8)], "
         f"seeds={n_seeds}, budget={{'n_gen': 3}})\n"
-        f"    r = run_study(study, {str(directory)!r}, workers={workers}, progress=False, check=False)\n"
+        f"    r = run_study(study, {str(directory)!r}, workers={workers}, progress=False, check=False, trusted=True)\n"
         "    print(r.n_finished, r.n_elsewhere, r.n_skipped, len(r.failures))\n"
     )
 
@@ -139,7 +139,7 @@ def test_two_studies_on_one_folder_compute_each_run_once(tmp_path):
     assert len(log.read_text().splitlines()) == 8                                 # built once per run
     pids = set(log.read_text().split())
     assert len(pids) == 2, "both processes should have computed part of the study"
-    assert len(ResultStore(out).done_ids()) == 8 and len(load_results(out)) == 8
+    assert len(ResultStore(out).done_ids()) == 8 and len(load_results(out, trusted=True)) == 8
     assert not list(out.rglob(".tmp-*"))
 
 
@@ -207,7 +207,7 @@ def test_killed_study_process_its_workers_exit_and_keep_every_run_they_finished(
         assert store.check(path)["format"] == RECORD_FORMAT
     again = Study("shared", problems=[problem(f"{STUDIES}:slow_zdt1", n_var=4, delay_s=0.4)],
                   algorithms=[algorithm("nsga2", pop_size=8)], seeds=10, budget={"n_gen": 3})
-    report = run_study(again, out, workers=2, progress=False, check=False)
+    report = run_study(again, out, workers=2, progress=False, check=False, trusted=True)
     assert (report.n_skipped, report.n_finished, report.failures) == (len(stored), 10 - len(stored), [])
 
 
@@ -217,10 +217,10 @@ def test_tables_leave_out_a_record_whose_case_changed_and_say_so(tmp_path):
     case_file.write_text(original, encoding="utf-8")
     study = Study("case", problems=[problem(f"{STUDIES}:case_sphere", case=str(case_file))],
                   algorithms=[algorithm("nsga2", pop_size=8)], seeds=1, budget={"n_gen": 2})
-    run_study(study, tmp_path / "out", workers=1, progress=False)
+    run_study(study, tmp_path / "out", workers=1, progress=False, trusted=True)
     case_file.write_text(original.replace("mass_t = 332.0", "mass_t = 300.0"), encoding="utf-8")
     with pytest.warns(UserWarning, match="problem.case .* changed"):
-        assert load_results(tmp_path / "out").empty
+        assert load_results(tmp_path / "out", trusted=True).empty
 
 
 def test_written_files_get_the_mode_open_gives_them(tmp_path, monkeypatch):

@@ -20,6 +20,7 @@ from pymoo_rail.model import CaseError
 
 RELEASE = Path(__file__).resolve().parents[1] / "data" / "ttobench"
 JOURNEY = RELEASE / "journeys" / "CH_StGallen_Wil_Journey_01.json"
+FIRST_PUBLISHED = RELEASE / "journeys" / "CH_StGallen_Wil_Journey_01_first_published.json"
 TRACK = RELEASE / "tracks" / "CH_StGallen_Wil.json"
 KISS = RELEASE / "trains" / "CH_Stadler_KISS_SBB.json"
 YIZHUANG = RELEASE / "tracks" / "CN_Songjiazhuang_Yizhuang.json"
@@ -131,14 +132,24 @@ def test_no_reading_of_the_public_journey_makes_its_last_stretch_reachable():
     assert (_limit_time_s(20000.0, 29556.1) - 250.0) * 105 / 3.6 > 2700.0
 
 
+def test_the_shipped_first_published_journey_differs_only_in_its_arrival_and_is_reachable():
+    # TTOBench first published the journey ending at 25000 m; its release moved the arrival to the
+    # track's end (29556.1 m) and kept the window 1400-1450 s, which made the last stretch unreachable
+    from pymoo_rail.journeys.timing import check_windows_reachable
+
+    first = json.loads(FIRST_PUBLISHED.read_text())["timing points"]["values"]
+    released = json.loads(JOURNEY.read_text())["timing points"]["values"]
+    assert first[:-1] == released[:-1] and first[-1][1:] == released[-1][1:]
+    assert (first[-1][0], released[-1][0]) == (25000, 29556.1)
+    check_windows_reachable(timed(FIRST_PUBLISHED))  # no TimingError: the windows leave enough time
+    with pytest.raises(TimingError, match="29556.1"):
+        check_windows_reachable(timed(JOURNEY))
+
+
 @pytest.mark.slow
 def test_stgallen_wil_as_first_published_is_solved_within_every_window():
-    # TTOBench commit b33a3ff published the journey ending at 25000 m; the review commit 7d62ff9
-    # moved the arrival to the track's end (29556.1 m) and kept its window 1400-1450 s, which made
-    # the last stretch unreachable. With the arrival at 25000 m every window is met (14 s CPU).
-    data = json.loads(JOURNEY.read_text())
-    data["timing points"]["values"][-1][0] = 25000
-    run = solve_timed_journey(timed(data))
+    # the shipped first version of the journey: every window is met (14 s CPU)
+    run = solve_timed_journey(timed(FIRST_PUBLISHED))
     assert run.all_met
     assert [c["time_ok"] and c["speed_ok"] for c in run.checks] == [True] * 6
     assert run.departures_s == (0.0, 800.0)

@@ -16,7 +16,7 @@ def reference(yizhuang):
 
 def test_no_optimiser_point_lies_below_the_reference_by_more_than_its_certificate(yizhuang, reference):
     problem = SpeedProfileProblem(yizhuang, objectives=("energy", "running_time"))
-    res = minimize(problem, MOABC(pop_size=20), ("n_gen", 15), seed=3)
+    res = minimize(problem, MOABC(pop_size=20), ("n_gen", 1 + 2 * 14), seed=3)
     front = res.F[np.argsort(res.F[:, 1])][:, ::-1]  # (running time, energy)
     picks = front[np.linspace(0, front.shape[0] - 1, min(4, front.shape[0])).astype(int)]
     result = solved_energy_gap(picks, reference)

@@ -208,3 +208,27 @@ def test_saved_png_figures_use_a_palette_and_are_smaller(tmp_path):
         diff = np.abs(np.asarray(a.convert("RGB"), dtype=int) - np.asarray(b.convert("RGB"), dtype=int))
     assert np.percentile(diff, 99) <= 16
     assert small.stat().st_size < 0.6 * full.stat().st_size
+
+
+def test_disconnected_true_front_is_drawn_as_points_connected_as_a_line():
+    """ZDT3's five pieces are not bridged by a line; ZDT1's connected front (steep near f1 = 0) is one."""
+    from pymoo.problems import get_problem
+
+    from pymoo_rail.plotting.fronts import is_disconnected
+
+    drawn = {}
+    for name in ("zdt1", "zdt3"):
+        pf = get_problem(name).pareto_front()
+        fig = plot_fronts({"run": pf[::7]}, reference=pf)
+        ax = fig.axes[0]
+        drawn[name] = ([line.get_label() for line in ax.lines],
+                       [c.get_label() for c in ax.collections])
+        plt.close(fig)
+    assert drawn["zdt1"][0] == ["optimal front"]
+    assert drawn["zdt3"][0] == [] and "optimal front" in drawn["zdt3"][1]
+    assert is_disconnected(get_problem("zdt3").pareto_front())
+    # a flat step is a gap only where it is long: a small flat step inside a front is not
+    line = np.column_stack([np.linspace(0, 1, 50), np.linspace(1, 0, 50)])
+    assert not is_disconnected(line)
+    gapped = np.vstack([line[:20], line[20:] + [0.3, -1e-9 - (line[20, 1] - line[19, 1])]])
+    assert is_disconnected(gapped)

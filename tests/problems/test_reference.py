@@ -71,6 +71,25 @@ def test_pareto_front_in_objective_space(cache, metro):
     assert best == energy and t == pytest.approx(metro.planned_time_s + 2.0)
 
 
+def test_pareto_front_honours_n_pareto_points(cache, metro):
+    """pymoo's argument: n evenly spaced points on the front, in both objective spaces."""
+    both = SpeedProfileProblem(metro, objectives=("energy", "running_time"), time_window_s="default")
+    nodes = len(both.certified_front().table)
+    assert len(both.pareto_front()) > 100  # by default the front's nodes are added to 100 points
+    pf = both.pareto_front(n_pareto_points=10, use_cache=False)
+    lo, hi = both.certified_front().clip(both.time_window_s)  # the window inside the front's range
+    assert pf.shape == (10, 2) and nodes > 10
+    np.testing.assert_allclose(np.sort(pf[:, 1]), np.linspace(lo, hi, 10))
+    e, _ = both.certified_front().energy_at(pf[:, 1])
+    np.testing.assert_allclose(pf[:, 0], e)
+    err = SpeedProfileProblem(metro, objectives=("energy", "time_error"), time_window_s="default")
+    pf_err = err.pareto_front(n_pareto_points=7, use_cache=False)
+    assert 2 <= len(pf_err) <= 7  # mirrored: errors on the slower side may be dominated
+    for bad in (1, 2.5, True, "10"):
+        with pytest.raises(ValueError, match="n_pareto_points"):
+            both.pareto_front(n_pareto_points=bad, use_cache=False)
+
+
 def test_optimiser_never_below_front_by_more_than_certificate(cache, metro):
     problem = SpeedProfileProblem(metro, objectives=("energy", "time_error"), time_window_s="default")
     res = minimize(problem, NSGA2(pop_size=40), ("n_gen", 40), seed=3)

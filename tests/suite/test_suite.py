@@ -148,3 +148,20 @@ def test_cli_optimize_draws_the_optimum_and_prints_the_gap(capsys, tmp_path, mon
     lo, hi = problem.time_window_s
     feasible = front[front["feasible"]]
     assert ((feasible["running_time_s"] >= lo - 1e-6) & (feasible["running_time_s"] <= hi + 1e-6)).all()
+
+
+@pytest.mark.parametrize("entry", CASES, ids=lambda c: c.name)
+def test_every_suite_case_name_loads_everywhere(entry, capsys):
+    """The names docs/suite.md shows are case names for load_case, study files and the CLI."""
+    from pymoo_rail.cases import list_cases, load_case
+    from pymoo_rail.cli import main
+    from pymoo_rail.experiments import problem
+    from pymoo_rail.experiments.registry import build_problem
+
+    assert entry.name in list_cases()
+    case = load_case(entry.name)
+    assert case.name == entry.name and ref.case_hash(case) == ref.case_hash(entry.load())
+    built = build_problem(problem("speed_profile", case=entry.name, objectives=["energy", "running_time"]))
+    assert built.case.name == entry.name
+    assert main(["cases", entry.name]) == 0
+    assert entry.name in capsys.readouterr().out

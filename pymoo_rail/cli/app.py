@@ -1,0 +1,48 @@
+"""``main``: parse, run the command, and turn its errors into one clear line and an exit code."""
+
+from __future__ import annotations
+
+import sys
+from typing import Sequence
+
+from pymoo_rail.cli.arguments import UsageError
+from pymoo_rail.cli.parser import build_parser
+
+
+def _run(args) -> int:
+    if not args.compiles:
+        return args.run(args)
+    from tqdm import tqdm
+
+    from pymoo_rail.sim.jit import compile_notice
+
+    # a first run compiles the kernels: say so (tqdm.write keeps a progress bar intact)
+    with compile_notice(say=lambda text: tqdm.write(text, file=sys.stderr)):
+        return args.run(args)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``pymoo-rail``; returns the exit code (0 ok, 1 failure, 2 bad arguments)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exit_:  # --help, or argparse's own usage errors (already printed)
+        return int(exit_.code or 0)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    try:
+        return _run(args)
+    except UsageError as err:
+        args.usage_parser.print_usage(sys.stderr)
+        print(f"{args.usage_parser.prog}: error: argument {err.argument}: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("pymoo-rail: interrupted (a study keeps every run it finished; run it again to resume)",
+              file=sys.stderr)
+        return 130
+    except Exception as err:  # noqa: BLE001 - one clear line unless --debug
+        if args.debug:
+            raise
+        print(f"pymoo-rail {args.command}: error: {type(err).__name__}: {err}", file=sys.stderr)
+        return 1
