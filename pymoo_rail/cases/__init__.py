@@ -85,7 +85,9 @@ def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
     if candidate.suffix == ".toml" or candidate.is_file():
         if not candidate.is_file():
             raise CaseError("path", str(candidate), "no such case file")
-        case = read_case(candidate)
+        from pymoo_rail.cases.railjson import is_railjson_file, read_railjson_file  # OSRD railjson cases
+
+        case = read_railjson_file(candidate) if is_railjson_file(candidate) else read_case(candidate)
     elif str(name_or_path) in TTOBENCH_SECTIONS:
         case = _ttobench_section(str(name_or_path))
     else:

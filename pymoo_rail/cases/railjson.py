@@ -13,6 +13,8 @@ The formats, the mapping of every field and what is not represented: ``docs/rail
 from __future__ import annotations
 
 import json
+import re
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -26,6 +28,11 @@ from pymoo_rail.cases.railjson_rolling_stock import (
     read_rolling_stock,
 )
 from pymoo_rail.model import GRAVITY_MS2, Case, CaseError, ForceCurve, Line, Train, read_case
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 PathLike = Union[str, Path]
 TRAIN_FORMATS = ("a case file (.toml) or a built-in case name: its train", "a TTOBench train (.json)",
@@ -205,6 +212,91 @@ def describe_path(steps: Sequence[PathStep]) -> str:
                      for s in steps)
 
 
-__all__ = ["load_train", "railjson_case", "traction_voltages", "braking_force_kn", "describe_path",
+# the keys of a railjson case file (docs/railjson.md): a case whose train and line come from OSRD files
+RAILJSON_CASE_KEYS = {"": {"name", "source", "description", "run", "railjson"},
+                      "run": {"planned_time_s", "dwell_s", "time_margin_s"},
+                      "railjson": {"infra", "rolling_stock", "path", "begin_m", "end_m", "from_point", "to_point",
+                                   "mode", "comfort", "category", "routes", "power_recovery"}}
+_RAILJSON_TABLE = re.compile(r"^\s*(\[railjson\]|railjson\s*=)", re.MULTILINE)
+
+
+def is_railjson_file(path: PathLike) -> bool:
+    """Whether a file is OSRD railjson: a railjson case file (TOML with a ``[railjson]`` table), a
+    railjson infrastructure or a railjson rolling stock (JSON)."""
+    path = Path(path)
+    if not path.is_file():
+        return False
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return False
+    if path.suffix == ".toml":
+        return bool(_RAILJSON_TABLE.search(text))
+    if path.suffix == ".json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError:
+            return False
+        return isinstance(data, dict) and (is_infra(data) or is_rolling_stock(data))
+    return False
+
+
+def _keys(data: object, table: str, source: str, required: set[str]) -> dict:
+    if not isinstance(data, dict):
+        raise CaseError(table or "<file>", data, "must be a table", source)
+    for key in data:
+        if key not in RAILJSON_CASE_KEYS[table]:
+            raise CaseError(f"{table}.{key}" if table else key, data[key],
+                            f"unknown key (allowed: {', '.join(sorted(RAILJSON_CASE_KEYS[table]))})", source)
+    for key in sorted(required - set(data)):
+        raise CaseError(f"{table}.{key}" if table else key, None, "is required", source)
+    return data
+
+
+def read_railjson_file(path: PathLike) -> Case:
+    """The case of a railjson case file (TOML): a ``[run]`` and a ``[railjson]`` table naming the
+    infrastructure, the rolling stock (paths relative to the file), the path and the options of
+    :func:`railjson_case`. A railjson infrastructure or rolling stock alone is not a case: a
+    :class:`CaseError` says what to give with it."""
+    path = Path(path)
+    if path.suffix == ".json":
+        data = json.loads(path.read_text(encoding="utf-8"))
+        what = "infrastructure" if is_infra(data) else "rolling stock"
+        raise CaseError("<file>", str(path), f"is an OSRD railjson {what}, not a case: a case file names the "
+                                             f"infrastructure, the rolling stock, the path and the planned time "
+                                             f"([railjson] table, docs/railjson.md); load_train reads a rolling "
+                                             f"stock", str(path))
+    source = str(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as err:
+        raise CaseError("toml", source, f"is not valid TOML: {err}", source) from None
+    data = _keys(data, "", source, {"run", "railjson"})
+    run = _keys(data["run"], "run", source, {"planned_time_s"})
+    spec = _keys(data["railjson"], "railjson", source, {"infra", "rolling_stock"})
+    files = {key: path.parent / spec[key] if isinstance(spec[key], str) else spec[key]
+             for key in ("infra", "rolling_stock")}
+    for key, value in files.items():
+        if not isinstance(value, Path) or not value.is_file():
+            raise CaseError(f"railjson.{key}", spec[key], "must be the path of a file (relative to the case file)",
+                            source)
+    options = {key: spec[key] for key in ("path", "begin_m", "end_m", "from_point", "to_point", "mode", "comfort",
+                                          "category", "routes", "power_recovery") if key in spec}
+    if "path" in options:
+        options["path"] = [tuple(step) if isinstance(step, list) else step for step in options["path"]]
+    try:
+        case = railjson_case(files["infra"], files["rolling_stock"], planned_time_s=run["planned_time_s"],
+                             name=data.get("name"), **options)
+        return replace(case, dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0),
+                       source=data.get("source", case.source), description=data.get("description", case.description))
+    except CaseError as err:
+        if err.source is None:  # a run value: the case file's (errors in the OSRD files name those files)
+            raise CaseError(err.field, err.value, err.reason, source) from None
+        raise
+    except TypeError as err:  # a value of the wrong kind that no check above named
+        raise CaseError("railjson", type(err).__name__, f"malformed value: {err}", source) from None
+
+
+__all__ = ["load_train", "railjson_case", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS", "traction_voltages", "braking_force_kn", "describe_path",
            "read_infra", "read_rolling_stock", "path_line", "is_infra", "is_rolling_stock", "RailjsonWarning",
            "TRAIN_FORMATS"]
