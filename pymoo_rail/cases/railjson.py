@@ -20,7 +20,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Union
 
-from pymoo_rail.cases.railjson_infra import PathStep, RailjsonInfra, is_infra, path_line, read_infra
+from pymoo_rail.cases.railjson_infra import SPEED_DIGITS, PathStep, RailjsonInfra, is_infra, path_line, read_infra
 from pymoo_rail.cases.railjson_rolling_stock import (
     RailjsonRollingStock,
     RailjsonWarning,
@@ -181,7 +181,8 @@ def railjson_case(infra: RailjsonInfra | PathLike | Mapping, rolling_stock: Rail
     recovery = (stock.raise_pantograph_time_s or 0.0, stock.electrical_power_startup_time_s or 0.0) \
         if power_recovery and voltages is not None else (0.0, 0.0)
     line = path_line(infra, steps, category=category, voltages=voltages, neutral_sections=voltages is not None,
-                     routes=routes, default_limit_kmh=train.max_speed_kmh, power_recovery_s=recovery)
+                     routes=routes, default_limit_kmh=round(train.max_speed_kmh, SPEED_DIGITS),
+                     power_recovery_s=recovery)
     if line.neutral_sections and line.neutral_sections[0][0] == 0.0:
         powered = "any electrification" if voltages is None else f"electrification {', '.join(voltages)}"
         raise CaseError("mode", mode or stock.default_mode,
