@@ -277,7 +277,9 @@ class OptimalPolicy:
         value = np.zeros((n, self.n_speeds)) if entry is None else entry[1]
         prices = np.full(n - 1 - node, self._price(k))
         tables = line.tables[:-1] + (np.ascontiguousarray(line.tables[-1][node:]),)
-        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64))
+        # the end speed the case asks for is priced at the end of the line, as in the solver
+        terminal_j = dp.terminal_cost(m, self.n_speeds, self.bias, self.case.end_speed_window_ms()[0])
+        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), terminal_j)
         self.n_sweeps += 1
         line.values[k] = (node, value)
         if len(line.values) > MAX_PRICES_KEPT:  # forget the price farthest from this one
