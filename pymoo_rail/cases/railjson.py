@@ -298,6 +298,6 @@ def read_railjson_file(path: PathLike) -> Case:
         raise CaseError("railjson", type(err).__name__, f"malformed value: {err}", source) from None
 
 
-__all__ = ["load_train", "railjson_case", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS", "traction_voltages", "braking_force_kn", "describe_path",
-           "read_infra", "read_rolling_stock", "path_line", "is_infra", "is_rolling_stock", "RailjsonWarning",
+__all__ = ["load_train", "railjson_case", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS",
+           "traction_voltages", "braking_force_kn", "describe_path", "read_infra", "read_rolling_stock", "path_line", "is_infra", "is_rolling_stock", "RailjsonWarning",
            "TRAIN_FORMATS"]

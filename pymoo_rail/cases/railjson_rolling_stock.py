@@ -42,19 +42,16 @@ Mapping (the full table is in ``docs/railjson.md``):
 
 from __future__ import annotations
 
-import json
 import math
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
+from pymoo_rail.cases.json_files import Source, load_json_object
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import CaseError, DavisResistance, ForceCurve, Train
-
-Source = Union[str, Path, Mapping]
-
 
 class RailjsonWarning(UserWarning):
     """A railjson field that is read and checked but not modelled (the message names it)."""
@@ -67,21 +64,7 @@ def warn_field(field: str, reason: str, source: str) -> None:
 
 def load_json(source: Source, what: str) -> tuple[dict, str]:
     """The parsed JSON object of a railjson file (or a dict as is) and a label for messages."""
-    if isinstance(source, Mapping):
-        return dict(source), f"<railjson {what} dict>"
-    path = Path(source)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise CaseError("<file>", str(path), f"cannot read the railjson {what} file: {err.strerror}",
-                        str(path)) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise CaseError("<file>", str(path), f"is not valid JSON: {err}", str(path)) from None
-    if not isinstance(data, dict):
-        raise CaseError("<file>", str(path), f"a railjson {what} must be a JSON object", str(path))
-    return data, str(path)
+    return load_json_object(source, f"railjson {what}")
 
 
 def number(data: Mapping, key: str, source: str, *, field: str | None = None, positive: bool = False,

@@ -172,7 +172,8 @@ def test_railjson_case_writes_a_case_file_that_reloads(small, tmp_path):
 
 
 def test_a_mode_without_traction_at_the_start_is_refused(small):
-    with pytest.raises(CaseError, match=r"field 'mode' = '1500V'.*no traction where the path starts.*modes: 1500V, 25000V"):
+    with pytest.raises(CaseError, match=r"field 'mode' = '1500V'.*no traction where the path starts"
+                                        r".*modes: 1500V, 25000V"):
         railjson_case(small, DATA / "rolling_stocks" / "high-speed-train.json", from_point="Mid_West_station",
                       to_point="Mid_East_station", planned_time_s=700.0)
 
