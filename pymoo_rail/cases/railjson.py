@@ -221,6 +221,17 @@ RAILJSON_CASE_KEYS = {"": {"name", "source", "description", "run", "railjson"},
 _RAILJSON_TABLE = re.compile(r"^\s*(\[railjson\]|railjson\s*=)", re.MULTILINE)
 
 
+_RAILJSON_JSON_KEY = re.compile(r'"(railjson_version|effort_curves|rolling_resistance|track_sections|'
+                                r'extended_switch_types|speed_sections|neutral_sections)"\s*:')
+
+
+def looks_like(head: bytes) -> bool:
+    """Whether the first bytes of a file are OSRD railjson: a case file with a ``[railjson]`` table, or
+    a rolling stock or an infrastructure (JSON keys only railjson has)."""
+    text = head.decode("utf-8", errors="ignore")
+    return bool(_RAILJSON_TABLE.search(text) or _RAILJSON_JSON_KEY.search(text))
+
+
 def is_railjson_file(path: PathLike) -> bool:
     """Whether a file is OSRD railjson: a railjson case file (TOML with a ``[railjson]`` table), a
     railjson infrastructure or a railjson rolling stock (JSON)."""
@@ -298,6 +309,6 @@ def read_railjson_file(path: PathLike) -> Case:
         raise CaseError("railjson", type(err).__name__, f"malformed value: {err}", source) from None
 
 
-__all__ = ["load_train", "railjson_case", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS",
+__all__ = ["load_train", "railjson_case", "looks_like", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS",
            "traction_voltages", "braking_force_kn", "describe_path", "read_infra", "read_rolling_stock", "path_line", "is_infra", "is_rolling_stock", "RailjsonWarning",
            "TRAIN_FORMATS"]

@@ -68,3 +68,14 @@ def test_a_missing_file_and_a_lone_railjson_file(tmp_path):
         load_case(DATA / "infras" / "small_infra.json")
     with pytest.raises(CaseError, match="is an OSRD railjson rolling stock, not a case.*load_train"):
         load_case(DATA / "rolling_stocks" / "night-train.json")
+
+
+def test_railjson_files_are_told_apart_by_their_first_bytes():
+    from pymoo_rail.cases.railjson import looks_like
+
+    for path in [EXAMPLE, DATA / "infras" / "small_infra.json", *sorted((DATA / "rolling_stocks").glob("*.json"))]:
+        assert looks_like(path.read_bytes()[:4096]), path
+    others = [Path(__file__).resolve().parents[2] / "pymoo_rail" / "cases" / name
+              for name in ("yizhuang.toml", "data/CN_Beijing_Subway.json", "data/CN_Songjiazhuang_Yizhuang.json")]
+    for path in others:
+        assert not looks_like(path.read_bytes()[:4096]), path

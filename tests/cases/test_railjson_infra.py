@@ -223,3 +223,33 @@ def test_a_loop_is_read_once_per_pass():
     line = path_line(infra, twice, default_limit_kmh=100.0)
     assert line.gradients == ((0.0, 1000.0, 10.0), (1000.0, 2000.0, -10.0), (2000.0, 3000.0, 10.0),
                               (3000.0, 4000.0, -10.0))
+
+
+def _mirror(rows, length, negate=False):
+    return tuple((length - b, length - a, -v if negate else v) for a, b, v in reversed(rows))
+
+
+def test_every_station_pair_run_backwards_mirrors_the_profile(small):
+    # on every path between two stations of small_infra, the same tracks run the other way give the
+    # mirrored line: gradients mirrored and negated, limits and curves mirrored (its speed sections
+    # apply both ways); the altitude at the end is the same climb with the opposite sign
+    pairs = 0
+    for a in small.operational_points:
+        for b in small.operational_points:
+            if a == b:
+                continue
+            try:
+                steps = small.shortest_path(a, b)
+            except CaseError:
+                continue
+            back = tuple(PathStep(s.track, s.begin_m, s.end_m, S2T if s.direction == S2S else S2S)
+                         for s in reversed(steps))
+            forward, backward = path_line(small, steps), path_line(small, back)
+            length = forward.length_m
+            assert backward.length_m == length == pytest.approx(sum(s.length_m for s in steps))
+            assert backward.gradients == _mirror(forward.gradients, length, negate=True)
+            assert backward.speed_limits == _mirror(forward.speed_limits, length)
+            assert backward.curves == _mirror(forward.curves, length)
+            assert backward.altitude_m(length) == pytest.approx(-forward.altitude_m(length))
+            pairs += 1
+    assert pairs == 40  # of the 56 ordered pairs, 16 need a reversal
