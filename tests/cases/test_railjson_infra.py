@@ -253,3 +253,17 @@ def test_every_station_pair_run_backwards_mirrors_the_profile(small):
             assert backward.altitude_m(length) == pytest.approx(-forward.altitude_m(length))
             pairs += 1
     assert pairs == 40  # of the 56 ordered pairs, 16 need a reversal
+
+
+def test_power_recovery_uses_the_rolling_stocks_times(small):
+    # West_station -> Mid_East_station crosses neutral_section.1 (TA0 [1960, 2000], pantograph lowered)
+    # and .0 (TA6 [0, 10], lowered) then .2 (TA6 [8500, 8600], not lowered) at 300 km/h
+    stock = DATA / "rolling_stocks" / "commuter-train.json"  # raise_pantograph_time 25 s, power start-up 5 s
+    plain = railjson_case(small, stock, path=[("TA0", S2S), ("TA6", S2S)], begin_m=700.0, end_m=10000.0,
+                          mode="1500V", planned_time_s=600.0)
+    slow = railjson_case(small, stock, path=[("TA0", S2S), ("TA6", S2S)], begin_m=700.0, end_m=10000.0,
+                         mode="1500V", planned_time_s=600.0, power_recovery=True)
+    assert plain.line.neutral_sections == ((1260.0, 1310.0), (9800.0, 9900.0))
+    # 25 s after the lowered ones (they join), 5 s after the other, each at the 300 km/h limit
+    assert [x for row in slow.line.neutral_sections for x in row] == pytest.approx(
+        [1260.0, 1310.0 + 25.0 * 300.0 / 3.6, 9800.0, 9900.0 + 5.0 * 300.0 / 3.6])
