@@ -27,7 +27,7 @@ from pymoo_rail.cases.railjson_rolling_stock import (
     is_rolling_stock,
     read_rolling_stock,
 )
-from pymoo_rail.model import GRAVITY_MS2, Case, CaseError, ForceCurve, Line, Train, read_case
+from pymoo_rail.model import GRAVITY_MS2, Case, CaseError, ForceCurve, Line, Train
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -78,7 +78,7 @@ def load_train(path: PathLike, mode: str | None = None, comfort: str | None = No
     candidate = Path(path)
     if candidate.suffix == ".toml" or (not candidate.is_file() and str(path) in list_cases()):
         _no_choice(str(path), "a case file", mode, comfort)
-        return (read_case(candidate) if candidate.is_file() else load_case(str(path))).train
+        return load_case(candidate if candidate.is_file() else str(path)).train
     if not candidate.is_file():
         raise CaseError("path", str(path), "no such train file or built-in case (formats: "
                                            f"{'; '.join(TRAIN_FORMATS)})")

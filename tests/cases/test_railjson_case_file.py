@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from pymoo_rail.cases import load_case, railjson_case
+from pymoo_rail.cases import load_case, load_train, railjson_case
 from pymoo_rail.cli import main
 from pymoo_rail.model import CaseError, read_case
 
@@ -23,6 +23,7 @@ def test_load_case_reads_a_railjson_case_file():
     assert case.line == direct.line and case.train == direct.train
     assert case.name == "osrd-night-train" and case.planned_time_s == 700.0
     assert case.description.startswith("OSRD's night train")
+    assert load_train(EXAMPLE) == case.train  # the train of a railjson case file, mode and comfort as it says
 
 
 def test_the_cli_writes_it_back_as_a_complete_case_file(tmp_path, capsys):
