@@ -21,7 +21,9 @@ Mapping (the full table is in ``docs/railjson.md``):
   speed_unit="ms")`` after dividing by 1000 (same force, kN).
 - The effort curve of the chosen mode and comfort -> ``traction`` as a table (km/h, kN), linear
   between OSRD's points as OSRD interpolates them; the last force holds beyond the last speed.
-- ``comfort_acceleration`` -> ``max_accel_ms2`` (OSRD caps the acceleration at it).
+- ``comfort_acceleration`` -> ``max_accel_ms2``: the schema's "maximum operational acceleration".
+  OSRD's simulator (2025 core) passes it on but its integrator accelerates with the full effort;
+  ``dataclasses.replace(train, max_accel_ms2=None)`` drives that way.
 - ``const_gamma`` -> ``max_decel_ms2`` and a braking force ``const_gamma x mass x k``: the
   deceleration is ``const_gamma`` on level track, as in OSRD, which holds it on every gradient;
   :func:`pymoo_rail.cases.railjson.railjson_case` adds the force that keeps it on the steepest
