@@ -126,7 +126,7 @@ def railjson_case(infra: RailjsonInfra | PathLike | Mapping, rolling_stock: Rail
                   begin_m: float | None = None, end_m: float | None = None, from_point: str | None = None,
                   to_point: str | None = None, mode: str | None = None, comfort: str | None = None,
                   category: str | None = None, routes: Sequence[str] = (), power_recovery: bool = False,
-                  name: str | None = None) -> Case:
+                  name: str | None = None, allow_implausible: bool | Sequence[str] | None = None) -> Case:
     """A case: an OSRD rolling stock on a path of an OSRD infrastructure.
 
     Parameters
@@ -155,6 +155,8 @@ def railjson_case(infra: RailjsonInfra | PathLike | Mapping, rolling_stock: Rail
         as OSRD's simulator.
     name : str, optional
         The case's name (default from the infrastructure and the path).
+    allow_implausible : bool or sequence of str, optional
+        Handed to the :class:`Case` when given (the plausibility bounds of the case model).
 
     Returns
     -------
@@ -191,9 +193,10 @@ def railjson_case(infra: RailjsonInfra | PathLike | Mapping, rolling_stock: Rail
                         f"stock (modes: {', '.join(stock.modes)})", infra.source)
     train = replace(train, braking=ForceCurve(max_force_kn=braking_force_kn(stock, line)))
     label = Path(infra.source).stem if not infra.source.startswith("<") else "railjson"
+    extra = {} if allow_implausible is None else {"allow_implausible": allow_implausible}
     return Case(name=name or f"{label}: {where}", train=train, line=line, planned_time_s=planned_time_s,
                 source=f"OSRD railjson: infrastructure {infra.source}, rolling stock {stock.source}",
-                description=f"{stock.name} from {where}; path {describe_path(steps)}")
+                description=f"{stock.name} from {where}; path {describe_path(steps)}", **extra)
 
 
 def braking_force_kn(stock: RailjsonRollingStock, line: Line) -> float:
@@ -265,7 +268,7 @@ def _keys(data: object, table: str, source: str, required: set[str]) -> dict:
     return data
 
 
-def read_railjson_file(path: PathLike) -> Case:
+def read_railjson_file(path: PathLike, *, allow_implausible: bool | Sequence[str] | None = None) -> Case:
     """The case of a railjson case file (TOML): a ``[run]`` and a ``[railjson]`` table naming the
     infrastructure, the rolling stock (paths relative to the file), the path and the options of
     :func:`railjson_case`. A railjson infrastructure or rolling stock alone is not a case: a
@@ -298,7 +301,7 @@ def read_railjson_file(path: PathLike) -> Case:
         options["path"] = [tuple(step) if isinstance(step, list) else step for step in options["path"]]
     try:
         case = railjson_case(files["infra"], files["rolling_stock"], planned_time_s=run["planned_time_s"],
-                             name=data.get("name"), **options)
+                             name=data.get("name"), allow_implausible=allow_implausible, **options)
         return replace(case, dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0),
                        source=data.get("source", case.source), description=data.get("description", case.description))
     except CaseError as err:
@@ -309,6 +312,33 @@ def read_railjson_file(path: PathLike) -> Case:
         raise CaseError("railjson", type(err).__name__, f"malformed value: {err}", source) from None
 
 
-__all__ = ["load_train", "railjson_case", "looks_like", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS",
+def read_case(path: PathLike, *, allow_implausible: bool | Sequence[str] | None = None, **options) -> Case:
+    """The case-format registry's reader of OSRD railjson files.
+
+    A railjson case file (TOML with a ``[railjson]`` table) takes no options. An infrastructure
+    takes those of :func:`railjson_case`:
+    ``load_case("small_infra.json", rolling_stock=..., from_point=..., to_point=..., planned_time_s=...)``.
+    A rolling stock alone is not a case (a :class:`CaseError` says so).
+    """
+    path = Path(path)
+    if path.suffix == ".json" and options:
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            data = None
+        if isinstance(data, dict) and is_infra(data):
+            if "rolling_stock" not in options or "planned_time_s" not in options:
+                missing = "rolling_stock" if "rolling_stock" not in options else "planned_time_s"
+                raise CaseError(missing, None, "is required to make a case of an OSRD infrastructure "
+                                               "(with from_point/to_point or path)", str(path))
+            return railjson_case(path, options.pop("rolling_stock"),
+                                 allow_implausible=allow_implausible, **options)
+    if options:
+        raise CaseError(next(iter(options)), options[next(iter(options))],
+                        "options are for an OSRD infrastructure; a railjson case file names its own", str(path))
+    return read_railjson_file(path, allow_implausible=allow_implausible)
+
+
+__all__ = ["load_train", "railjson_case", "looks_like", "read_case", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS",
            "traction_voltages", "braking_force_kn", "describe_path", "read_infra", "read_rolling_stock", "path_line", "is_infra", "is_rolling_stock", "RailjsonWarning",
            "TRAIN_FORMATS"]

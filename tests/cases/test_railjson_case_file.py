@@ -80,3 +80,18 @@ def test_railjson_files_are_told_apart_by_their_first_bytes():
               for name in ("yizhuang.toml", "data/CN_Beijing_Subway.json", "data/CN_Songjiazhuang_Yizhuang.json")]
     for path in others:
         assert not looks_like(path.read_bytes()[:4096]), path
+
+
+def test_the_registry_reader_takes_an_infrastructure_with_options():
+    from pymoo_rail.cases.railjson import read_case
+
+    case = read_case(DATA / "infras" / "small_infra.json", rolling_stock=DATA / "rolling_stocks" / "night-train.json",
+                     from_point="Mid_West_station", to_point="Mid_East_station", planned_time_s=700.0,
+                     mode="25000V", comfort="AIR_CONDITIONING", name="osrd-night-train")
+    assert case.line == load_case(EXAMPLE).line and case.train == load_case(EXAMPLE).train
+    with pytest.raises(CaseError, match="field 'planned_time_s'.*required"):
+        read_case(DATA / "infras" / "small_infra.json", rolling_stock=DATA / "rolling_stocks" / "night-train.json",
+                  from_point="Mid_West_station", to_point="Mid_East_station")
+    with pytest.raises(CaseError, match="field 'mode'.*names its own"):
+        read_case(EXAMPLE, mode="1500V")
+    assert read_case(EXAMPLE) == load_case(EXAMPLE)
