@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import re
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -27,12 +26,8 @@ from pymoo_rail.cases.railjson_rolling_stock import (
     is_rolling_stock,
     read_rolling_stock,
 )
+from pymoo_rail.cases.toml_case import parse_toml
 from pymoo_rail.model import GRAVITY_MS2, Case, CaseError, ForceCurve, Line, Train
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
 
 PathLike = Union[str, Path]
 TRAIN_FORMATS = ("a case file (.toml) or a built-in case name: its train", "a TTOBench train (.json)",
@@ -235,27 +230,6 @@ def looks_like(head: bytes) -> bool:
     return bool(_RAILJSON_TABLE.search(text) or _RAILJSON_JSON_KEY.search(text))
 
 
-def is_railjson_file(path: PathLike) -> bool:
-    """Whether a file is OSRD railjson: a railjson case file (TOML with a ``[railjson]`` table), a
-    railjson infrastructure or a railjson rolling stock (JSON)."""
-    path = Path(path)
-    if not path.is_file():
-        return False
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
-        return False
-    if path.suffix == ".toml":
-        return bool(_RAILJSON_TABLE.search(text))
-    if path.suffix == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError:
-            return False
-        return isinstance(data, dict) and (is_infra(data) or is_rolling_stock(data))
-    return False
-
-
 def _keys(data: object, table: str, source: str, required: set[str]) -> dict:
     if not isinstance(data, dict):
         raise CaseError(table or "<file>", data, "must be a table", source)
@@ -283,10 +257,10 @@ def read_railjson_file(path: PathLike, *, allow_implausible: bool | Sequence[str
                                              f"stock", str(path))
     source = str(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as err:
-        raise CaseError("toml", source, f"is not valid TOML: {err}", source) from None
-    data = _keys(data, "", source, {"run", "railjson"})
+        raw = path.read_bytes()
+    except OSError as err:
+        raise CaseError("path", source, f"cannot be read: {err.strerror or err}", source) from None
+    data = _keys(parse_toml(raw, source), "", source, {"run", "railjson"})
     run = _keys(data["run"], "run", source, {"planned_time_s"})
     spec = _keys(data["railjson"], "railjson", source, {"infra", "rolling_stock"})
     files = {key: path.parent / spec[key] if isinstance(spec[key], str) else spec[key]
@@ -339,6 +313,6 @@ def read_case(path: PathLike, *, allow_implausible: bool | Sequence[str] | None 
     return read_railjson_file(path, allow_implausible=allow_implausible)
 
 
-__all__ = ["load_train", "railjson_case", "looks_like", "read_case", "is_railjson_file", "read_railjson_file", "RAILJSON_CASE_KEYS",
-           "traction_voltages", "braking_force_kn", "describe_path", "read_infra", "read_rolling_stock", "path_line", "is_infra", "is_rolling_stock", "RailjsonWarning",
-           "TRAIN_FORMATS"]
+__all__ = ["load_train", "railjson_case", "looks_like", "read_case", "read_railjson_file", "RAILJSON_CASE_KEYS",
+           "traction_voltages", "braking_force_kn", "describe_path", "read_infra", "read_rolling_stock", "path_line",
+           "is_infra", "is_rolling_stock", "RailjsonWarning", "TRAIN_FORMATS"]

@@ -13,6 +13,7 @@ import pkgutil
 from types import ModuleType
 
 from pymoo_rail.cli import commands
+from pymoo_rail.cli.arguments import Parser
 
 MAIN_EPILOG = """\
 examples:
@@ -44,7 +45,7 @@ def command_modules() -> list[ModuleType]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``pymoo-rail`` command with all its subcommands."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="pymoo-rail",
         description="Energy-efficient train driving with pymoo: optimise recommended speed profiles of "
                     "built-in or your own cases, compute the exact minimum-energy reference, run algorithm "

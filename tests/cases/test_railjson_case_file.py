@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from pymoo_rail.cases import load_case, load_train, railjson_case
+from pymoo_rail.cases import load_case, load_train, railjson_case, read_case
 from pymoo_rail.cli import main
-from pymoo_rail.model import CaseError, read_case
+from pymoo_rail.model import CaseError
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "osrd"
 EXAMPLE = DATA / "night-train-mid-west-to-mid-east.toml"

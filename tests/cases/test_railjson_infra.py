@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from pymoo_rail.cases import load_train, railjson_case
+from pymoo_rail.cases import load_train, railjson_case, read_case, write_case
 from pymoo_rail.cases.railjson_infra import PathStep, path_line, read_infra
-from pymoo_rail.model import Case, CaseError, read_case, write_case
+from pymoo_rail.model import Case, CaseError
 from pymoo_rail.model.grid import curve_resistance_n_per_kn
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "osrd"

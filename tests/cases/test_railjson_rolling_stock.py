@@ -13,9 +13,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pymoo_rail.cases import load_case, load_train
+from pymoo_rail.cases import load_case, load_train, write_case
 from pymoo_rail.cases.railjson_rolling_stock import RailjsonWarning, read_rolling_stock
-from pymoo_rail.model import CaseError, write_case
+from pymoo_rail.model import CaseError
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "osrd"
 STOCKS = sorted((DATA / "rolling_stocks").glob("*.json"))

@@ -73,7 +73,7 @@ def run(args) -> int:
         case = load_case("CASE", args.case)
         _describe(case)
         if args.write:
-            from pymoo_rail.model import write_case
+            from pymoo_rail.cases import write_case
 
             say(f"written: {write_case(case, args.write)}")
     return 0
