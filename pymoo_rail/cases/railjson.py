@@ -1,6 +1,7 @@
-"""OSRD railjson: trains from any supported format, cases from an infrastructure, a path and a train.
+"""OSRD railjson in the case-format registry: trains from rolling stocks, cases from an infrastructure,
+a path and a rolling stock, and case files that name them.
 
->>> from pymoo_rail.cases.railjson import load_train, railjson_case
+>>> from pymoo_rail.cases import load_train, railjson_case
 >>> train = load_train("tests/data/osrd/rolling_stocks/intercity-train.json", mode="25000V")  # doctest: +SKIP
 >>> case = railjson_case("tests/data/osrd/infras/small_infra.json",
 ...                      "tests/data/osrd/rolling_stocks/intercity-train.json",
@@ -24,74 +25,40 @@ from pymoo_rail.cases.railjson_rolling_stock import (
     RailjsonRollingStock,
     RailjsonWarning,
     is_rolling_stock,
+    load_json,
     read_rolling_stock,
 )
 from pymoo_rail.cases.toml_case import parse_toml
 from pymoo_rail.model import GRAVITY_MS2, Case, CaseError, ForceCurve, Line, Train
 
 PathLike = Union[str, Path]
-TRAIN_FORMATS = ("a case file (.toml) or a built-in case name: its train", "a TTOBench train (.json)",
-                 "an OSRD railjson rolling stock (.json)")
 
 
-def _is_ttobench_train(data: Mapping) -> bool:
-    # TTOBench gives every scalar as {"unit": ..., "value": ...} and names the train in metadata.id
-    mass = data.get("mass")
-    return isinstance(mass, Mapping) and "unit" in mass and "value" in mass
-
-
-def _no_choice(source: str, what: str, mode: str | None, comfort: str | None) -> None:
-    for field, value in (("mode", mode), ("comfort", comfort)):
-        if value is not None:
-            raise CaseError(field, value, f"{what} has one traction curve: traction modes and comfort classes "
-                                          f"are railjson rolling stock options", source)
-
-
-def load_train(path: PathLike, mode: str | None = None, comfort: str | None = None) -> Train:
-    """Read a train from any supported format.
+def read_train(path: PathLike, *, mode: str | None = None, comfort: str | None = None) -> Train:
+    """The case-format registry's train reader: ``load_train(path, mode=..., comfort=...)``.
 
     Parameters
     ----------
     path : str or Path
-        A case file (``.toml``: its ``[train]``), a built-in case name, a TTOBench train file or an
-        OSRD railjson rolling stock (``.json``, told apart by their content).
+        An OSRD railjson rolling stock (``.json``), or a railjson case file (its rolling stock in
+        the mode and comfort class it names).
     mode : str, optional
-        railjson only: the traction mode (``"25000V"``, ``"1500V"``, ``"thermal"``, ...); default the
-        file's ``default_mode``. An unknown mode is a :class:`CaseError` listing the available ones.
+        The traction mode (``"25000V"``, ``"1500V"``, ``"thermal"``, ...); default the file's
+        ``default_mode``. An unknown mode is a :class:`CaseError` listing the available ones.
     comfort : str, optional
-        railjson only: the comfort class (``"STANDARD"``, ``"AIR_CONDITIONING"``, ``"HEATING"``);
-        default the mode's ``default_curve``. An unknown class is a :class:`CaseError` listing the
-        available ones.
-
-    Returns
-    -------
-    Train
+        The comfort class (``"STANDARD"``, ``"AIR_CONDITIONING"``, ``"HEATING"``); default the
+        mode's ``default_curve``. An unknown class is a :class:`CaseError` listing the available ones.
     """
-    # the case readers of pymoo_rail.cases (imported here: that package imports this module lazily)
-    from pymoo_rail.cases import list_cases, load_case
-
-    candidate = Path(path)
-    if candidate.suffix == ".toml" or (not candidate.is_file() and str(path) in list_cases()):
-        _no_choice(str(path), "a case file", mode, comfort)
-        return load_case(candidate if candidate.is_file() else str(path)).train
-    if not candidate.is_file():
-        raise CaseError("path", str(path), "no such train file or built-in case (formats: "
-                                           f"{'; '.join(TRAIN_FORMATS)})")
-    try:
-        data = json.loads(candidate.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise CaseError("<file>", str(candidate), f"is neither TOML (.toml) nor valid JSON: {err}",
-                        str(candidate)) from None
-    if isinstance(data, dict) and is_rolling_stock(data):
-        return read_rolling_stock(candidate).train(mode, comfort)
-    if isinstance(data, dict) and _is_ttobench_train(data):
-        # TTOBench support is read only when asked for (as pymoo_rail.cases does)
-        from pymoo_rail.cases.ttobench import read_train
-
-        _no_choice(str(candidate), "a TTOBench train", mode, comfort)
-        return read_train(candidate).train
-    raise CaseError("<file>", str(candidate), f"is not a train in a known format ({'; '.join(TRAIN_FORMATS)})",
-                    str(candidate))
+    path = Path(path)
+    if path.suffix == ".toml":
+        for field, value in (("mode", mode), ("comfort", comfort)):
+            if value is not None:
+                raise CaseError(field, value, "a railjson case file names its own mode and comfort", str(path))
+        return read_railjson_file(path).train
+    data, _ = load_json(path, "rolling stock")
+    if is_infra(data):
+        raise CaseError("<file>", str(path), "is an OSRD railjson infrastructure, not a train", str(path))
+    return read_rolling_stock(path).train(mode, comfort)
 
 
 def traction_voltages(stock: RailjsonRollingStock, mode: str | None = None,
@@ -313,6 +280,6 @@ def read_case(path: PathLike, *, allow_implausible: bool | Sequence[str] | None 
     return read_railjson_file(path, allow_implausible=allow_implausible)
 
 
-__all__ = ["load_train", "railjson_case", "looks_like", "read_case", "read_railjson_file", "RAILJSON_CASE_KEYS",
+__all__ = ["read_train", "railjson_case", "looks_like", "read_case", "read_railjson_file", "RAILJSON_CASE_KEYS",
            "traction_voltages", "braking_force_kn", "describe_path", "read_infra", "read_rolling_stock", "path_line",
-           "is_infra", "is_rolling_stock", "RailjsonWarning", "TRAIN_FORMATS"]
+           "is_infra", "is_rolling_stock", "RailjsonWarning"]

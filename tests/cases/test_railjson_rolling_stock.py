@@ -108,30 +108,27 @@ def test_a_comfort_curve_is_used_when_it_differs(tmp_path):
 
 
 def test_load_train_reads_every_format(tmp_path):
-    # a built-in case name, a case file, a TTOBench train, a railjson rolling stock
+    # a case file, a TTOBench train, a railjson rolling stock, through the format registry
     yizhuang = load_case("yizhuang")
-    assert load_train("yizhuang") == yizhuang.train
     path = write_case(yizhuang, tmp_path / "y.toml")
     assert load_train(path) == yizhuang.train
     tto = Path(__file__).resolve().parents[2] / "pymoo_rail" / "cases" / "data" / "CN_Beijing_Subway.json"
     assert load_train(tto).mass_t == pytest.approx(278.0)
     assert load_train(STOCKS[0]).mass_t == pytest.approx(390.0)
-    with pytest.raises(CaseError, match="field 'mode'.*railjson rolling stock options"):
+    with pytest.raises(CaseError, match="field 'options'.*mode.*the toml reader takes"):
         load_train(path, mode="25000V")
-    with pytest.raises(CaseError, match="field 'comfort'.*railjson rolling stock options"):
+    with pytest.raises(CaseError, match="field 'options'.*comfort.*the ttobench reader takes"):
         load_train(tto, comfort="STANDARD")
 
 
 def test_load_train_names_what_it_cannot_read(tmp_path):
-    with pytest.raises(CaseError, match="no such train file or built-in case"):
+    with pytest.raises(CaseError, match="no such train file"):
         load_train(tmp_path / "missing.json")
-    other = tmp_path / "other.json"
-    other.write_text(json.dumps({"track_sections": []}))
-    with pytest.raises(CaseError, match="not a train in a known format"):
-        load_train(other)
+    with pytest.raises(CaseError, match="railjson infrastructure, not a train"):
+        load_train(DATA / "infras" / "tiny_infra.json")
     broken = tmp_path / "broken.json"
     broken.write_text("{")
-    with pytest.raises(CaseError, match="neither TOML"):
+    with pytest.raises(CaseError, match="not valid JSON"):
         load_train(broken)
 
 
