@@ -377,6 +377,8 @@ def read_infra(source: Source) -> RailjsonInfra:
         by_tag = {tag: number(tags, tag, label, field=f"{where}.speed_limit_by_tag.{tag}", positive=True)
                   for tag in tags}
         routes = entry.get("on_routes") or []
+        if not isinstance(routes, list) or not all(isinstance(r, str) for r in routes):
+            raise CaseError(f"{where}.on_routes", routes, "must be an array of route ids", label)
         speed_sections.append(SpeedSection(
             id=str(entry.get("id", k)), speed_limit_ms=default, by_tag_ms=by_tag, on_routes=tuple(routes),
             ranges=tuple(_ranges(entry.get("track_ranges"), f"{where}.track_ranges", label, None, tracks,

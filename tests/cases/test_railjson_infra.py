@@ -204,6 +204,7 @@ def test_bad_paths_name_the_problem(small):
      "speed_sections[0].track_ranges[0].applicable_directions"),
     (lambda d: d["speed_sections"][0].update(speed_limit=0.0), "speed_sections[0].speed_limit"),
     (lambda d: d["neutral_sections"][0].update(lower_pantograph=None), "neutral_sections[0].lower_pantograph"),
+    (lambda d: d["speed_sections"][0].update(on_routes="rt.a"), "speed_sections[0].on_routes"),
     (lambda d: d["operational_points"][0]["parts"][0].update(position=1e6), "operational_points[0].parts[0].position"),
 ])
 def test_bad_infrastructures_name_the_field(change, field):
