@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from typing import Sequence
 
-from pymoo_rail.cli.arguments import UsageError
+from pymoo_rail.cli.arguments import UsageError, usage_error
 from pymoo_rail.cli.parser import build_parser
 
 
@@ -14,10 +14,11 @@ def _run(args) -> int:
         return args.run(args)
     from tqdm import tqdm
 
-    from pymoo_rail.sim.jit import compile_notice
+    from pymoo_rail.sim.jit import NOTICE, compile_notice
 
     # a first run compiles the kernels: say so (tqdm.write keeps a progress bar intact)
-    with compile_notice(say=lambda text: tqdm.write(text, file=sys.stderr)):
+    message = args.compiles if isinstance(args.compiles, str) else NOTICE
+    with compile_notice(say=lambda text: tqdm.write(text, file=sys.stderr), message=message):
         return args.run(args)
 
 
@@ -34,12 +35,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return _run(args)
     except UsageError as err:
-        args.usage_parser.print_usage(sys.stderr)
-        print(f"{args.usage_parser.prog}: error: argument {err.argument}: {err}", file=sys.stderr)
+        print(usage_error(args.usage_parser.prog, f"argument {err.argument}: {err}"), file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("pymoo-rail: interrupted (a study keeps every run it finished; run it again to resume)",
-              file=sys.stderr)
+    except KeyboardInterrupt as err:  # the command may say what it kept
+        print(f"pymoo-rail {args.command}: interrupted; {str(err) or args.interrupted}", file=sys.stderr)
         return 130
     except Exception as err:  # noqa: BLE001 - one clear line unless --debug
         if args.debug:

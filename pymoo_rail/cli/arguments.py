@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import tempfile
 from pathlib import Path
 
 
@@ -12,6 +13,27 @@ class UsageError(Exception):
     def __init__(self, argument: str, message: str):
         self.argument = argument
         super().__init__(message)
+
+
+def usage_error(prog: str, message: str) -> str:
+    """The two lines of a bad argument: the error, and where the options are explained."""
+    return f"{prog}: error: {message}\n{prog}: run '{prog} --help' for the options and examples"
+
+
+class Parser(argparse.ArgumentParser):
+    """``argparse.ArgumentParser`` whose errors are one line and a hint, not the whole usage block."""
+
+    def parse_args(self, args=None, namespace=None):
+        """argparse's ``parse_args``; an unknown option is blamed on the command it was given to."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            prog = getattr(parsed, "usage_parser", self).prog
+            self.exit(2, usage_error(prog, f"unrecognized arguments: {' '.join(extras)}") + "\n")
+        return parsed
+
+    def error(self, message: str):
+        """Print the error and the ``--help`` hint on standard error; exit 2 (argparse's hook)."""
+        self.exit(2, usage_error(self.prog, message) + "\n")
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
@@ -60,7 +82,12 @@ def out_dir(value: str) -> Path:
     path = Path(value)
     if path.exists() and not path.is_dir():
         raise UsageError("--out", f"{value!r} exists and is not a directory")
-    path.mkdir(parents=True, exist_ok=True)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):  # writable? (a read-only disk lets mkdir of an existing folder pass)
+            pass
+    except OSError as err:
+        raise UsageError("--out", f"cannot write into {value!r}: {err.strerror or err}") from None
     return path
 
 
@@ -74,14 +101,24 @@ def count(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
-def add_command(subparsers, name: str, run, *, compiles: bool, aliases: tuple[str, ...] = (),
-                **kwargs) -> argparse.ArgumentParser:
+EXACT_SOLVER_NOTICE = ("compiling the simulator and the exact solver (first run only: Numba compiles the kernels "
+                       "of the simulation and the dynamic programme once and caches them on disk; this takes a "
+                       "while on a small machine) ...")
+"""What a first run of a command that solves exactly compiles (``add_command(compiles=...)``)."""
+
+NOTHING_KEPT = "nothing to resume: run the command again"
+
+
+def add_command(subparsers, name: str, run, *, compiles: bool | str, aliases: tuple[str, ...] = (),
+                interrupted: str = NOTHING_KEPT, **kwargs) -> argparse.ArgumentParser:
     """Add a subcommand whose ``run(args)`` gives the exit code.
 
-    ``compiles`` says that the command may compile the simulator's kernels on a first run (the
-    user is told). The parser is remembered as ``args.usage_parser``: a ``UsageError`` prints its
-    usage line.
+    ``compiles`` says that the command may compile the simulator's kernels on a first run: the
+    user is told, with this text if it is one (what is compiled and roughly how long it takes).
+    ``interrupted`` says what Ctrl-C keeps (a ``KeyboardInterrupt`` raised with a message says it
+    instead). The parser is remembered as ``args.usage_parser``: a ``UsageError`` names its
+    program.
     """
     p = subparsers.add_parser(name, aliases=list(aliases), formatter_class=HelpFormatter, **kwargs)
-    p.set_defaults(run=run, compiles=compiles, usage_parser=p)
+    p.set_defaults(run=run, compiles=compiles, usage_parser=p, interrupted=interrupted)
     return p

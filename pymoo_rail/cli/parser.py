@@ -13,13 +13,14 @@ import pkgutil
 from types import ModuleType
 
 from pymoo_rail.cli import commands
+from pymoo_rail.cli.arguments import Parser
 
 MAIN_EPILOG = """\
 examples:
   pymoo-rail cases                                  list the built-in cases
   pymoo-rail cases yizhuang                         describe one case
-  pymoo-rail optimize yizhuang --out out/           NSGA-II on energy and time error (about 3 s of
-                                                    CPU; the first run compiles, about 18 s more)
+  pymoo-rail optimize yizhuang --out out/           NSGA-II on energy and time error (about 3.5 s
+                                                    of CPU; the first run compiles, about 17 s more)
   pymoo-rail optimize yizhuang --algorithm moabc --pop-size 40 --n-gen 100 --seed 3 --out out/moabc
   pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
   pymoo-rail reference yizhuang --out out/ref       the exact minimum-energy front
@@ -44,7 +45,7 @@ def command_modules() -> list[ModuleType]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``pymoo-rail`` command with all its subcommands."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="pymoo-rail",
         description="Energy-efficient train driving with pymoo: optimise recommended speed profiles of "
                     "built-in or your own cases, compute the exact minimum-energy reference, run algorithm "

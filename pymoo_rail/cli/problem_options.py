@@ -6,7 +6,8 @@ import argparse
 from typing import Sequence
 
 from pymoo_rail.cli.arguments import UsageError, positive_float, positive_int, random_seed, say
-from pymoo_rail.constants import OBJECTIVES
+from pymoo_rail.problems.encodings import encoding_names
+from pymoo_rail.problems.objectives import check_objectives
 
 
 def add_problem_arguments(p: argparse.ArgumentParser) -> None:
@@ -17,9 +18,8 @@ def add_problem_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--objectives", "-o", nargs="+", default=["energy", "time_error"], metavar="NAME",
                    help="objectives to minimise")
     p.add_argument("--seed", "-s", type=random_seed, default=1, help="random seed (same seed, same result)")
-    p.add_argument("--encoding", default="speed_codes", choices=["speed_codes", "switching_points", "braking_onset"],
-                   help="decision variables: a speed code per section, regime switching positions, or "
-                        "phases with the braking onset and deceleration (a live stop error)")
+    p.add_argument("--encoding", default="speed_codes", choices=encoding_names(),
+                   help="decision variables (see 'encodings' below)")
     p.add_argument("--partition", default="gradient_limit", choices=["gradient_limit", "equal"],
                    help="sections of the speed-code encoding")
     p.add_argument("--n-sections", type=positive_int, default=None, metavar="N",
@@ -33,17 +33,24 @@ def add_problem_arguments(p: argparse.ArgumentParser) -> None:
                    help="running-time window constraint LO HI in seconds; 'default' (the minimum running time "
                         "to 1.3 x planned, where the certified optimal front is known: the times a timetable "
                         "planner uses) or 'none'; applies to running_time / time_error fronts")
+    add_grid_argument(p)
     p.add_argument("--no-reference", action="store_true",
                    help="skip the certified optimal front, the optimal profile and the gap to the optimum")
 
 
+def add_grid_argument(p: argparse.ArgumentParser) -> None:
+    """``--dx M``: the position step of the simulation and of the exact reference."""
+    p.add_argument("--dx", type=positive_float, default=None, metavar="M",
+                   help="position step of the simulation grid and of the exact reference, in m (default: the "
+                        "case's, 1 m on metro lines); a finer step lets the exact reference meet running times "
+                        "a coarse grid jumps over")
+
+
 def _objectives(values: Sequence[str]) -> tuple[str, ...]:
-    for name in values:
-        if name not in OBJECTIVES:
-            raise UsageError("--objectives", f"unknown objective {name!r} (choose from {', '.join(OBJECTIVES)})")
-    if len(set(values)) != len(values):
-        raise UsageError("--objectives", f"{' '.join(values)}: an objective is repeated")
-    return tuple(values)
+    try:
+        return check_objectives(values)  # the objective table: known names, none repeated (aliases count)
+    except ValueError as err:
+        raise UsageError("--objectives", str(err)) from None
 
 
 def _time_window(args, objectives):
@@ -93,6 +100,8 @@ def problem_from_args(case, args):
               "time_tolerance_s": time_tolerance_s, "time_window_s": _time_window(args, objectives)}
     if args.n_sections is not None:
         kwargs["n_sections"] = args.n_sections
+    if args.dx is not None:
+        kwargs["dx_m"] = args.dx
     if args.weights is not None:
         kwargs["weights"] = args.weights
     try:
@@ -104,13 +113,30 @@ def problem_from_args(case, args):
 
 
 def algorithm_from_args(problem, args):
-    """The pymoo algorithm of ``--algorithm`` and ``--pop-size`` for ``problem``."""
-    from pymoo_rail.experiments.registry import build_algorithm
+    """The pymoo algorithm of ``--algorithm`` and ``--pop-size`` for ``problem``, and its constraint penalty.
+
+    Returns
+    -------
+    (Algorithm, float or None)
+        The algorithm, and the penalty for ``optimize_profile`` when the algorithm has no
+        constraint handling (MOEA/D) and the problem has constraints (the user is told), else None.
+    """
+    from pymoo_rail.experiments.penalty import DEFAULT_PENALTY, handles_constraints
+    from pymoo_rail.experiments.registry import ALGORITHMS, build_algorithm, canonical_name
     from pymoo_rail.experiments.spec import AlgorithmSpec, StudyError
 
     try:
-        return build_algorithm(AlgorithmSpec(args.algorithm, {"pop_size": args.pop_size}), problem)
+        algorithm = build_algorithm(AlgorithmSpec(args.algorithm, {"pop_size": args.pop_size}), problem)
     except StudyError as err:
         raise UsageError("--algorithm", f"{args.algorithm!r}: {err.reason}") from None
     except ValueError as err:
         raise UsageError("--pop-size", f"{args.pop_size} with {args.algorithm}: {err}") from None
+    if handles_constraints(algorithm) or not problem.has_constraints():
+        return algorithm, None
+    others = [name for name, entry in ALGORITHMS.items()
+              if entry.objectives != "single" and name != canonical_name(args.algorithm)]
+    say(f"{args.algorithm} has no constraint handling (pymoo's {type(algorithm).__name__}): the problem's "
+        f"{problem.n_ieq_constr} constraints are added to every objective as a penalty ({DEFAULT_PENALTY:g} per "
+        f"unit of violation), and the front is reported with its true objectives and violations; "
+        f"{', '.join(others)} handle the constraints themselves")
+    return algorithm, DEFAULT_PENALTY

@@ -26,6 +26,8 @@ from numba import njit, prange
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control.controllers import CTRL_HYSTERESIS, CTRL_PID
+# Numba's disk cache checks only this file: a change to the run summary (N_OUT, OUT_*) or the
+# running totals of sim/kernel.py must touch this file too, or a stale cache keeps the old layout.
 from pymoo_rail.sim.kernel import (
     N_OUT,
     TOTAL_TIME,

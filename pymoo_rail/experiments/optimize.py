@@ -22,12 +22,16 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 import pandas as pd
+from pymoo.core.evaluator import Evaluator
+from pymoo.core.population import Population
 from pymoo.optimize import minimize
 
-from pymoo_rail.constants import TIME_OBJECTIVES
 from pymoo_rail.experiments.fronts import choose_member, distinct_front
+from pymoo_rail.experiments.penalty import PenalisedConstraints, handles_constraints
 from pymoo_rail.optimal import optimal_profile
 from pymoo_rail.problems import reference as certified
+from pymoo_rail.problems.encodings import decision_columns
+from pymoo_rail.problems.objectives import time_objectives
 
 DEFAULT_TIME_TOLERANCE_S = 1.0
 """How close to the planned time a member counts as punctual when the problem has no tolerance (s)."""
@@ -112,7 +116,7 @@ def default_time_tolerance_s(objectives: Sequence[str], weights: Sequence[float]
     run take any time; ``|T - T_plan| <= 1 s`` keeps it to the timetable (the form of Liu (2019)).
     """
     if time_tolerance_s is None and len(objectives) == 1 and weights is None \
-            and objectives[0] not in TIME_OBJECTIVES:
+            and objectives[0] not in time_objectives():
         return DEFAULT_TIME_TOLERANCE_S
     return time_tolerance_s
 
@@ -136,7 +140,6 @@ def front_table(problem, opt) -> tuple[pd.DataFrame, list]:
     X, F, CV, running, energy = X[order], F[order], CV[order], running[order], energy[order]
     trajectories = [trajectories[i] for i in order]
 
-    unit = "kmh" if problem.encoding.name == "speed_codes" else "m"
     objective_cols = ([f"f_{name}" for name in problem.objectives] if problem.n_obj == len(problem.objectives)
                       else ["f_weighted_sum"])
     front = pd.DataFrame(F, columns=objective_cols)
@@ -146,13 +149,56 @@ def front_table(problem, opt) -> tuple[pd.DataFrame, list]:
     front["accel_variation_ms2"] = [t.accel_variation_ms2 for t in trajectories]
     front["feasible"] = CV <= 0
     front["cv"] = CV
-    for j in range(X.shape[1]):
-        front[f"x{j}_{unit}"] = X[:, j]
+    for j, column in enumerate(decision_columns(problem.encoding)):  # x0_kmh, x3_m, x4_ms2: the encoding's units
+        front[column] = X[:, j]
     return front, trajectories
+
+
+def _grid_hint(problem) -> str:
+    dx_m = float(problem.simulator.grid.dx_m)
+    return f"; a finer grid may meet it (dx_m, now {dx_m:.4g} m; --dx {dx_m / 2:.4g} on the command line)"
+
+
+def _optimal_run(problem, running_time_s: float, front=None) -> tuple[Any, str]:
+    """The optimal run at ``running_time_s``, else at the front's node nearest to it; and a note on any miss."""
+    dx_m = problem.simulator.grid.dx_m
+    try:
+        return optimal_profile(problem.case, running_time_s, dx_m=dx_m), ""
+    except (RuntimeError, ValueError) as err:  # a time the solver's grid jumps over
+        note = f"; no optimal run at {running_time_s:.2f} s ({err})"
+    if front is None:
+        return None, note
+    nodes = front.table["running_time_s"].to_numpy(float)
+    nearest = float(nodes[np.argmin(np.abs(nodes - running_time_s))])
+    try:
+        run = optimal_profile(problem.case, nearest, dx_m=dx_m)
+    except (RuntimeError, ValueError):
+        return None, note + "; none drawn"
+    return run, note + (f"; drawn instead: the optimal run at {run.running_time_s:.2f} s "
+                        f"({run.running_time_s - running_time_s:+.2f} s), the front's nearest node")
+
+
+def _without_front(problem, trajectory, err: Exception) -> Optimum:
+    """The certified front failed: the optimum at the chosen run's own time, uncertified, if the solver meets it."""
+    t = trajectory.running_time_s
+    reason = f"optimum: the certified front could not be computed ({type(err).__name__}: {err})"
+    run, note = _optimal_run(problem, t)
+    if run is None:
+        return Optimum(f"{reason}{note}; no gap reported{_grid_hint(problem)}")
+    energy = run.energy.net_kwh
+    gap = trajectory.energy.net_kwh - energy
+    return Optimum(f"{reason}; the nearest optimum takes {run.running_time_s:.2f} s "
+                   f"({run.running_time_s - t:+.2f} s from the chosen run) and {energy:.3f} kWh: the chosen run is "
+                   f"{gap:+.3f} kWh above it (not certified){_grid_hint(problem)}",
+                   None, float(energy), float(gap), None, run)
 
 
 def optimum_at(problem, trajectory, reference: bool = True) -> Optimum:
     """The certified optimum at ``trajectory``'s running time: the gap, the front to draw, the optimal run.
+
+    A failure of the exact solver (a running time its grid cannot meet) never loses the run: the
+    message then says why, gives the nearest optimum it found and the time difference, and how a
+    finer grid may help.
 
     Parameters
     ----------
@@ -168,6 +214,8 @@ def optimum_at(problem, trajectory, reference: bool = True) -> Optimum:
         front = problem.certified_front()
     except certified.NoExactFrontError as err:
         return Optimum(f"optimum: none certified for this form ({str(err).split('no exact front: ')[-1]})")
+    except (RuntimeError, ValueError) as err:  # the solver could not meet one of the front's running times
+        return _without_front(problem, trajectory, err)
     front_F = None
     if problem.n_obj == 2:
         front_F, _ = certified.mirrored(front, problem.objectives, 200, problem.time_window_s)
@@ -180,16 +228,29 @@ def optimum_at(problem, trajectory, reference: bool = True) -> Optimum:
     gap = trajectory.energy.net_kwh - energy
     message = (f"gap to the optimum at {t:.2f} s: {gap:+.3f} kWh ({100 * gap / abs(energy):+.2f} %); "
                f"optimum {energy:.3f} kWh (certified within {bound:.3f} kWh, {front.certificate})")
-    profile = None
-    try:
-        profile = optimal_profile(problem.case, t)
-    except ValueError as err:  # a time the solver's grid cannot hit closely: the figure goes without it
-        message += f"; no optimal profile drawn ({err})"
-    return Optimum(message, front_F, float(energy), float(gap), float(bound), profile)
+    profile, note = _optimal_run(problem, t, front)
+    return Optimum(message + note, front_F, float(energy), float(gap), float(bound), profile)
+
+
+def _search(problem, algorithm, termination, seed, callback, penalty):
+    """pymoo's ``minimize``; with a penalty, on the penalised problem, and its front evaluated again on ``problem``."""
+    if penalty is None:
+        if problem.has_constraints() and not handles_constraints(algorithm):
+            raise ValueError(f"{type(algorithm).__name__} has no constraint handling and the problem has "
+                             f"{problem.n_ieq_constr + problem.n_eq_constr} constraints: pass penalty=... "
+                             "(constraints as a penalty) or use an algorithm that handles constraints (NSGA2)")
+        res = minimize(problem, algorithm, termination, seed=seed, verbose=False, callback=callback)
+        return res.algorithm.opt, int(res.algorithm.evaluator.n_eval)
+    res = minimize(PenalisedConstraints(problem, penalty), algorithm, termination, seed=seed, verbose=False,
+                   callback=callback)
+    # the true objectives and violations, not the penalised ones
+    opt = Evaluator().eval(problem, Population.new(X=res.algorithm.opt.get("X")))
+    return opt, int(res.algorithm.evaluator.n_eval)
 
 
 def optimize_profile(problem, algorithm, termination, seed: int | None = None, *,
-                     callback: Callable | None = None, reference: bool = True) -> OptimizeResult:
+                     callback: Callable | None = None, reference: bool = True,
+                     penalty: float | None = None) -> OptimizeResult:
     """Optimise a speed-profile problem and return its front table, chosen member and gap to the optimum.
 
     Parameters
@@ -204,17 +265,22 @@ def optimize_profile(problem, algorithm, termination, seed: int | None = None, *
         pymoo callback, called with the algorithm after every generation (a progress bar).
     reference : bool
         Compare the chosen member with the certified optimum (see :func:`optimum_at`).
+    penalty : float, optional
+        Search with the constraints as a penalty (:class:`~pymoo_rail.experiments.penalty.PenalisedConstraints`),
+        for an algorithm without constraint handling (MOEA/D); the front is then evaluated again on
+        ``problem``, so its table holds the true objectives and violations. Without it such an
+        algorithm on a constrained problem is a ``ValueError`` before any work.
 
     Returns
     -------
     OptimizeResult
     """
-    res = minimize(problem, algorithm, termination, seed=seed, verbose=False, callback=callback)
-    front, trajectories = front_table(problem, res.algorithm.opt)
+    opt, n_eval = _search(problem, algorithm, termination, seed, callback, penalty)
+    front, trajectories = front_table(problem, opt)
     window_s = problem.time_tolerance_s if problem.time_tolerance_s is not None else DEFAULT_TIME_TOLERANCE_S
     chosen = choose_member(front[[c for c in front.columns if c.startswith("f_")]].to_numpy(float),
                            front["cv"].to_numpy(float), front["running_time_s"].to_numpy(float),
                            front["energy_kwh"].to_numpy(float), problem.case.planned_time_s, window_s)
     front.insert(0, "chosen", np.arange(len(front)) == chosen)
-    return OptimizeResult(problem, front, tuple(trajectories), chosen, int(res.algorithm.evaluator.n_eval),
+    return OptimizeResult(problem, front, tuple(trajectories), chosen, n_eval,
                           optimum_at(problem, trajectories[chosen], reference))

@@ -83,7 +83,8 @@ class CompileWatch(event.Listener):
 
 
 @contextmanager
-def compile_notice(say: Callable[[str], None] = _say_stderr, summary: bool = True) -> Iterator[CompileWatch]:
+def compile_notice(say: Callable[[str], None] = _say_stderr, summary: bool = True,
+                   message: str = NOTICE) -> Iterator[CompileWatch]:
     """Say when Numba starts compiling a package kernel inside the block (once), and how long it took.
 
     Parameters
@@ -92,13 +93,15 @@ def compile_notice(say: Callable[[str], None] = _say_stderr, summary: bool = Tru
         Where the lines go (default: standard error; with a tqdm bar pass ``tqdm.write``).
     summary : bool
         At the end of the block, say how long the compilation took (only if there was one).
+    message : str
+        The line said when the first compilation starts (it must say that it is the first run only).
 
     Yields
     ------
     CompileWatch
         The listener, with ``n_compiled`` and ``compile_s``.
     """
-    watch = CompileWatch(say)
+    watch = CompileWatch(say, message)
     with event.install_listener("numba:compile", watch):
         yield watch
     if summary and watch.n_compiled:

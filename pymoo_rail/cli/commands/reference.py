@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
-from pymoo_rail.cli.arguments import UsageError, add_command, out_dir, positive_float, positive_int, say
+from pymoo_rail.cli.arguments import (EXACT_SOLVER_NOTICE, UsageError, add_command, out_dir, positive_float,
+                                      positive_int, say)
 from pymoo_rail.cli.case_options import add_case_arguments, case_from_args
+from pymoo_rail.cli.problem_options import add_grid_argument
 
 ORDER = 40
 
 
 def add_parser(sub) -> None:
     """Add ``reference`` to the subcommands."""
-    p = add_command(sub, "reference", run, compiles=True, help="the exact minimum-energy front of a case",
+    p = add_command(sub, "reference", run, compiles=EXACT_SOLVER_NOTICE,
+                    help="the exact minimum-energy front of a case",
                     description="Compute the exact minimum-energy run for a range of running times (dynamic "
                                 "programming, pymoo_rail.optimal) and write optimal_front.csv / .png and the "
                                 "optimal run at the planned time (optimal_trajectory.csv, optimal_profile.png).",
@@ -20,6 +23,7 @@ def add_parser(sub) -> None:
     p.add_argument("--times", type=positive_float, nargs="+", default=None, metavar="S",
                    help="running times (s); default: --n-points from the minimum time to 1.3 x planned")
     p.add_argument("--n-points", type=positive_int, default=8, metavar="N", help="number of running times")
+    add_grid_argument(p)
     p.add_argument("--out", default="out", metavar="DIR", help="output directory")
 
 
@@ -31,7 +35,7 @@ def _times(case, args):
     from pymoo_rail.optimal import min_running_time
 
     try:
-        t_min = float(min_running_time(case))
+        t_min = float(min_running_time(case, args.dx))
     except InfeasibleCaseError as err:
         raise UsageError("CASE", str(err)) from None
     if args.times is not None:
@@ -62,13 +66,13 @@ def run(args) -> int:
     out = out_dir(args.out)
     say(f"{case.name}: exact minimum-energy runs for {len(times)} running times "
         f"({times.min():.1f}-{times.max():.1f} s)")
-    front = optimal_front(case, times)
+    front = optimal_front(case, times, dx_m=args.dx)
     front.to_csv(out / "optimal_front.csv", index=False)
     points = front[["running_time_s", "energy_kwh"]].to_numpy(float)
     figure = plot_fronts({"optimal": points}, ["running_time", "energy"], reference=points,
                          reference_label="optimal front", title=f"{case.name}: minimum energy against running time")
     written = [out / "optimal_front.csv", save_figure(figure, out / "optimal_front.png")]
-    trajectory = optimal_profile(case, case.planned_time_s)
+    trajectory = optimal_profile(case, case.planned_time_s, dx_m=args.dx)
     trajectory.to_frame().to_csv(out / "optimal_trajectory.csv", index=False)
     written.append(out / "optimal_trajectory.csv")
     written.append(save_figure(plot_speed_profile(trajectory, case, label="optimal"), out / "optimal_profile.png"))
