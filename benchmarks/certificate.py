@@ -25,7 +25,7 @@ from benchmarks.optimal import markdown  # noqa: E402
 from pymoo_rail.cases import load_case  # noqa: E402
 from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK  # noqa: E402
 from pymoo_rail.constants import J_PER_KWH  # noqa: E402
-from pymoo_rail.journeys import Journey  # noqa: E402
+from pymoo_rail.journeys import journey_from_ttobench  # noqa: E402
 from pymoo_rail.optimal import OptimalSolver  # noqa: E402
 
 REPORT = ROOT / "benchmarks" / "reports" / "certificate.md"
@@ -35,7 +35,7 @@ VARIANTS = ({"n_speeds": 100}, {"n_speeds": 400}, {"n_speeds": 800}, {"tie_j": 0
 def cases() -> list:
     """(label, case, running time s): wuguang-crh3 where the punctual switching-point members lay, and
     the Yizhuang line's section 1-2 where strategy-search runs lay closest below the reference."""
-    section = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES).sections[1]
+    section = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES).sections[1]
     return [("wuguang-crh3", load_case("wuguang-crh3"), 1050.53), ("Yizhuang section 1-2", section, 119.432943)]
 
 

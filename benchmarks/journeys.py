@@ -39,7 +39,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK  # noqa: E402
 from pymoo_rail.journeys import (  # noqa: E402
     BudgetRepair,
-    Journey,
+    journey_from_ttobench,
     RunningTimeAllocationProblem,
     allocate_running_time,
     convex_front,
@@ -97,7 +97,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
 
-    journey = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
+    journey = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
     strategy_front(journey.sections[0], n_speeds=3, n_coast=3)  # JIT warm-up outside the timings
     exact, exact_time, exact_cached = timed_fronts(journey, "optimal", args.out / "journeys_fronts_optimal.csv",
                                                    n_times=args.n_times)

@@ -84,7 +84,7 @@ def main(argv=None) -> None:
 
     from pymoo_rail.cases import load_case
     from pymoo_rail.control import PID, FuzzyPID, draw_disturbances, track_disturbed
-    from pymoo_rail.control.tuning import controller_from_gains, table3_reference
+    from pymoo_rail.problems.controller_tuning import controller_from_gains, table3_reference
     from pymoo_rail.experiments import load_results, run_study
     from pymoo_rail.experiments.stats import rank_sum
 

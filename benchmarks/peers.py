@@ -7,12 +7,16 @@ count), beside
 
 - ms-eetc (Kouzoupis et al., direct multiple shooting with CasADi/IPOPT; not on the package index):
   run here when ``--mseetc PATH`` gives a checkout and ``--mseetc-python`` an interpreter with its
-  dependencies (casadi, pandas < 2); otherwise its figures recorded on this machine (date below);
+  dependency casadi (``pip install casadi``; pandas >= 2 is bridged by the driver); otherwise its figures recorded on this machine (date below);
 - GPOPS-II (hp-adaptive pseudospectral), the published figure of the ms-eetc paper for the 48.5 km
   case: 440.14 kWh in 7.0 s;
 - the closed form (Pontryagin, ``pymoo_rail.optimal.flat``) on the level case.
 
-Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--quick] [--breakdown]``
+Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--quick] [--breakdown]``, or
+``python benchmarks/peers.py --generated N [--first-seed S] [--intervals 300 1000] [--repeats R] --mseetc PATH``:
+the reference and ms-eetc on N generated intercity lines (``pymoo_rail.cases.generate_case``) x 3
+running times, with differences in % of traction energy, CPU ratios and every certificate violation
+(report ``benchmarks/reports/peers_generated.md``).
 (``--quick``: only the two intercity cases; ``--breakdown``: also where pymoo-rail's CPU time goes, per
 Numba kernel of the exact solver, from a second run under cProfile). Writes ``benchmarks/reports/peers.md``.
 """
@@ -22,6 +26,7 @@ from __future__ import annotations
 import argparse
 import cProfile
 import json
+import math
 import os
 import pstats
 import subprocess
@@ -56,15 +61,26 @@ MSEETC_RECORDED = {
 }
 MSEETC_DATE = "2026-11-24"
 
-# ms-eetc set up as for its fig. 10 (the GPOPS-II comparison); runs inside the checkout
+# ms-eetc set up as for its fig. 10 (the GPOPS-II comparison); runs inside the checkout. ms-eetc was
+# written for pandas < 2: its fillna(method=...) calls are served by ffill()/bfill() here.
 _DRIVER = """
 import json, os, sys, time
 from pathlib import Path
+import pandas as pd
+for cls in (pd.DataFrame, pd.Series):
+    def fillna(self, value=None, *args, method=None, _f=cls.fillna, **kw):
+        if method in ('ffill', 'pad'):
+            return self.ffill()
+        if method in ('bfill', 'backfill'):
+            return self.bfill()
+        return _f(self, value, *args, **kw)
+    cls.fillna = fillna
 sys.path.insert(0, os.getcwd())
 from mseetc.train import Train
 from mseetc.track import Track
 from mseetc.ocp import casadiSolver
 track_id, trip, n_int, tracks = sys.argv[1], float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+v0, v_end, repeats = float(sys.argv[5]), float(sys.argv[6]), int(sys.argv[7])
 train = Train(config={'id': 'NL_Intercity_VIRM6'})
 train.forceMinPn = 0
 train.forceMin = -train.forceMax
@@ -78,17 +94,32 @@ opts['minimumVelocity'] = 1
 opts['numIntervals'] = n_int
 solver = casadiSolver(train, track, opts)
 best = None
-for _ in range(3):
+for _ in range(repeats):
     t0 = time.process_time()
-    df, stats = solver.solve(trip, terminalVelocity=1, initialVelocity=1)
+    df, stats = solver.solve(trip, terminalVelocity=v_end, initialVelocity=v0)
     cpu = time.process_time() - t0
     best = cpu if best is None else min(best, cpu)
-print(json.dumps({'energy_kwh': float(df['Energy [kWh]'].sum()), 'cpu_s': best}))
+print(json.dumps({'energy_kwh': float(df['Energy [kWh]'].sum()), 'cpu_s': best,
+                  'final_speed_ms': float(df['Velocity [m/s]'].iloc[-1])}))
 """
 
 
-def run_mseetc(checkout: Path, python: str, track_id: str, trip_s: float, n_intervals: int) -> tuple[float, float]:
-    """(energy kWh, CPU s) of ms-eetc on one case, run in its checkout."""
+def run_mseetc(checkout: Path, python: str, track_id: str, trip_s: float, n_intervals: int,
+               extra_tracks: dict | None = None, v0_ms: float = 1.0, v_end_ms: float = 1.0,
+               repeats: int = 3) -> tuple[float, float]:
+    """(energy kWh, CPU s) of ms-eetc on one case, run in its checkout (the best CPU of ``repeats`` solves).
+
+    ``extra_tracks``: TTOBench track files (id -> JSON dict) to add beside the checkout's own.
+    """
+    energy, cpu, _ = run_mseetc_full(checkout, python, track_id, trip_s, n_intervals, extra_tracks, v0_ms,
+                                     v_end_ms, repeats)
+    return energy, cpu
+
+
+def run_mseetc_full(checkout: Path, python: str, track_id: str, trip_s: float, n_intervals: int,
+                    extra_tracks: dict | None = None, v0_ms: float = 1.0, v_end_ms: float = 1.0,
+                    repeats: int = 3) -> tuple[float, float, float]:
+    """:func:`run_mseetc` and ms-eetc's final speed (m/s)."""
     with tempfile.TemporaryDirectory() as tmp:
         tracks = Path(tmp)
         for p in (checkout / "tracks").glob("*.json"):
@@ -98,11 +129,14 @@ def run_mseetc(checkout: Path, python: str, track_id: str, trip_s: float, n_inte
         level["stops"]["values"] = [0.0, 10000.0]
         level["speed limits"]["values"] = [[0.0, 140]]
         (tracks / "level_10km.json").write_text(json.dumps(level))
+        for name, data in (extra_tracks or {}).items():
+            (tracks / f"{name}.json").write_text(json.dumps(data))
         driver = tracks / "driver.py"
         driver.write_text(_DRIVER)
-        out = subprocess.run([python, str(driver), track_id, str(trip_s), str(n_intervals), str(tracks)],
-                             cwd=checkout, capture_output=True, text=True, check=True)
-    return parse_mseetc_output(out.stdout)
+        out = subprocess.run([python, str(driver), track_id, str(trip_s), str(n_intervals), str(tracks), str(v0_ms),
+                              str(v_end_ms), str(repeats)], cwd=checkout, capture_output=True, text=True, check=True)
+    energy, cpu = parse_mseetc_output(out.stdout)
+    return energy, cpu, float(json.loads(out.stdout.strip().splitlines()[-1]).get("final_speed_ms", math.nan))
 
 
 def parse_mseetc_output(stdout: str) -> tuple[float, float]:
@@ -181,13 +215,141 @@ def speed_ratios(ours: pd.DataFrame, theirs: pd.DataFrame) -> pd.DataFrame:
     return merged[["case", "solver", "source", "cpu_ratio", "energy_diff_pct"]]
 
 
+GENERATED_FACTORS = (1.05, 1.2, 1.5)  # running times of the generated lines, x the minimum running time
+MSEETC_MIN_SPEED_MS = 1.0  # ms-eetc's smallest speed (its "minimumVelocity", as in the fig. 10 set-up)
+MSEETC_MAX_DECEL_MS2 = 0.66  # VIRM6's deceleration cap in ms-eetc's train file
+
+
+def comparable_case(seed: int):
+    """``generate_case(seed, "intercity")`` as both solvers model it.
+
+    The features ms-eetc cannot model are left out for both (curves, tunnels, neutral sections),
+    boundary speeds are at least ms-eetc's 1 m/s, and the train has VIRM6's 0.66 m/s^2 deceleration
+    cap of ms-eetc's train file; the rest (391 t, Davis, 213.9 kN / 3129 kW both ways, 0.73 both
+    ways, all braking regenerative, point mass) is the same in both.
+    """
+    from dataclasses import replace
+
+    from pymoo_rail.cases import generate_case
+
+    case = generate_case(seed, "intercity")
+    line = replace(case.line, curves=(), tunnels=(), neutral_sections=())
+    return replace(case, line=line, train=replace(case.train, max_decel_ms2=MSEETC_MAX_DECEL_MS2),
+                   initial_speed_ms=max(case.initial_speed_ms, MSEETC_MIN_SPEED_MS),
+                   final_speed_ms=max(case.final_speed_ms, MSEETC_MIN_SPEED_MS))
+
+
+def mseetc_track(case, track_id: str) -> dict:
+    """The case's line as a TTOBench track file (stops, speed limits, gradients) for ms-eetc."""
+    return {"metadata": {"id": track_id, "library version": "TTOBench v1.1"}, "altitude": {"unit": "m", "value": 0},
+            "stops": {"unit": "m", "values": [0.0, case.line.length_m]},
+            "speed limits": {"units": {"position": "m", "velocity": "km/h"},
+                             "values": [[a, v] for a, _, v in case.line.speed_limits]},
+            "gradients": {"units": {"position": "m", "slope": "permil"},
+                          "values": [[a, g] for a, _, g in case.line.gradients]}}
+
+
+def generated_rows(seeds, checkout: Path | None, python: str, intervals: tuple[int, ...], repeats: int) -> pd.DataFrame:
+    """pymoo-rail and ms-eetc on generated lines at 1.05, 1.2 and 1.5 x the minimum running time."""
+    from pymoo_rail.optimal import OptimalSolver, min_running_time
+
+    rows = []
+    for seed in seeds:
+        case = comparable_case(seed)
+        t_min = min_running_time(case)
+        features = case.description.split(": ", 1)[1]
+        for factor in GENERATED_FACTORS:
+            t = factor * t_min
+            start = time.process_time()
+            tr = OptimalSolver(case).profile(t)
+            cpu = time.process_time() - start
+            lam = tr.summary["lambda_w"]
+            row = {"seed": seed, "length_km": case.line.length_m / 1000.0, "factor": factor, "time_s": t,
+                   "end_ms": case.final_speed_ms, "energy_kwh": tr.energy.net_kwh + lam * (tr.running_time_s - t) / J_PER_KWH,
+                   "bound_kwh": tr.summary["energy_bound_kwh"], "traction_kwh": tr.energy.traction_kwh,
+                   "end_error_ms": abs(tr.speed_ms[-1] - case.final_speed_ms), "cpu_s": cpu, "features": features}
+            for n in intervals if checkout is not None else ():
+                try:
+                    energy, cpu_m, v_end = run_mseetc_full(checkout, python, f"generated_{seed}", t, n,
+                                                           {f"generated_{seed}": mseetc_track(case, f"generated_{seed}")},
+                                                           case.initial_speed_ms, case.final_speed_ms, repeats)
+                except subprocess.CalledProcessError:
+                    energy, cpu_m, v_end = math.nan, math.nan, math.nan
+                row[f"ms{n}_kwh"], row[f"ms{n}_cpu_s"], row[f"ms{n}_end_ms"] = energy, cpu_m, v_end
+            rows.append(row)
+            print({k: (round(v, 4) if isinstance(v, float) else v) for k, v in row.items() if k != "features"},
+                  flush=True)
+    return pd.DataFrame(rows)
+
+
+def generated_summary(table: pd.DataFrame, intervals: tuple[int, ...]) -> list[str]:
+    """Differences in % of traction energy, CPU ratios and every certificate violation, as report lines."""
+    out = []
+    if not intervals or f"ms{max(intervals)}_kwh" not in table:
+        return ["(ms-eetc not run)"]
+    best = f"ms{max(intervals)}_kwh"
+    ok = table[best].notna()
+    diff = 100.0 * (table["energy_kwh"] - table[best]) / table["traction_kwh"]
+    out.append(f"- {int(ok.sum())} answers with ms-eetc N={max(intervals)}; pymoo-rail minus ms-eetc in % of"
+               f" pymoo-rail's traction energy: median {diff[ok].median():+.4f} %, range {diff[ok].min():+.4f} .."
+               f" {diff[ok].max():+.4f} %; median |difference| {diff[ok].abs().median():.4f} %")
+    if "ms300_cpu_s" in table:
+        ratio = table["ms300_cpu_s"] / table["cpu_s"]
+        out.append(f"- CPU ratio ms-eetc N=300 / pymoo-rail: median {ratio.median():.1f}x (range {ratio.min():.1f} .."
+                   f" {ratio.max():.1f}x)")
+    out.append(f"- end speed: largest |pymoo-rail's arrival speed - asked| = {table['end_error_ms'].max():.2e} m/s")
+    violations = table[ok & (table[best] < table["energy_kwh"] - table["bound_kwh"])]
+    out.append(f"- certificate violations (ms-eetc N={max(intervals)} below pymoo-rail's energy minus its"
+               f" certificate): {len(violations)}")
+    for _, v in violations.iterrows():
+        out.append(f"  - seed {int(v.seed)} at {v.factor} x: pymoo-rail {v.energy_kwh:.3f} +- {v.bound_kwh:.3f},"
+                   f" ms-eetc {v[best]:.3f} kWh ({v.features})")
+    return out
+
+
+def main_generated(args) -> None:
+    """``--generated N``: the reference and ms-eetc side by side on generated lines."""
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.optimal import OptimalSolver
+
+    OptimalSolver(load_case("yizhuang"), n_speeds=20).profile(150.0)  # warm-up: load the Numba cache
+    load_at_start = os.getloadavg()[0]
+    seeds = range(args.first_seed, args.first_seed + args.generated)
+    intervals = tuple(args.intervals)
+    table = generated_rows(seeds, args.mseetc, args.mseetc_python, intervals, args.repeats)
+    from optimal import markdown  # benchmarks/optimal.py (this script's directory is on sys.path)
+
+    text = ["# pymoo-rail's exact solver beside ms-eetc on generated lines", "",
+            f"Written by `python benchmarks/peers.py --generated {args.generated} --first-seed {args.first_seed}"
+            f" --intervals {' '.join(map(str, intervals))} --repeats {args.repeats} --mseetc PATH`: lines"
+            " `pymoo_rail.cases.generate_case(seed, \"intercity\")` without curves, tunnels and neutral sections,"
+            " boundary speeds at least 1 m/s (`comparable_case`), at 1.05, 1.2 and 1.5 x the minimum running time."
+            " Energies net (kWh), pymoo-rail's moved to the requested time along lambda; `bound_kwh` its"
+            " certificate; CPU `time.process_time` (pymoo-rail: tables, search, replay and certificate from a"
+            f" fresh solver; ms-eetc: IPOPT, best of {args.repeats}). Load average (1 min) at the start and the end:"
+            f" {load_at_start:.2f} / {os.getloadavg()[0]:.2f}.", "",
+            *generated_summary(table, intervals), "", markdown(table.drop(columns=["features"])), "",
+            "Features of the lines:", "",
+            *[f"- seed {s}: {f}" for s, f in table.groupby("seed")["features"].first().items()], ""]
+    report = HERE / "reports" / "peers_generated.md"
+    report.write_text("\n".join(text))
+    print("\n".join(text))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--mseetc", type=Path, help="an ms-eetc checkout to run here")
     parser.add_argument("--mseetc-python", default=sys.executable, help="interpreter with ms-eetc's dependencies")
     parser.add_argument("--quick", action="store_true", help="only the two intercity cases")
     parser.add_argument("--breakdown", action="store_true", help="also pymoo-rail's CPU time per solver kernel")
+    parser.add_argument("--generated", type=int, default=0, help="instead: N generated intercity lines x 3 times")
+    parser.add_argument("--first-seed", type=int, default=0, help="seed of the first generated line")
+    parser.add_argument("--intervals", type=int, nargs="+", default=[300, 1000], help="ms-eetc's N on generated lines")
+    parser.add_argument("--repeats", type=int, default=1, help="ms-eetc solves per answer (best CPU time)")
     args = parser.parse_args()
+    if args.generated:
+        main_generated(args)
+        return
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import OptimalSolver
 

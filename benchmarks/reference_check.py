@@ -70,9 +70,9 @@ def case_objects() -> dict:
     """The cases the members ran on, by the names :func:`members` gives them."""
     from pymoo_rail.cases import load_case
     from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
-    from pymoo_rail.journeys import Journey
+    from pymoo_rail.journeys import journey_from_ttobench
 
-    journey = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
+    journey = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
     cases = {"yizhuang": load_case("yizhuang"), "wuguang-crh3": load_case("wuguang-crh3")}
     cases.update({f"section {k}": c for k, c in enumerate(journey.sections)})
     return cases

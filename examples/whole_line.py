@@ -31,7 +31,7 @@ import pandas as pd  # noqa: E402
 from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK  # noqa: E402
 from pymoo_rail.journeys import (  # noqa: E402
     DEFAULT_FRONT_SOURCE,
-    Journey,
+    journey_from_ttobench,
     allocate_running_time,
     section_fronts,
     supplement_split,
@@ -48,7 +48,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
 
-    journey = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES,
+    journey = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES,
                                     dwell_s=args.dwell)
     print(f"{journey.name}: {journey.length_m / 1000:.3f} km, {journey.n_sections} sections, "
           f"train {journey.train.name}; computing {args.fronts} section fronts ...")

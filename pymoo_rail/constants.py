@@ -1,7 +1,7 @@
-"""Unit factors and objective names that every room shares, defined once.
+"""Unit factors that every room shares, defined once.
 
-This module imports nothing, so the command line reads the objective names without loading Numba,
-and a Numba kernel may use the factors as compile-time constants.
+This module imports nothing, so a Numba kernel may use the factors as compile-time constants.
+The objectives are a table of their own: :mod:`pymoo_rail.problems.objectives`.
 """
 
 from __future__ import annotations
@@ -11,14 +11,3 @@ KMH_PER_MS = 3.6
 
 J_PER_KWH = 3.6e6
 """Energy: joules in one kWh (``energy_kwh = energy_j / J_PER_KWH``)."""
-
-OBJECTIVES = ("energy", "running_time", "time_error", "accel_variation", "jerk", "stop_error")
-"""Objective names of :class:`pymoo_rail.problems.SpeedProfileProblem` (``"jerk"`` is an alias of
-``"accel_variation"``)."""
-
-TIME_OBJECTIVES = ("running_time", "time_error")
-"""The objectives that measure the running time (absolute, or off the plan)."""
-
-OBJECTIVE_COLUMNS = {"energy": "energy_kwh", "running_time": "running_time_s", "time_error": "time_error_s",
-                     "accel_variation": "accel_variation_ms2", "stop_error": "stop_error_m"}
-"""Column name, with its unit, under which a table of runs stores each objective."""

@@ -20,11 +20,15 @@ LAYERS = {
     "model": 1,
     "cases": 2,
     "sim": 3,
-    "problems": 4, "optimal": 4, "control": 4, "journeys": 4,
-    "suite": 5,
-    "experiments": 6, "plotting": 6,
-    "cli": 7, "warmup": 7,
+    "optimal": 4,
+    "control": 5,
+    "problems": 6,
+    "journeys": 7,
+    "suite": 8,
+    "experiments": 9, "plotting": 9,
+    "cli": 10, "warmup": 10,
 }
+KNOW_NO_PYMOO = ("model", "cases", "sim", "optimal", "control")  # usable without the optimisers
 PYMOO_ONLY = ("algorithms", "indicators")  # know no other room
 
 
@@ -71,6 +75,33 @@ def test_arrows_point_down():
         if src in PYMOO_ONLY or LAYERS.get(dst, 99) > LAYERS[src]:
             wrong.append(f"{where} {src} -> {dst}")
     assert not wrong, "imports against the layers:\n" + "\n".join(wrong)
+
+
+def _third_party_imports(path: Path):
+    """(line, top-level module) of every import of another distribution in a file, at any depth."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            yield node.lineno, node.module.split(".")[0]
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                yield node.lineno, alias.name.split(".")[0]
+
+
+def test_the_lower_rooms_know_no_pymoo():
+    # the simulator, the exact solver and the controllers work without the optimisation layer
+    wrong = [f"{path.relative_to(PACKAGE.parent)}:{line}" for path in _sources() if _room(path) in KNOW_NO_PYMOO
+             for line, top in _third_party_imports(path) if top == "pymoo"]
+    assert not wrong, "pymoo imported below the problems:\n" + "\n".join(wrong)
+
+
+def test_imports_inside_functions_count(tmp_path):
+    # a lazy import is an arrow too: the checker sees it at any depth
+    lazy = tmp_path / "lazy.py"
+    lazy.write_text("class A:\n    def f(self):\n        if True:\n            import pymoo_rail.cli\n"
+                    "            import pymoo.core.problem\n")
+    assert [m for _, m, _ in _imports(lazy)] == ["pymoo_rail.cli"]
+    assert ("pymoo" in [m for _, m in _third_party_imports(lazy)])
 
 
 def _private(name: str) -> bool:

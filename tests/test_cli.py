@@ -210,3 +210,20 @@ def test_journey_command_reports_an_unreachable_window(capsys, tmp_path):
                        root / "trains" / "CH_Stadler_KISS_SBB.json", "--out", tmp_path)
     assert code == 1 and "timing point at 29556.1 m" in err and "345.4 s" in err
     assert "before 1545.4 s (latest allowed 1450 s)" in err and "Traceback" not in err
+
+
+def test_optimize_takes_every_registered_encoding_and_objective(capsys, tmp_path):
+    # choices come from the encoding registry and the objective table: paced codes, peak power;
+    # the front's decision columns carry each variable's unit (shape shares, then the running time)
+    code, out, err = run(capsys, "optimize", "metro-a", "--encoding", "paced_speed_codes", "--objectives", "energy",
+                         "time_error", "peak_power", "--pop-size", 8, "--n-gen", 2, "--no-reference", "--quiet",
+                         "--out", tmp_path)
+    assert code == 0, err
+    front = pd.read_csv(tmp_path / "front.csv")
+    assert {"f_energy", "f_time_error", "f_peak_power"} <= set(front)
+    decisions = [c for c in front.columns if c.startswith("x")]
+    assert decisions[0] == "x0_share" and decisions[-1] == f"x{len(decisions) - 1}_s"
+    assert (front["f_peak_power"] > 0).all()
+    code, _, err = run(capsys, "optimize", "metro-a", "--encoding", "switching_points", "--partition", "equal",
+                       "--out", tmp_path / "points")
+    assert code == 2 and "partition = 'equal' does not apply to encoding = 'switching_points'" in err

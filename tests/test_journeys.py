@@ -11,6 +11,8 @@ from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES,
 from pymoo_rail.journeys import (
     BudgetRepair,
     Journey,
+    journey_from_ttobench,
+    journey_to_ttobench,
     RunningTimeAllocationProblem,
     allocate_on_fronts,
     allocate_running_time,
@@ -29,7 +31,7 @@ from pymoo_rail.sim import kernel as k
 
 @pytest.fixture(scope="module")
 def journey():
-    return Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
+    return journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
 
 
 @pytest.fixture(scope="module")
@@ -80,7 +82,7 @@ def test_whole_yizhuang_line_as_13_sections(journey):
 
 
 def test_journey_with_chosen_stops_and_times():
-    j = Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stops=["Tongjinan Rd", "Jinghai Rd", -1],
+    j = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stops=["Tongjinan Rd", "Jinghai Rd", -1],
                               stop_names=YIZHUANG_STOP_NAMES, planned_times_s=[150.0, 300.0], dwell_s=[40.0])
     assert j.n_sections == 2 and j.length_m == 22728.0 - 15757.0
     assert j.stop_names == ("Tongjinan Rd", "Jinghai Rd", "Yizhuang Railway Station")
@@ -89,8 +91,8 @@ def test_journey_with_chosen_stops_and_times():
 
 
 def test_journey_round_trips_through_ttobench(journey, tmp_path):
-    track_path, train_path = journey.to_ttobench(tmp_path)
-    back = Journey.from_ttobench(track_path, train_path, planned_times_s=list(journey.planned_running_times_s),
+    track_path, train_path = journey_to_ttobench(journey, tmp_path)
+    back = journey_from_ttobench(track_path, train_path, planned_times_s=list(journey.planned_running_times_s),
                                  stop_names=YIZHUANG_STOP_NAMES)
     assert back.stops_m == journey.stops_m and back.altitude_m == journey.altitude_m
     for a, b in zip(back.sections, journey.sections):

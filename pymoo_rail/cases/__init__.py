@@ -1,4 +1,8 @@
-"""Built-in cases and case loading.
+"""Built-in cases and case loading: one reader module per file format behind :func:`load_case`.
+
+The formats are registered in :mod:`pymoo_rail.cases.formats` (TOML: :mod:`~pymoo_rail.cases.toml_case`,
+TTOBench: :mod:`~pymoo_rail.cases.ttobench`, written back by :mod:`~pymoo_rail.cases.ttobench_writer`);
+:func:`load_case` picks one by the file's suffix or content.
 
 >>> from pymoo_rail.cases import load_case, list_cases
 >>> case = load_case("yizhuang")
@@ -9,11 +13,16 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
+from pymoo_rail.cases.formats import FORMATS, format_of
 from pymoo_rail.cases.generate import KINDS, generate_case
-from pymoo_rail.model import Case, CaseError, read_case
+from pymoo_rail.cases.toml_case import read_case, write_case
+from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
+from pymoo_rail.cases.ttobench_writer import to_ttobench
+from pymoo_rail.model import Case, CaseError
 
 _HERE = Path(__file__).resolve().parent
 
@@ -62,45 +71,47 @@ def case_path(name: str) -> Path:
 
 
 def _ttobench_section(name: str) -> Case:
-    from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
-
     first, last, planned_time_s = TTOBENCH_SECTIONS[name]
     return from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, first, last, planned_time_s,
                          stop_names=YIZHUANG_STOP_NAMES, name=name)
 
 
-def load_case(name_or_path: str | Path, load: str | None = None) -> Case:
+def load_case(name_or_path: str | Path, load: str | None = None, *,
+              allow_implausible: bool | Sequence[str] | None = None, **options) -> Case:
     """Load a built-in case by name, or any case file by path.
 
     Parameters
     ----------
     name_or_path : str or Path
         A built-in name from :func:`list_cases` (a case file, or a section of the TTOBench Yizhuang
-        line such as ``"ttobench-wanyuan-rongjing"``) or the path of a TOML case file.
+        line such as ``"ttobench-wanyuan-rongjing"``) or the path of a case file in any format of
+        :data:`~pymoo_rail.cases.formats.FORMATS`, found by suffix or content: a TOML case file, or
+        a TTOBench track with ``train=``, ``planned_time_s=`` and optionally ``from_stop=``,
+        ``to_stop=`` (default: first to last stop) and the other keywords of :func:`from_ttobench`.
     load : str, optional
         A passenger load state of the case (``LOADS_T``), e.g. ``load_case("yizhuang", load="AW3")``:
         the train mass of that load, the rest of the case unchanged.
+    allow_implausible : bool or sequence of str, optional
+        Waive the plausibility bounds (``True``) or some kinds of them (``["gradient"]``) for a
+        research case; replaces the file's own ``allow_implausible`` key when given
+        (``docs/case-format.md``).
+    **options
+        Keywords of the format's reader (a TTOBench track's ``train=``, ``planned_time_s=``, ...).
     """
     candidate = Path(name_or_path)
-    if candidate.suffix == ".toml" or candidate.is_file():
+    if candidate.suffix.lower() in {s for f in FORMATS for s in f.suffixes} or candidate.is_file():
         if not candidate.is_file():
             raise CaseError("path", str(candidate), "no such case file")
-        case = read_case(candidate)
+        case = format_of(candidate).read_case(candidate, allow_implausible=allow_implausible, **options)
+    elif options:
+        raise CaseError("options", sorted(options), f"'{name_or_path}' is a built-in case: it takes no reader "
+                                                    "options (they are for files of other formats)")
     elif str(name_or_path) in TTOBENCH_SECTIONS:
         case = _ttobench_section(str(name_or_path))
     else:
-        case = read_case(case_path(str(name_or_path)))
+        case = read_case(case_path(str(name_or_path)), allow_implausible=allow_implausible)
     return case if load is None else with_load(case, load)
 
 
-def __getattr__(name: str):
-    # TTOBench support imports json readers only when asked for
-    if name in ("from_ttobench", "to_ttobench"):
-        from pymoo_rail.cases import ttobench
-
-        return getattr(ttobench, name)
-    raise AttributeError(f"module 'pymoo_rail.cases' has no attribute {name!r}")
-
-
 __all__ = ["load_case", "generate_case", "KINDS", "list_cases", "case_path", "with_load", "LOADS_T",
-           "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench"]
+           "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench", "read_case", "write_case", "FORMATS", "format_of"]

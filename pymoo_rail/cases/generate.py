@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from pymoo_rail.constants import KMH_PER_MS
-from pymoo_rail.model import Case, CaseError, read_case
-from pymoo_rail.model.toml_io import case_to_dict
+from pymoo_rail.cases.toml_case import read_case
+from pymoo_rail.model import Case, CaseError, case_to_dict
 
 _HERE = Path(__file__).resolve().parent
 

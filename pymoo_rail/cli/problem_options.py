@@ -6,7 +6,8 @@ import argparse
 from typing import Sequence
 
 from pymoo_rail.cli.arguments import UsageError, positive_float, positive_int, random_seed, say
-from pymoo_rail.constants import OBJECTIVES
+from pymoo_rail.problems.encodings import encoding_names
+from pymoo_rail.problems.objectives import check_objectives
 
 
 def add_problem_arguments(p: argparse.ArgumentParser) -> None:
@@ -17,9 +18,8 @@ def add_problem_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--objectives", "-o", nargs="+", default=["energy", "time_error"], metavar="NAME",
                    help="objectives to minimise")
     p.add_argument("--seed", "-s", type=random_seed, default=1, help="random seed (same seed, same result)")
-    p.add_argument("--encoding", default="speed_codes", choices=["speed_codes", "switching_points", "braking_onset"],
-                   help="decision variables: a speed code per section, regime switching positions, or "
-                        "phases with the braking onset and deceleration (a live stop error)")
+    p.add_argument("--encoding", default="speed_codes", choices=encoding_names(),
+                   help="decision variables (see 'encodings' below)")
     p.add_argument("--partition", default="gradient_limit", choices=["gradient_limit", "equal"],
                    help="sections of the speed-code encoding")
     p.add_argument("--n-sections", type=positive_int, default=None, metavar="N",
@@ -47,12 +47,10 @@ def add_grid_argument(p: argparse.ArgumentParser) -> None:
 
 
 def _objectives(values: Sequence[str]) -> tuple[str, ...]:
-    for name in values:
-        if name not in OBJECTIVES:
-            raise UsageError("--objectives", f"unknown objective {name!r} (choose from {', '.join(OBJECTIVES)})")
-    if len(set(values)) != len(values):
-        raise UsageError("--objectives", f"{' '.join(values)}: an objective is repeated")
-    return tuple(values)
+    try:
+        return check_objectives(values)  # the objective table: known names, none repeated (aliases count)
+    except ValueError as err:
+        raise UsageError("--objectives", str(err)) from None
 
 
 def _time_window(args, objectives):

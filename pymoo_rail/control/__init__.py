@@ -30,8 +30,22 @@ from pymoo_rail.control.disturbances import (  # noqa: E402 (needs Tracker)
     draw_disturbances,
     track_disturbed,
 )
+from pymoo_rail.control.closed_loop import (
+    CurveTracking,
+    LoopController,
+    LoopDisturbance,
+    LoopState,
+    OptimalControls,
+    Recovery,
+    Replanning,
+    closed_loop,
+)
+
+from pymoo_rail.control.advice import Advice, AdvisedDriving, advice_frame, advice_from_run
 
 __all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMMETRIC_RULES",
            "symmetric_rules", "make_controller", "TERMS", "Tracker", "track",
            "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
-           "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES", "OptimalPolicy", "SpeedRestriction"]
+           "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES", "OptimalPolicy", "SpeedRestriction",
+           "closed_loop", "LoopController", "LoopDisturbance", "LoopState", "CurveTracking", "Replanning",
+           "Recovery", "OptimalControls", "Advice", "AdvisedDriving", "advice_from_run", "advice_frame"]

@@ -26,6 +26,8 @@ from numba import njit, prange
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control.controllers import CTRL_HYSTERESIS, CTRL_PID
+# Numba's disk cache checks only this file: a change to the run summary (N_OUT, OUT_*) or the
+# running totals of sim/kernel.py must touch this file too, or a stale cache keeps the old layout.
 from pymoo_rail.sim.kernel import (
     N_OUT,
     TOTAL_TIME,
@@ -46,6 +48,10 @@ from pymoo_rail.sim.physics import davis_force, max_braking, max_traction
 _N_STATE = 4
 # controller state slots
 _S_MODE, _S_INTEGRAL, _S_PREV_E, _S_HAS_PREV = 0, 1, 2, 3
+# What a run carries over to the next call that continues it (a closed loop changes the reference
+# at decision instants): the controller state, then these slots
+C_COMMAND, C_TO_NEXT, C_SINCE_LAST, C_INSTANT, C_RESUME, C_PHASE = 4, 5, 6, 7, 8, 9
+N_CARRY = 10
 
 
 # ---------------------------------------------------------------- controllers
@@ -149,6 +155,21 @@ def controller_command(code, params, state, e_kmh, dt_s):
 
 
 @njit(cache=True)
+def align_controller(code, params, state, u):
+    """Set a running controller's memory so that at zero error it commands ``u`` (bumpless transfer).
+
+    For a new reference in a closed loop: the hysteresis takes the mode of ``u`` (traction,
+    coast, brake); a PID's integral takes the value whose output is ``u``, its error history is
+    cleared.
+    """
+    if code == CTRL_HYSTERESIS:
+        state[_S_MODE] = 1.0 if u > 0.0 else (-1.0 if u < 0.0 else 0.0)
+    else:
+        state[_S_HAS_PREV] = 0.0
+        state[_S_INTEGRAL] = u / params[1] if params[1] > 0.0 else 0.0
+
+
+@njit(cache=True)
 def _start_controller(m, code, params, state, v, cell):
     """Controller state on entering the middle part (coming from maximum traction)."""
     state[:] = 0.0
@@ -212,8 +233,16 @@ def reference_phases(x, regime, count):
 
 @njit(cache=True)
 def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record,
-              tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, tr_u, noise_ms, lag_s):
+              tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, tr_u, noise_ms, lag_s, carry, t_end_s, x_end_m):
     """One tracked run; writes the ``OUT_*`` summary into ``out`` and, if ``record``, the trace.
+
+    The run starts at the model's first node at its ``initial_speed_ms`` (0 for a run from the
+    platform; a closed loop continues a run on the model of the line ahead,
+    :func:`pymoo_rail.control.policy.model_from`) and ends at the platform, or at the end of the
+    first cell ending at or after ``t_end_s`` (run time) or ``x_end_m``. ``carry`` (``N_CARRY``)
+    receives the controller's state, the command in force, the control clock, the noise index and
+    the phase there; with ``carry[C_RESUME] > 0`` the run continues from them (no bumpless
+    restart), with a new reference if need be: a run cut in pieces is the run in one piece.
 
     ``v_ref`` is the reference speed at each grid node. ``tr_u`` receives the command applied
     per cell (1 / -1 in the start / stop phases where the reference's own regime applies).
@@ -225,23 +254,33 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
     """
     n = m.position_m.shape[0]
     totals = new_totals()
-    state = np.zeros(_N_STATE)
+    state = carry[:_N_STATE]
+    resume = carry[C_RESUME] > 0.0
     phase = 0  # 0 start, 1 middle, 2 stop
     u_cmd = 1.0
     t_next = 0.0
     t_last = 0.0
-    v = 0.0
+    k_instant = 0
+    u_act = 1.0
+    if resume:
+        phase = int(carry[C_PHASE])
+        u_cmd = carry[C_COMMAND]
+        u_act = u_cmd
+        t_next = carry[C_TO_NEXT]
+        t_last = -carry[C_SINCE_LAST]
+        k_instant = int(carry[C_INSTANT])
+    else:
+        state[:] = 0.0
+    v = m.initial_speed_ms
     t = 0.0
     reached = n > 0  # a run-time True, not the literal: one compiled close_cell for every caller
     stop_pos = m.position_m[n - 1]
     count = 1
     n_noise = noise_ms.shape[0]
-    k_instant = 0
-    u_act = 1.0
     t_cell = 0.0
     if record:
-        tr_x[0] = 0.0
-        tr_v[0] = 0.0
+        tr_x[0] = m.position_m[0]
+        tr_v[0] = v
         tr_t[0] = 0.0
     for i in range(n - 1):
         x0 = m.position_m[i]
@@ -294,8 +333,13 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
                                               regime, stopped, reached, stop_pos)
         if record:
             tr_u[i] = u_act
-        if stopped:
+        if stopped or t >= t_end_s or x1 >= x_end_m:
             break
+    carry[C_COMMAND] = u_act
+    carry[C_TO_NEXT] = t_next - t
+    carry[C_SINCE_LAST] = t - t_last
+    carry[C_INSTANT] = k_instant
+    carry[C_PHASE] = phase
     write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_f, tr_r)
     if record:
         tr_u[count - 1] = 0.0
@@ -303,15 +347,15 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
 
 
 @njit(cache=True)
-def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms, lag_s):
-    """One tracked run with its trace: (summary, x, v, t, a, force, regime, command), trimmed."""
+def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms, lag_s, carry, t_end_s, x_end_m):
+    """One tracked run with its trace: (summary, x, v, t, a, force, regime, command), trimmed (see :func:`track_run`)."""
     n = m.position_m.shape[0]
     out = np.empty(N_OUT)
     x, v, t, a, f, r = trace_arrays(n)
     u = np.empty(n)
     record = n >= 0  # run-time booleans, not literals: one compiled track_run / run_program each
     count = track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record, x, v, t, a, f, r, u,
-                      noise_ms, lag_s)
+                      noise_ms, lag_s, carry, t_end_s, x_end_m)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count], u[:count]
 
 
@@ -338,5 +382,6 @@ def track_programs(m, programs, code, params, period_s):
         v[count:] = 0.0
         x_start, x_stop = reference_phases(x, r, count)
         track_run(m, v, x_start, x_stop, code, params, period_s, out[j], no_record,
-                  empty, empty, empty, empty, empty, empty_r, empty, empty, 0.0)
+                  empty, empty, empty, empty, empty, empty_r, empty, empty, 0.0,
+                  np.zeros(N_CARRY), math.inf, math.inf)
     return out

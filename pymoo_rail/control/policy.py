@@ -5,13 +5,14 @@
 time`` from position ``x`` at speed ``v`` to the platform) answers "what is optimal from here" for
 a whole grid of states at once, so a re-plan needs no new solve:
 
-1. ``V_lambda`` is kept for a lattice of prices of time ``lambda_k = lambda_plan r^k`` (computed
+1. ``V_lambda`` is kept for a lattice of prices of time, ``lambda_k + P_aux = (lambda_plan + P_aux) r^k`` (computed
    lazily, each by one backward sweep over the line still ahead);
 2. ``dV/dlambda`` is the running time of the optimal rest of the run (envelope theorem), so the
    slope of ``V`` between two neighbouring prices, read at the train's state, says which price
    arrives on time: no forward run is needed to choose it;
 3. one forward run of the DP from the state at that price, then the last switch into the final
-   coast is moved (a few simulator runs) until the run arrives at the planned time;
+   coast is moved (a few simulator runs) until the run arrives at the planned time (where that
+   is not enough, the cost-to-go between the two neighbouring prices is interpolated, by bisection);
 4. the energy's lower bound comes from weak duality, ``E*(T) >= V_lambda(x, v) - lambda T`` for
    every price computed: the re-plan's certificate costs nothing more.
 
@@ -48,8 +49,9 @@ ARRIVAL_TOL_S = 0.25
 # A re-planned run counts as on time within this of the plan (moving the switch by one cell
 # changes the time by dx / v: 0.07 s at 50 km/h on a 1 m grid)
 ON_TIME_TOL_S = 1.0
-LAMBDA_MIN_W = 1.0e2
-LAMBDA_MAX_W = 1.0e10
+# Bounds of the total price of time (lambda plus the auxiliary power) the lattice spans
+TIME_PRICE_MIN_W = 1.0e2
+TIME_PRICE_MAX_W = 1.0e10
 
 
 @dataclass(frozen=True)
@@ -159,9 +161,10 @@ def merged_tables(old_model: KernelModel, old_tables: tuple, new_model: KernelMo
 class _Line:
     """What the policy knows of one variant of the line and train: model, tables, cost-to-go per price."""
 
-    def __init__(self, model: KernelModel, tables: tuple):
+    def __init__(self, model: KernelModel, tables: tuple, terminal_j: np.ndarray):
         self.model = model
         self.tables = tables
+        self.terminal_j = terminal_j  # cost-to-go at the end of the line (the case's end speed)
         self.values: dict[int, tuple[int, np.ndarray]] = {}  # lattice index -> (first valid node, V)
         self.last_k = 0
 
@@ -186,6 +189,9 @@ class OptimalPolicy:
         Its price of time (W), the centre of the lattice of prices the policy keeps.
     n_sweeps : int
         Backward sweeps done so far (a re-plan that reuses the lattice does none).
+    last_program : array (rows, 3)
+        The driving program (``end_m, mode, target_ms``, absolute positions) of the last run
+        returned: the optimal controls themselves, for a controller that applies them directly.
 
     Examples
     --------
@@ -210,11 +216,17 @@ class OptimalPolicy:
         self.bias = self.solver.top_bias
         self.tie_j = self.solver.tie_j
         self.n_sweeps = 0
+        self.last_program: np.ndarray | None = None
         self._lines: dict[tuple, _Line] = {}
         self._solvers: dict[float, OptimalSolver] = {}
         model = self.solver.simulator.model
         self.dx_m = float(self.solver.dx_m)
-        self._lines[(self.case.train.mass_t, None)] = _Line(model, self.solver.transition_tables())
+        self.aux_w = float(model.aux_power_w)
+        self._lines[(self.case.train.mass_t, None)] = _Line(model, self.solver.transition_tables(),
+                                                            self._terminal(model))
+
+    def _terminal(self, model: KernelModel) -> np.ndarray:
+        return dp.terminal_cost(model, self.n_speeds, self.bias, self.case.end_speed_window_ms()[0])
 
     # ------------------------------------------------------------------ inputs
     def _check_state(self, model: KernelModel, position_m, speed_ms, elapsed_s,
@@ -253,19 +265,36 @@ class OptimalPolicy:
             case = replace(self.case, train=replace(self.case.train, mass_t=mass))
             solver = OptimalSolver(case, self.dx_m, self.n_speeds, self.max_targets, top_bias=self.bias,
                                    tie_j=self.tie_j, certify=False)
-            self._lines[base_key] = _Line(solver.simulator.model, solver.transition_tables())
+            self._lines[base_key] = _Line(solver.simulator.model, solver.transition_tables(),
+                                          self._terminal(solver.simulator.model))
         base = self._lines[base_key]
         if restriction is None:
             return base
         model = restricted_model(base.model, restriction, float(self.case.train.length_m))
         tables = merged_tables(base.model, base.tables, model, self.n_speeds, self.max_targets, self.bias)
-        self._lines[key] = line = _Line(model, tables)
+        self._lines[key] = line = _Line(model, tables, base.terminal_j)
         line.last_k = base.last_k
         return line
 
+    def envelope_ms(self, position_m: float, restriction: SpeedRestriction | None = None,
+                    mass_t: float | None = None) -> float:
+        """The planner's braking envelope at the grid node nearest ``position_m`` (m/s): the highest speed it plans from."""
+        model = self._line(restriction, mass_t).model
+        node = min(max(int(round(float(position_m) / self.dx_m)), 0), model.position_m.shape[0] - 1)
+        return float(model.envelope_ms[node])
+
+    def model_ahead(self, position_m: float, speed_ms: float, restriction: SpeedRestriction | None = None,
+                    mass_t: float | None = None) -> KernelModel:
+        """The planner's model of the line ahead of ``position_m`` (nearest node) with the train at ``speed_ms``."""
+        model = self._line(restriction, mass_t).model
+        node = min(max(int(round(float(position_m) / self.dx_m)), 0), model.position_m.shape[0] - 2)
+        return model_from(model, node, min(float(speed_ms), float(model.envelope_ms[node])))
+
     # ------------------------------------------------------------------ the lattice of prices
     def _price(self, k: int) -> float:
-        return self.lambda_w * PRICE_RATIO ** k
+        # geometric in the total price of time: towards cheap prices time becomes free (lambda ->
+        # -P_aux), so a train ahead of its plan is not driven faster to save auxiliary energy
+        return (self.lambda_w + self.aux_w) * PRICE_RATIO ** k - self.aux_w
 
     def _value(self, line: _Line, k: int, node: int) -> np.ndarray:
         """Cost-to-go at lattice price ``k``, valid from ``node`` on (swept over the line ahead only)."""
@@ -277,9 +306,7 @@ class OptimalPolicy:
         value = np.zeros((n, self.n_speeds)) if entry is None else entry[1]
         prices = np.full(n - 1 - node, self._price(k))
         tables = line.tables[:-1] + (np.ascontiguousarray(line.tables[-1][node:]),)
-        # the end speed the case asks for is priced at the end of the line, as in the solver
-        terminal_j = dp.terminal_cost(m, self.n_speeds, self.bias, self.case.end_speed_window_ms()[0])
-        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), terminal_j)
+        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), line.terminal_j)
         self.n_sweeps += 1
         line.values[k] = (node, value)
         if len(line.values) > MAX_PRICES_KEPT:  # forget the price farthest from this one
@@ -303,8 +330,9 @@ class OptimalPolicy:
         A galloping search from the last price chosen: a re-plan close to the last one tests one or
         two prices, already swept; a large change (a late departure) doubles its steps.
         """
-        k_min = int(math.floor(math.log(LAMBDA_MIN_W / self.lambda_w) / math.log(PRICE_RATIO)))
-        k_max = int(math.ceil(math.log(LAMBDA_MAX_W / self.lambda_w) / math.log(PRICE_RATIO)))
+        total = self.lambda_w + self.aux_w
+        k_min = int(math.floor(math.log(TIME_PRICE_MIN_W / total) / math.log(PRICE_RATIO)))
+        k_max = int(math.ceil(math.log(TIME_PRICE_MAX_W / total) / math.log(PRICE_RATIO)))
 
         def too_slow(k: int) -> bool:  # between prices k and k + 1 the rest still takes too long
             return k < k_max and self._run_time_between(line, k, node, speed_ms) > remaining_s + ARRIVAL_TOL_S
@@ -336,19 +364,56 @@ class OptimalPolicy:
         return right
 
     # ------------------------------------------------------------------ the runs
-    def _rollout(self, line: _Line, k: int, node: int, speed_ms: float) -> np.ndarray:
+    def _rollout(self, line: _Line, k: int, node: int, speed_ms: float, share: float = 0.0) -> np.ndarray:
+        """The DP's forward run from the state at lattice price ``k`` (or ``share`` of the way to ``k + 1``).
+
+        Between two lattice prices the cost-to-go is interpolated linearly in the price (the
+        supporting lines of the front at both ends): the run in between when neither end, nor
+        its moved last switch, meets the time.
+        """
         model = model_from(line.model, node, speed_ms)
         value = self._value(line, k, node)[node:]
+        price_w = self._price(k)
+        if share > 0.0:
+            value = (1.0 - share) * value + share * self._value(line, k + 1, node)[node:]
+            price_w = (1.0 - share) * price_w + share * self._price(k + 1)
         n = model.position_m.shape[0]
         modes = np.zeros(n - 1, dtype=np.int64)
         targets = np.zeros(n - 1)
         speeds = np.zeros(n)
-        price = np.full(n - 1, self._price(k) + model.aux_power_w)
-        done = dp.forward_rollout(model, price, value, self.max_targets, self.bias, self.tie_j, modes, targets,
-                                  speeds)[0]
+        price = np.full(n - 1, price_w + model.aux_power_w)
+        done = dp.forward_rollout(model, price, np.ascontiguousarray(value), self.max_targets, self.bias, self.tie_j,
+                                  modes, targets, speeds)[0]
         if done < n - 1:
             raise FieldError("speed_ms", speed_ms, f"leaves no way to the platform from {model.position_m[0]:.1f} m")
         return np.column_stack([model.position_m[1:], modes.astype(float), targets])
+
+    def _on_time_program(self, line: _Line, k: int, node: int, speed_ms: float, model: KernelModel,
+                         remaining_s: float) -> tuple[np.ndarray, float]:
+        """The run at price ``k`` with its last switch moved to the time; if that misses, a price between
+        ``k`` and its neighbour on the other side of the time, by bisection. Returns (program, price)."""
+        program = self.meet_time(model, self._rollout(line, k, node, speed_ms), remaining_s)
+        miss = self._times(model, program[None])[0] - remaining_s
+        if abs(miss) <= ARRIVAL_TOL_S:
+            return program, self._price(k)
+        lo = k if miss > 0 else k - 1  # the time lies between prices lo and lo + 1
+        # the share of the way from lo to lo + 1: 0 runs slower, 1 faster
+        slow, fast = 0.0, 1.0
+        best = (abs(miss), program, self._price(k))
+        for _ in range(8):
+            share = 0.5 * (slow + fast)
+            trial = self.meet_time(model, self._rollout(line, lo, node, speed_ms, share), remaining_s)
+            late = self._times(model, trial[None])[0] - remaining_s
+            price = (1.0 - share) * self._price(lo) + share * self._price(lo + 1)
+            if abs(late) < best[0]:
+                best = (abs(late), trial, price)
+            if abs(late) <= ARRIVAL_TOL_S:
+                break
+            if late > 0:
+                slow = share
+            else:
+                fast = share
+        return best[1], best[2]
 
     @staticmethod
     def _times(model: KernelModel, programs: np.ndarray) -> np.ndarray:
@@ -408,7 +473,8 @@ class OptimalPolicy:
         line = self._line(restriction, mass_t)
         node, v, elapsed = self._check_state(line.model, position_m, speed_ms, elapsed_s, before_plan=False)
         model = model_from(line.model, node, v)
-        tr = run_trace(model, flat_out_program(float(model.position_m[-1])), elapsed)
+        self.last_program = flat_out_program(float(model.position_m[-1]))
+        tr = run_trace(model, self.last_program, elapsed)
         return self._finish(tr, elapsed, math.inf, math.nan,
                             on_time=abs(tr.time_s[-1] - self.planned_time_s) <= ON_TIME_TOL_S)
 
@@ -467,15 +533,17 @@ class OptimalPolicy:
         model = model_from(line.model, node, v)
         fastest = flat_out_program(float(model.position_m[-1]))
         t_min = self._times(model, fastest[None])[0]
-        if t_min >= remaining - ARRIVAL_TOL_S:
+        if t_min >= remaining:  # not even the fastest run is on time: the earliest arrival
+            self.last_program = fastest
             tr = run_trace(model, fastest, elapsed)
             return self._finish(tr, elapsed, math.inf, math.nan, on_time=t_min <= remaining + ON_TIME_TOL_S,
                                 cpu_s=_time.process_time() - started)
         k = self._choose_price(line, node, v, remaining)
-        program = self.meet_time(model, self._rollout(line, k, node, v), remaining)
+        program, price_w = self._on_time_program(line, k, node, v, model, remaining)
+        self.last_program = program
         tr = run_trace(model, program, elapsed)
         # weak duality: E*(T) >= V_lambda(state) - lambda T for every price swept so far
         lower = max(self._cost_to_go(line, j, node, v) - self._price(j) * remaining
                     for j, (first, _) in list(line.values.items()) if first <= node)
         on_time = abs(tr.time_s[-1] - self.planned_time_s) <= ON_TIME_TOL_S
-        return self._finish(tr, elapsed, self._price(k), lower, on_time, _time.process_time() - started)
+        return self._finish(tr, elapsed, price_w, lower, on_time, _time.process_time() - started)

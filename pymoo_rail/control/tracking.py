@@ -90,7 +90,8 @@ class Tracker:
         x_start, x_stop = ck.reference_phases(np.ascontiguousarray(x_ref), regime, x_ref.shape[0])
         out, x, v, t, a, f, r, u = ck.track_trace(self.simulator.model, v_ref, float(x_start), float(x_stop),
                                                  self._code, self._params, self.control_period_s,
-                                                 noise, float(traction_lag_s))
+                                                 noise, float(traction_lag_s), np.zeros(ck.N_CARRY),
+                                                 np.inf, np.inf)
         summary = summary_dict(out)
         err_kmh = (v - np.interp(x, x_ref, v_ref_ms, right=0.0)) * KMH_PER_MS
         summary["speed_error_rms_kmh"] = float(np.sqrt(np.mean(err_kmh**2)))

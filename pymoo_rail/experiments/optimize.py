@@ -26,11 +26,12 @@ from pymoo.core.evaluator import Evaluator
 from pymoo.core.population import Population
 from pymoo.optimize import minimize
 
-from pymoo_rail.constants import TIME_OBJECTIVES
 from pymoo_rail.experiments.fronts import choose_member, distinct_front
 from pymoo_rail.experiments.penalty import PenalisedConstraints, handles_constraints
 from pymoo_rail.optimal import optimal_profile
 from pymoo_rail.problems import reference as certified
+from pymoo_rail.problems.encodings import decision_columns
+from pymoo_rail.problems.objectives import time_objectives
 
 DEFAULT_TIME_TOLERANCE_S = 1.0
 """How close to the planned time a member counts as punctual when the problem has no tolerance (s)."""
@@ -115,7 +116,7 @@ def default_time_tolerance_s(objectives: Sequence[str], weights: Sequence[float]
     run take any time; ``|T - T_plan| <= 1 s`` keeps it to the timetable (the form of Liu (2019)).
     """
     if time_tolerance_s is None and len(objectives) == 1 and weights is None \
-            and objectives[0] not in TIME_OBJECTIVES:
+            and objectives[0] not in time_objectives():
         return DEFAULT_TIME_TOLERANCE_S
     return time_tolerance_s
 
@@ -139,7 +140,6 @@ def front_table(problem, opt) -> tuple[pd.DataFrame, list]:
     X, F, CV, running, energy = X[order], F[order], CV[order], running[order], energy[order]
     trajectories = [trajectories[i] for i in order]
 
-    unit = "kmh" if problem.encoding.name == "speed_codes" else "m"
     objective_cols = ([f"f_{name}" for name in problem.objectives] if problem.n_obj == len(problem.objectives)
                       else ["f_weighted_sum"])
     front = pd.DataFrame(F, columns=objective_cols)
@@ -149,8 +149,8 @@ def front_table(problem, opt) -> tuple[pd.DataFrame, list]:
     front["accel_variation_ms2"] = [t.accel_variation_ms2 for t in trajectories]
     front["feasible"] = CV <= 0
     front["cv"] = CV
-    for j in range(X.shape[1]):
-        front[f"x{j}_{unit}"] = X[:, j]
+    for j, column in enumerate(decision_columns(problem.encoding)):  # x0_kmh, x3_m, x4_ms2: the encoding's units
+        front[column] = X[:, j]
     return front, trajectories
 
 

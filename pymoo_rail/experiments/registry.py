@@ -162,8 +162,8 @@ def _kinematic_phases(case: Any = "metro-a", **params):
 
 @_forwards("pymoo_rail.control.tuning", "ControllerTuningProblem")
 def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
-    """``pymoo_rail.control.tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
-    from pymoo_rail.control.tuning import ControllerTuningProblem
+    """``pymoo_rail.problems.controller_tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
+    from pymoo_rail.problems.controller_tuning import ControllerTuningProblem
 
     return ControllerTuningProblem(_case(case, load), **params)
 
@@ -440,7 +440,8 @@ def check_trust(study: Study, trusted: bool) -> None:
 
 # pymoo's base classes take **kwargs and drop what they do not know: a keyword that reaches them
 # unused is a mistake, not an extension point
-_DROPPING_BASES = {("pymoo.core.algorithm", "Algorithm"), ("pymoo.core.problem", "Problem")}
+_DROPPING_BASES = {("pymoo.core.algorithm", "Algorithm"), ("pymoo.core.problem", "Problem"),
+                   ("pymoo.core.infill", "InfillCriterion")}
 
 
 def accepted_parameters(target: Callable[..., Any]) -> frozenset[str] | None:

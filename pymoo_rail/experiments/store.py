@@ -40,9 +40,11 @@ from pathlib import Path
 from contextlib import contextmanager
 from typing import Iterator
 
+import numpy as np
 from filelock import FileLock, Timeout
 
 from pymoo_rail.atomic import TEMP_PREFIX, atomic_write_text, is_abandoned_temp
+from pymoo_rail.experiments.spec import canonical_json
 
 RECORD_FORMAT = "pymoo-rail/run-record/2"
 # records written before checksums and input fingerprints: readable, but always redone by a study
@@ -54,7 +56,7 @@ STALE_DIR = "stale"
 LOCKS_DIR = "locks"
 STUDY_FILE = "study.toml"
 REQUIRED_FIELDS = ("format", "run_id", "problem", "algorithm", "seed", "budget", "n_var", "n_obj", "front",
-                   "indicators")
+                   "indicators", "problem_label", "algorithm_label", "n_eval", "n_gen", "wall_time_s", "feasible")
 
 __all__ = ["ResultStore", "RecordError", "LegacyRecordError", "StoreError", "record_checksum",
            "atomic_write_text", "RECORD_FORMAT"]
@@ -115,6 +117,76 @@ def record_checksum(record: dict) -> str:
     body = {k: v for k, v in record.items() if k != "checksum"}
     text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
     return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
+
+
+def _is_int(value: object) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value: object) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _check_fields(path: Path, record: dict) -> None:
+    """The types a reader relies on, and a run id that is the hash of the record's own identity.
+
+    A checksum only shows the record was not damaged; anyone can write a record with a valid one,
+    so a received results folder is read only after these checks (a bad one is a RecordError).
+    """
+    def bad(name: str, what: str) -> RecordError:
+        return RecordError(path, f"field '{name}' = {record.get(name)!r:.80}: {what}")
+
+    if not isinstance(record["run_id"], str):
+        raise bad("run_id", "must be a string")
+    for key in ("problem", "algorithm"):
+        spec = record[key]
+        if not isinstance(spec, dict) or not isinstance(spec.get(key), str):
+            raise bad(key, f"must be a table naming the {key}")
+    if not _is_int(record["seed"]):
+        raise bad("seed", "must be an integer")
+    budget = record["budget"]
+    if not isinstance(budget, dict) or len(budget) != 1 or not all(_is_int(v) for v in budget.values()):
+        raise bad("budget", "must be a table with one integer")
+    for key in ("n_var", "n_obj"):
+        if not _is_int(record[key]) or record[key] < 1:
+            raise bad(key, "must be a positive integer")
+    identity = {"problem": record["problem"], "algorithm": record["algorithm"], "seed": record["seed"],
+                "budget": budget}
+    if hashlib.sha256(canonical_json(identity).encode()).hexdigest()[:16] != record["run_id"]:
+        raise bad("run_id", "is not the id of the record's own problem, algorithm, seed and budget")
+    indicators = record["indicators"]
+    if not isinstance(indicators, dict) or not all(_is_number(v) for v in indicators.values()):
+        raise bad("indicators", "must be a table of numbers")
+    for key in ("unavailable", "inputs"):
+        table = record.get(key, {})
+        if not isinstance(table, dict) or not all(isinstance(v, str) for v in table.values()):
+            raise bad(key, "must be a table of strings")
+    if not isinstance(record.get("counters", {}), dict):
+        raise bad("counters", "must be a table")
+    front = record["front"]
+    if not isinstance(front, dict) or not isinstance(front.get("extras", {}), dict):
+        raise bad("front", "must be a table with F, X, CV (and extras)")
+    try:
+        n = len(front["F"])
+        shapes = (np.asarray(front["F"], dtype=float).reshape(n, record["n_obj"]),
+                  np.asarray(front["X"], dtype=float).reshape(n, record["n_var"]),
+                  np.asarray(front["CV"], dtype=float).reshape(n),
+                  *(np.asarray(v, dtype=float).reshape(n) for v in front.get("extras", {}).values()))
+    except (KeyError, TypeError, ValueError) as err:
+        raise bad("front", f"F, X, CV and extras must be arrays of numbers of one member per row ({err})") \
+            from None
+    del shapes
+    for key in ("wall_time_s", "cpu_time_s", "n_eval", "n_gen"):
+        if key in record and not _is_number(record[key]):
+            raise bad(key, "must be a number")
+    for key in ("problem_label", "algorithm_label"):
+        if not isinstance(record[key], str):
+            raise bad(key, "must be a string")
+    if not isinstance(record["feasible"], bool):
+        raise bad("feasible", "must be true or false")
+    history = record.get("history")
+    if history is not None and not (isinstance(history, dict) and all(isinstance(v, list) for v in history.values())):
+        raise bad("history", "must be a table of lists (or null)")
 
 
 def _stamp() -> str:
@@ -246,6 +318,7 @@ class ResultStore:
         if record.get("checksum") != expected:
             raise RecordError(path, f"field 'checksum' = {record.get('checksum')!r} does not match the "
                                     f"content ({expected}): the record was altered or damaged")
+        _check_fields(path, record)
         return record
 
     def load(self, run_id: str) -> dict | None:

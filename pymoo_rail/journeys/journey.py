@@ -5,12 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from functools import cached_property
-from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 
-from pymoo_rail.cases import ttobench
 from pymoo_rail.model import Case, CaseError, Leg, Line, Train
 from pymoo_rail.sim import Simulator
 
@@ -187,79 +185,6 @@ class Journey:
     def min_running_times_s(self, dx_m: float | None = None) -> np.ndarray:
         """Flat-out running time of each section on the simulator grid."""
         return np.array([Simulator(c, dx_m).min_running_time_s() for c in self.sections])
-
-    # --------------------------------------------------------------------------------- TTOBench
-
-    @classmethod
-    def from_ttobench(cls, track_path: ttobench.Source, train_path: ttobench.Source,
-                      stops: Sequence[ttobench.StopRef] | None = None, *,
-                      stop_names: Sequence[str] | None = None,
-                      planned_times_s: Sequence[float] | float | None = None, supplement: float = 0.10,
-                      dwell_s: Sequence[float] | float = 30.0, train_length_m: float | None = None,
-                      name: str | None = None, dx_m: float | None = None) -> Journey:
-        """A journey on a TTOBench track calling at ``stops`` (default: every stop).
-
-        Parameters
-        ----------
-        stops : sequence of int, str or float, optional
-            Stops called at, in order, by index, name (with ``stop_names``) or position (m); see
-            :func:`pymoo_rail.cases.ttobench.from_ttobench`. Stops left out are passed.
-        planned_times_s : float or sequence of float, optional
-            Planned running time of each section (TTOBench has none). Default: each section's
-            minimum running time plus ``supplement`` (10 %), a usual timetable running-time supplement.
-        dwell_s : float or sequence of float
-            Dwell at each intermediate stop (default 30 s, Liu (2019) 5.1.1 for this line).
-        train_length_m : float, optional
-            As in :func:`~pymoo_rail.cases.ttobench.from_ttobench` (default: point mass).
-        """
-        track = ttobench.read_track(track_path)
-        indices = list(range(len(track.stops_m))) if stops is None else \
-            [track.stop_index(s, stop_names) for s in stops]
-        if len(indices) < 2:
-            raise CaseError("stops", stops, "a journey calls at two stops at least")
-        for a, b in zip(indices, indices[1:]):
-            if b <= a:
-                raise CaseError("stops", stops, f"stop {b} does not follow stop {a} in the track's direction")
-        n = len(indices) - 1
-        dwell = [float(dwell_s)] * (n - 1) if np.isscalar(dwell_s) else [float(d) for d in dwell_s]
-        plans = [None] * n if planned_times_s is None else \
-            ([float(planned_times_s)] * n if np.isscalar(planned_times_s) else list(planned_times_s))
-        if len(plans) != n:
-            raise CaseError("planned_times_s", planned_times_s, f"needs one time per section ({n})")
-        sections = []
-        for k, (a, b) in enumerate(zip(indices, indices[1:])):
-            case = ttobench.from_ttobench(track_path, train_path, a, b, plans[k] or 1.0,
-                                          dwell_s=dwell[k] if k < n - 1 else 0.0, stop_names=stop_names,
-                                          train_length_m=train_length_m)
-            if plans[k] is None:
-                case = case.with_planned_time(Simulator(case, dx_m).min_running_time_s() * (1.0 + supplement))
-            sections.append(case)
-        names = tuple(stop_names[i] for i in indices) if stop_names else ()
-        altitude = track.altitude_m + float(track.line().altitude_m(track.stops_m[indices[0]]))
-        return cls.from_sections(name or f"{track.id}[{indices[0]}-{indices[-1]}]", sections, dwell,
-                                 tuple(track.stops_m[i] for i in indices), names, altitude, sections[0].source)
-
-    def to_ttobench(self, out_dir: str | Path, *, track_id: str | None = None,
-                    train_id: str | None = None) -> tuple[Path, Path]:
-        """Write the journey's line (its stops only) and train as TTOBench files.
-
-        Positions restart at 0 at the first stop. Returns ``(track_path, train_path)``.
-        """
-        first = self.sections[0]
-        if self.train.length_m > ttobench.POINT_MASS_LENGTH_M and first.line.gradient_model != "train_length":
-            raise CaseError("line.gradient_model", first.line.gradient_model,
-                            "a train with a length is written with gradients averaged over it")
-        license_text = ttobench.TTOBENCH_NOTICE if "TTOBench" in self.source else None
-        meta = {"description": self.name}
-        if license_text:
-            meta["license"] = license_text
-        track_id = track_id or ttobench.ttobench_id(self.name)
-        train_id = train_id or ttobench.ttobench_id(self.train.name or f"{self.name}_train")
-        track = ttobench.track_to_json([c.line for c in self.sections], track_id, altitude_m=self.altitude_m,
-                                       metadata=meta)
-        train = ttobench.train_to_json(self.train, train_id,
-                                       metadata={"license": license_text} if license_text else None)
-        return ttobench.write_pair(out_dir, track, train)
 
 
 def as_journey(run: Journey | Case) -> Journey:

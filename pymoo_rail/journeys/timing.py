@@ -1,7 +1,8 @@
 """Journeys with timing points: time windows and speed bounds along the track, stops with dwell.
 
-A TTOBench *journey* file lists timing points ``[position, earliest, latest, min speed, max speed]``
-(times from the journey's start, ``null`` where unset). Two consecutive points at one position with
+A journey file (TTOBench JSON or TOML, read by :mod:`pymoo_rail.journeys.formats`) lists timing
+points ``[position, earliest, latest, min speed, max speed]`` (times from the journey's start,
+``null`` where unset). Two consecutive points at one position with
 both speed bounds 0 are the arrival at and the departure from an intermediate stop; a point with
 both speed bounds 0 is a stopping point, any other a passing point. The stopping points cut the
 journey into stop-to-stop sections: a :class:`~pymoo_rail.journeys.Journey`, i.e. a
@@ -20,12 +21,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
-from pymoo_rail.cases import ttobench
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import CaseError, InfeasibleCaseError
 from pymoo_rail.sim import Trajectory
@@ -66,40 +65,6 @@ class TimingPoint:
             (self.max_speed_kmh is None or speed_kmh <= self.max_speed_kmh + tol_kmh)
 
 
-def read_timing_points(source: ttobench.Source) -> tuple[str, str | None, tuple[TimingPoint, ...], dict]:
-    """Read a TTOBench journey file: ``(id, associated track id, timing points, metadata)``.
-
-    Checks the rules of the TTOBench journey format (ordered positions, equal positions only for an
-    arrival/departure pair of stopping points, first and last points stops, lower <= upper bounds).
-    """
-    journey_id, track_id, rows, meta, label = ttobench.read_journey(source)
-    values = [list(r) for r in rows]
-    points = []
-    for k, row in enumerate(rows):
-        field = f"timing points.values[{k}]"
-        pos = row[0]
-        point = TimingPoint(*row)
-        for lo, hi, what in ((point.earliest_s, point.latest_s, "time"),
-                             (point.min_speed_kmh, point.max_speed_kmh, "speed")):
-            if lo is not None and hi is not None and lo > hi:
-                raise CaseError(field, row, f"the lower {what} constraint exceeds the upper one", label)
-        if (point.min_speed_kmh or 0.0) < 0 or (point.max_speed_kmh is not None and point.max_speed_kmh < 0):
-            raise CaseError(field, row, "speed constraints must be >= 0", label)
-        if points and pos < points[-1].position_m:
-            raise CaseError(field, row, "timing points must be ordered by position", label)
-        if points and pos == points[-1].position_m and not (point.is_stop and points[-1].is_stop):
-            raise CaseError(field, row, "equal positions are only allowed for the arrival and departure "
-                                        "stopping points of one station", label)
-        points.append(point)
-    if len(points) < 2:
-        raise CaseError("timing points.values", values, "needs at least two timing points", label)
-    for k in (0, len(points) - 1):
-        if not points[k].is_stop:
-            raise CaseError(f"timing points.values[{k}]", values[k], "the first and last timing points must be "
-                                                                    "stops (both speed constraints 0)", label)
-    return journey_id, track_id, tuple(points), meta
-
-
 @dataclass(frozen=True)
 class TimedJourney:
     """A :class:`Journey` with the timing points of each section.
@@ -108,7 +73,7 @@ class TimedJourney:
     (positions on the track); ``journey.stops_m`` are the section ends on the same track.
     """
 
-    journey: Any  # Journey (imported lazily to keep the module order one-way)
+    journey: Any  # a Journey (journey.py imports the simulator; this module stays below it)
     windows: tuple[tuple[TimingPoint, ...], ...]
 
     @property
@@ -118,90 +83,6 @@ class TimedJourney:
         for section in self.windows:
             out.extend(section)
         return tuple(out)
-
-
-def timed_journey_from_ttobench(journey_path: ttobench.Source, track_path: ttobench.Source,
-                                train_path: ttobench.Source, *, train_length_m: float | None = None,
-                                curve_model: str = "tang2020", tunnel_model: str = "liu2019") -> TimedJourney:
-    """A TTOBench journey file on its track with a train, as sections and their timing points."""
-    from pymoo_rail.journeys.journey import Journey
-
-    journey_id, track_id, points, _ = read_timing_points(journey_path)
-    track = ttobench.read_track(track_path)
-    if track_id is not None and track_id != track.id:
-        raise CaseError("metadata.associated track", track_id, f"the journey belongs to another track "
-                                                               f"(this one is {track.id!r})", str(journey_path))
-    groups: list[list[TimingPoint]] = [[points[0]]]
-    for point in points[1:]:
-        groups[-1].append(point)
-        if point.is_stop and point is not points[-1]:
-            groups.append([point])
-    # An intermediate station is two stopping points at one position: arrival ends one section,
-    # departure starts the next (the grouping above put the arrival at the head of a one-point group).
-    merged: list[list[TimingPoint]] = []
-    for group in groups:
-        if merged and len(group) >= 2 and group[0].position_m == group[1].position_m:
-            group = group[1:]
-        if len(group) >= 2:
-            merged.append(group)
-    stops = [g[0].position_m for g in merged] + [merged[-1][-1].position_m]
-    tt_train = ttobench.read_train(train_path, train_length_m=train_length_m)
-    sections, dwell = [], []
-    for k, group in enumerate(merged):
-        planned = window_end_s(group[-1]) - window_start_s(group[0])
-        if not math.isfinite(planned):
-            planned = 1.0  # no window: the solver picks the time
-        case = ttobench.case_between(track, tt_train, stops[k], stops[k + 1], max(planned, 1.0),
-                                     name=f"{journey_id}[{k}]", curve_model=curve_model, tunnel_model=tunnel_model)
-        case = replace(case, line=_with_speed_caps(case.line, group, stops[k]))
-        sections.append(case)
-        if k > 0:
-            arrival = merged[k - 1][-1]
-            dwell.append(max(0.0, window_start_s(group[0]) - window_end_s(arrival)))
-    journey = Journey.from_sections(journey_id, sections, dwell, stops, source=sections[0].source)
-    return TimedJourney(journey=journey, windows=tuple(tuple(g) for g in merged))
-
-
-_TOML_TOP = {"name", "track", "train", "curve_model", "tunnel_model", "train_length_m", "timing_points"}
-_TOML_POINT = ("position_m", "earliest_s", "latest_s", "min_speed_kmh", "max_speed_kmh")
-
-
-def timed_journey_from_toml(path: str | Path) -> TimedJourney:
-    """A journey with timing points from a TOML file (TTOBench track and train files beside it).
-
-    ``name``, ``track`` and ``train`` (paths relative to the file), optional ``curve_model``,
-    ``tunnel_model``, ``train_length_m``, and one ``[[timing_points]]`` table per point with
-    ``position_m`` and any of ``earliest_s``, ``latest_s``, ``min_speed_kmh``, ``max_speed_kmh``
-    (a stop has both speeds 0). The rules are those of TTOBench journey files.
-    """
-    from pymoo_rail.model.toml_io import tomllib
-
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError) as err:
-        raise CaseError("<file>", str(path), f"cannot read the journey file: {err}", str(path)) from None
-    for key in sorted(set(data) - _TOML_TOP):
-        raise CaseError(key, data[key], f"unknown key (allowed: {', '.join(sorted(_TOML_TOP))})", str(path))
-    for key in ("name", "track", "train", "timing_points"):
-        if key not in data:
-            raise CaseError(key, None, "is required", str(path))
-    rows = []
-    for k, point in enumerate(data["timing_points"]):
-        if not isinstance(point, dict) or "position_m" not in point:
-            raise CaseError(f"timing_points[{k}].position_m", None, "is required", str(path))
-        for key in sorted(set(point) - set(_TOML_POINT)):
-            raise CaseError(f"timing_points[{k}].{key}", point[key],
-                            f"unknown key (allowed: {', '.join(_TOML_POINT)})", str(path))
-        rows.append([point.get(key) for key in _TOML_POINT])
-    journey = {"metadata": {"id": data["name"]},
-               "timing points": {"units": {"position": "m", "lower time constraint": "s",
-                                           "upper time constraint": "s", "lower speed constraint": "km/h",
-                                           "upper speed constraint": "km/h"}, "values": rows}}
-    return timed_journey_from_ttobench(journey, path.parent / data["track"], path.parent / data["train"],
-                                       train_length_m=data.get("train_length_m"),
-                                       curve_model=data.get("curve_model", "tang2020"),
-                                       tunnel_model=data.get("tunnel_model", "liu2019"))
 
 
 def window_start_s(point: TimingPoint) -> float:
@@ -217,7 +98,7 @@ def window_end_s(point: TimingPoint) -> float:
 _CAP_LENGTH_M = 1.0  # a passing point's maximum speed holds on this stretch of track after it
 
 
-def _with_speed_caps(line, group: Sequence[TimingPoint], start_m: float):
+def with_speed_caps(line, group: Sequence[TimingPoint], start_m: float):
     """The section's line with each passing point's maximum speed as a short speed limit."""
     caps = [(p.position_m - start_m, p.max_speed_kmh) for p in group[1:-1] if p.max_speed_kmh is not None]
     if not caps:

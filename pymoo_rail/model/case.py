@@ -8,6 +8,7 @@ from dataclasses import dataclass, replace
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
+from pymoo_rail.model.plausibility import allowed_kinds, check_plausible
 from pymoo_rail.model.train import Train
 
 END_SPEED_TOL_MS = 0.01
@@ -41,6 +42,11 @@ class Case:
     meet the case. ``final_speed_window_ms`` = ``(lo, hi)`` allows any arrival speed in between instead
     (``run.final_speed_window_kmh``); its upper end is then ``final_speed_ms`` (where the braking
     envelope ends). See :meth:`end_speed_window_ms` and :data:`END_SPEED_TOL_MS`.
+
+    Values no train or line has (a 120 permille gradient, a force in N where kN is meant; the
+    bounds of :mod:`pymoo_rail.model.plausibility`) raise :class:`CaseError`;
+    ``allow_implausible`` waives them for a research case: ``True`` for all, or a tuple of kinds
+    of bound (``("gradient", "speed")``, :data:`~pymoo_rail.model.plausibility.IMPLAUSIBLE_KINDS`).
     """
 
     name: str
@@ -55,10 +61,20 @@ class Case:
     initial_speed_ms: float = 0.0
     final_speed_ms: float = 0.0
     final_speed_window_ms: tuple[float, float] | None = None
+    allow_implausible: bool | tuple[str, ...] = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise CaseError("name", self.name, "must be a non-empty string")
+        for field in ("source", "description"):
+            if not isinstance(getattr(self, field), str):
+                raise CaseError(field, getattr(self, field), f"must be a string, not {type(getattr(self, field)).__name__}")
+        if not isinstance(self.train, Train):
+            raise CaseError("train", type(self.train).__name__, "must be a Train")
+        if not isinstance(self.line, Line):
+            raise CaseError("line", type(self.line).__name__, "must be a Line")
+        if not isinstance(self.allow_implausible, bool):
+            object.__setattr__(self, "allow_implausible", tuple(sorted(allowed_kinds(self.allow_implausible))))
         for field in ("planned_time_s", "dwell_s", "time_margin_s"):
             value = getattr(self, field)
             check_number(f"run.{field}", value, positive=field == "planned_time_s", nonneg=True)
@@ -76,6 +92,7 @@ class Case:
             previous_end = leg.end_m
         if self.legs and abs(previous_end - self.line.length_m) > 1e-9:
             raise CaseError("run.legs", f"end at {previous_end} m", f"must end at line.length_m = {self.line.length_m}")
+        check_plausible(self, self.allow_implausible)
 
     def _check_boundary_speeds(self) -> None:
         limits = self.line.speed_limits
@@ -121,6 +138,25 @@ class Case:
         if self.final_speed_window_ms is not None:
             return self.final_speed_window_ms
         return self.final_speed_ms, self.final_speed_ms
+
+    def require_single_run(self, user: str) -> Case:
+        """This case when it is one stop-to-stop run; a :class:`CaseError` naming the leg API when
+        it has legs (a single-run problem would run through the intermediate stops without a word).
+
+        Parameters
+        ----------
+        user : str
+            What refuses the legs (``"SpeedProfileProblem"``), named in the message.
+        """
+        if not self.legs:
+            return self
+        stops = ", ".join(f"{leg.end_m:g}" for leg in self.legs[:-1])
+        raise CaseError("run.legs", len(self.legs),
+                        f"case '{self.name}' has {len(self.legs)} legs (intermediate stops at {stops} m): "
+                        f"{user} optimises one stop-to-stop run and would run through them. Use "
+                        f"case.leg(k) for one leg, pymoo_rail.journeys.Journey(case) with allocate_running_time "
+                        "for the whole journey, or CooperativeTrainsProblem / TimetableProblem (pymoo_rail.problems) "
+                        "for the legs together")
 
     def leg(self, index: int) -> Case:
         """Leg ``index`` of a multi-section case as a single-run case."""

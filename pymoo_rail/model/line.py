@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from itertools import chain
 
 import numpy as np
 
@@ -19,8 +20,40 @@ GRADIENT_MODELS = ("train_length", "point_mass")
 CURVE_MODELS = ("tang2020", "roeckl")
 
 
-def _check_intervals(field: str, rows: tuple, length_m: float, *, tile: bool, width: int) -> None:
+def _intervals_hold(rows: np.ndarray, length_m: float, *, tile: bool) -> bool:
+    """True when the rows (an (n, width) array of finite numbers) pass :func:`_check_intervals`.
+
+    The same conditions on whole arrays, so a line of a million rows is checked in milliseconds;
+    only a line that fails them is walked row by row, to name the first bad row.
+    """
+    if rows.shape[0] == 0:
+        return not tile or abs(length_m) <= 1e-9
+    start, end = rows[:, 0], rows[:, 1]
+    ok = bool(np.all(end > start) and np.all(start >= 0) and np.all(end <= length_m + 1e-9))
+    if tile:
+        previous_end = np.concatenate([[0.0], end[:-1]])
+        return ok and bool(np.all(np.abs(start - previous_end) <= 1e-9)) and abs(end[-1] - length_m) <= 1e-9
+    return ok and bool(np.all(start[1:] >= end[:-1] - 1e-9))
+
+
+def _float_rows(rows: object, width: int) -> np.ndarray | None:
+    """``rows`` as an (n, width) float array when every row is a list or tuple of ``width`` Python
+    floats or ints, all finite; else None (the caller then checks entry by entry and names the bad one)."""
+    if not isinstance(rows, (list, tuple)) or not all(type(row) in (list, tuple) and len(row) == width
+                                                      for row in rows):
+        return None
+    flat = list(chain.from_iterable(rows))
+    if not set(map(type, flat)) <= {float, int}:
+        return None
+    array = np.array(flat, dtype=float).reshape(-1, width)
+    return array if np.isfinite(array).all() else None
+
+
+def _check_intervals(field: str, rows: tuple, length_m: float, *, tile: bool, width: int,
+                     array: np.ndarray | None = None) -> None:
     """Rows ``[start_m, end_m, ...]`` inside [0, length]; ``tile`` demands they cover it exactly."""
+    if array is not None and _intervals_hold(array, length_m, tile=tile):
+        return
     previous_end = 0.0
     for k, row in enumerate(rows):
         if len(row) != width:
@@ -64,21 +97,28 @@ class Line:
     gradient_model: str = "train_length"
     curve_model: str = "tang2020"
 
+    # (field, whether its rows tile the line, numbers per row)
+    _ROWS = (("gradients", True, 3), ("speed_limits", True, 3), ("curves", False, 3), ("tunnels", False, 2),
+             ("neutral_sections", False, 2))
+
     def __post_init__(self) -> None:
         check_number("line.length_m", self.length_m, positive=True)
-        for name in ("gradients", "speed_limits", "curves", "tunnels", "neutral_sections"):
-            rows = []
-            for k, row in enumerate(getattr(self, name)):
-                if isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
-                    raise CaseError(f"line.{name}[{k}]", row, "must be an array of numbers")
-                # type-checked before converting: true or "80" is not a number
-                rows.append(tuple(check_number(f"line.{name}[{k}][{j}]", v) for j, v in enumerate(row)))
-            object.__setattr__(self, name, tuple(rows))
-        _check_intervals("line.gradients", self.gradients, self.length_m, tile=True, width=3)
-        _check_intervals("line.speed_limits", self.speed_limits, self.length_m, tile=True, width=3)
-        _check_intervals("line.curves", self.curves, self.length_m, tile=False, width=3)
-        _check_intervals("line.tunnels", self.tunnels, self.length_m, tile=False, width=2)
-        _check_intervals("line.neutral_sections", self.neutral_sections, self.length_m, tile=False, width=2)
+        arrays = {}
+        for name, _, width in self._ROWS:
+            array = arrays[name] = _float_rows(getattr(self, name), width)
+            if array is not None:  # all plain numbers: converted at once (linear in the rows)
+                object.__setattr__(self, name, tuple(map(tuple, array.tolist())))
+            else:
+                rows = []
+                for k, row in enumerate(getattr(self, name)):
+                    if isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
+                        raise CaseError(f"line.{name}[{k}]", row, "must be an array of numbers")
+                    # type-checked before converting: true or "80" is not a number
+                    rows.append(tuple(check_number(f"line.{name}[{k}][{j}]", v) for j, v in enumerate(row)))
+                object.__setattr__(self, name, tuple(rows))
+        for name, tile, width in self._ROWS:
+            _check_intervals(f"line.{name}", getattr(self, name), self.length_m, tile=tile, width=width,
+                             array=arrays[name])
         for k, row in enumerate(self.speed_limits):
             if row[2] <= 0:
                 raise CaseError(f"line.speed_limits[{k}]", list(row), "the limit must be > 0 km/h")

@@ -54,8 +54,10 @@ PENALTY_J = 1.0e20
 # then brakes fully and records an excess of ~1e-9 m/s, or the single-precision tables round
 # the envelope up): counted as the top node.
 _TOP_RTOL = 1e-6
-# An arrival below the end speed asked for costs this many times the traction energy of the missing
-# kinetic energy (:func:`terminal_cost`)
+# An arrival below the end speed asked for costs m_eff / eta_traction per (m/s)^2 of u missing times
+# this (:func:`terminal_cost`); 1 (twice the traction energy of the missing kinetic energy) let a
+# run arrive 0.07 km/h below a window on the hilly test case, and 100 gave the same runs as 1 on a
+# generated line, so the interpolated cost-to-go near the end is not distorted by it
 END_PRICE_FACTOR = 100.0
 
 
@@ -188,24 +190,118 @@ def interp_at(v_next, p):
     return a + w * (b - a)
 
 
+@inlined
+def interp_aug(v_next, p, sing_p, sing_val):
+    """:func:`interp_at` with the singular speeds as further nodes between the regular ones.
+
+    ``sing_p`` holds the fractional node index of each singular speed at this position (-1: none
+    there), ``sing_val`` its cost-to-go; an interval holding one is interpolated on either side of it.
+    """
+    if p < 0.0:
+        return INF
+    k_max = v_next.shape[0] - 1
+    k = int(p)
+    if k >= k_max:
+        return v_next[k_max]
+    lp = float(k)
+    lv = v_next[k]
+    rp = lp + 1.0
+    rv = v_next[k + 1]
+    for s in range(sing_p.shape[0]):
+        q = sing_p[s]
+        if lp < q < rp:
+            if q <= p:
+                lp = q
+                lv = sing_val[s]
+            else:
+                rp = q
+                rv = sing_val[s]
+    if p <= lp:
+        return lv
+    if lv == INF or rv == INF:
+        return INF
+    return lv + (p - lp) / (rp - lp) * (rv - lv)
+
+
 @njit(cache=True)
 def interp_value(v_next, top_u, u, bias):
     """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
     return interp_at(v_next, value_position(top_u, u, v_next.shape[0] - 1, bias))
 
 
+@njit(cache=True)
+def psi_speed(b_nsm, c_ns2m2, psi_w):
+    """The speed ``v`` with ``psi(v) = v^2 R'(v) = v^2 (b + 2 c v) = psi_w`` (m/s; Davis ``R``; 0 if none).
+
+    ``psi`` increases with ``v``: Newton's method from above (it converges monotonically there).
+    """
+    if psi_w <= 0.0 or (b_nsm <= 0.0 and c_ns2m2 <= 0.0):
+        return 0.0
+    # a start above the root: the larger of the two one-term solutions
+    v = max(math.sqrt(psi_w / b_nsm) if b_nsm > 0.0 else 0.0, (psi_w / (2.0 * c_ns2m2)) ** (1.0 / 3.0)
+            if c_ns2m2 > 0.0 else 0.0)
+    for _ in range(100):
+        f = v * v * (b_nsm + 2.0 * c_ns2m2 * v) - psi_w
+        d = 2.0 * b_nsm * v + 6.0 * c_ns2m2 * v * v
+        step = f / d
+        v -= step
+        if abs(step) <= 1e-14 * v:
+            break
+    return v
+
+
+@njit(cache=True)
+def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p):
+    """The speeds at which holding is optimal for the price of time, at every grid node (Pontryagin).
+
+    With time priced at ``lambda`` plus the auxiliary power (W), holding by partial traction is
+    optimal at ``V`` with ``psi(V) = eta_traction (lambda + P_aux)``, holding by regenerative braking
+    at ``W`` with ``psi(W) = (lambda + P_aux) / eta_regen`` (``psi(v) = v^2 R'(v)``, ``R`` the Davis
+    resistance; gradient, curve and tunnel forces do not depend on the speed and do not enter). Writes
+    ``sing_v`` (n_nodes, 2) and their fractional node indices ``sing_p`` (-1 where a speed does not
+    apply: at or above the braking envelope, where the top node holds the limit; ``W`` without
+    regeneration or below its cut-off speed; within 1e-3 of a regular node, which holds it already;
+    at the last node). ``time_price_w`` (n_cells,) is each cell's ``lambda + P_aux``.
+    """
+    n = m.position_m.shape[0]
+    k_max = n_speeds - 1
+    for i in range(n):
+        for s in range(2):
+            sing_v[i, s] = 0.0
+            sing_p[i, s] = -1.0
+        if i == n - 1:
+            continue
+        price = time_price_w[i]
+        top_u = m.envelope_ms[i] ** 2
+        v_hold = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
+        v_regen = 0.0
+        if m.regen_efficiency > 0.0:
+            v_regen = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
+            if v_regen <= m.regen_min_speed_ms:
+                v_regen = 0.0
+        for s in range(2):
+            v = v_hold if s == 0 else v_regen
+            if v <= 0.0 or v * v >= top_u:
+                continue
+            p = node_position(top_u, v * v, k_max, bias)
+            if abs(p - round(p)) < 1e-3:
+                continue
+            sing_v[i, s] = v
+            sing_p[i, s] = p
+
+
 @inlined
 def control_cost(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, time_price_w,
-                 v_next, top_u, bias):
+                 v_next, top_u, bias, sing_p, sing_val):
     """Cell cost plus interpolated cost-to-go of one control from ``v0`` (:func:`cell_outcome`, :func:`cell_cost`).
 
     Infinite when the train stops inside the cell; the cost-to-go ``v_next`` is spread over
-    ``[0, top_u]`` (:func:`interp_value`).
+    ``[0, top_u]``, with the next position's singular speeds as further nodes (:func:`interp_aug`).
     """
     u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
     cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
     if cost < INF:
-        cost += interp_value(v_next, top_u, u1, bias)
+        cost += interp_aug(v_next, value_position(top_u, u1, v_next.shape[0] - 1, bias), sing_p, sing_val)
     return cost
 
 
@@ -254,9 +350,12 @@ def _n_targets(k_lo, k_hi, max_targets):
 
 
 @njit(cache=True)
-def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
+def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias, sing_v, sing_p, sing_val):
     """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
 
+    ``sing_v``, ``sing_p``, ``sing_val`` are the next position's singular speeds, their node
+    indices and cost-to-go (:func:`singular_speeds`): further nodes of the cost-to-go and further
+    ``toward`` targets, so that a run lands on them and holds them exactly.
     Returns ``(total_cost, mode, target_ms)``; ``total_cost`` is at least ``PENALTY_J`` when no
     control can reach the platform.
     """
@@ -272,11 +371,21 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
     for c in range(n_fixed):
         mode = _fixed_mode(c)
         cost = control_cost(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                            time_price_w, v_next, top_u, bias)
+                            time_price_w, v_next, top_u, bias, sing_p, sing_val)
         if cost < best:
             best = cost
             best_mode = mode
             best_target = 0.0
+    for s in range(sing_v.shape[0]):  # land exactly on a singular speed (holding it, from it)
+        if sing_p[s] < 0.0:
+            continue
+        target = sing_v[s]
+        cost = control_cost(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
+                            br_u, br_f, br_w, time_price_w, v_next, top_u, bias, sing_p, sing_val)
+        if cost < best:
+            best = cost
+            best_mode = MODE_TOWARD
+            best_target = target
     # partial traction (or braking) landing exactly on a speed node of the next position
     if top_u > 0.0 and k_max > 0:
         k_lo, k_hi = _target_range(top_u, k_max, v0 * v0, tr_u, co_u, bias)
@@ -284,7 +393,7 @@ def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias):
         for k in range(k_lo, k_hi + 1, stride):
             target = math.sqrt(node_u(top_u, k, k_max, bias))
             cost = control_cost(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                br_u, br_f, br_w, time_price_w, v_next, top_u, bias)
+                                br_u, br_f, br_w, time_price_w, v_next, top_u, bias, sing_p, sing_val)
             if cost < best:
                 best = cost
                 best_mode = MODE_TOWARD
@@ -407,8 +516,8 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
 
 
 @njit(cache=True)
-def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
-                   floor_k, terminal_j):
+def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
+                   floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
@@ -419,6 +528,13 @@ def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, t
     speed and at the end, where the case's end speed sets it): the nodes below it cost
     ``PENALTY_J``, so no run passes there slower. ``terminal_j`` (n_speeds,) is the cost-to-go at
     the end of the line (:func:`terminal_cost`).
+
+    The singular speeds (:func:`singular_speeds`: ``sing_v``, ``sing_p``, both (n_nodes, 2)) are
+    further states: their cost-to-go ``sing_val`` (n_nodes, 2) is found by evaluating every control
+    from them with the simulator's steps (:func:`best_control`, as in the forward run, prices
+    ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
+    through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
+    them exactly.
     """
     n, n_speeds = value.shape
     # at the end of the line the top node is the final speed (the envelope ends there; 0 at a
@@ -426,29 +542,42 @@ def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, t
     # (:func:`terminal_cost`)
     for j in range(n_speeds):
         value[n - 1, j] = terminal_j[j] if j >= floor_k[n - 1] else PENALTY_J
+    for s in range(sing_val.shape[1]):
+        sing_val[n - 1, s] = PENALTY_J
     for i in range(n - 2, -1, -1):
         v_next = value[i + 1]
+        sp_next = sing_p[i + 1]
+        sv_next = sing_val[i + 1]
         t = cell_type[i]
+        for s in range(sing_v.shape[1]):
+            sing_val[i, s] = PENALTY_J
+            if sing_p[i, s] < 0.0 or sing_p[i, s] < floor_k[i]:
+                continue
+            best = best_control(m, i, sing_v[i, s], time_price_w[i] + m.aux_power_w, v_next, max_targets, bias,
+                                sing_v[i + 1], sp_next, sv_next)[0]
+            sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
         for j in range(n_speeds):
             best = INF
             for c in range(N_FIXED):
                 e = fixed_e[t, j, c]
                 if e < INF:
-                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_at(v_next, fixed_u1[t, j, c])
+                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_aug(v_next, fixed_u1[t, j, c], sp_next,
+                                                                                 sv_next)
                     if cost < best:
                         best = cost
             s = t * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_at(v_next, tgt_u1[p])
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_aug(v_next, tgt_u1[p], sp_next, sv_next)
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
 
 
 @njit(cache=True)
-def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds):
+def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds, sing_v, sing_p,
+                    sing_val):
     """Drive from the case's initial speed choosing each cell's control from the cost-to-go (continuous state).
 
     Between controls whose costs differ by at most ``tie_j`` (J) the run keeps its previous mode,
@@ -468,7 +597,8 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     tie_cost = 0.0
     previous = MODE_TRACTION
     for i in range(n - 1):
-        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias)
+        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias, sing_v[i + 1],
+                                          sing_p[i + 1], sing_val[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
         tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
@@ -478,7 +608,8 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
                 c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias)
+                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias, sing_p[i + 1],
+                                      sing_val[i + 1])
                 if c_keep < INF and c_keep <= cost + tie_j:
                     tie_cost += c_keep - cost
                     mode, target = keep, 0.0
@@ -500,8 +631,8 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
     The top node is the final speed (the braking envelope ends there). Arriving slower than the
     case asks for (``end_lo_ms``: the final speed itself, or its window's lower end) costs
     ``END_PRICE_FACTOR x m_eff / eta_traction`` per (m/s)^2 of ``u`` missing: far more than the
-    traction energy the missing kinetic energy would have cost, so the optimum arrives at the speed
-    asked for wherever it can. A price linear in ``u`` rather than an infinite wall: the cost-to-go
+    missing kinetic energy could have saved, so the optimum arrives at the speed asked for wherever
+    it can. A price linear in ``u`` rather than an infinite wall: the cost-to-go
     is interpolated linearly in ``u``, so it is exact between the nodes, and the states from which
     the end speed is barely reachable are not cut off by a node spacing every cell (a wall at the
     nodes below the floor made those states infeasible back over the whole final approach).
@@ -515,7 +646,7 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
 
 
 def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray,
-          floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None):
+          floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None, singular: bool = True):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
@@ -524,8 +655,9 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     (n_speeds,), optional, the cost-to-go at the end (:func:`terminal_cost`; default 0: any arrival).
 
     ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
-    cost-to-go. Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s,
-    cost of the kept regimes J).
+    cost-to-go. ``singular`` adds the singular speeds of the price as states (:func:`singular_speeds`).
+    Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s, cost of the kept
+    regimes J) and the cost-to-go from the initial speed (J).
     Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
     energy, and the tables already hold it.
     """
@@ -535,14 +667,25 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
         floor_k = np.zeros(n, dtype=np.int64)
     if terminal_j is None:
         terminal_j = np.zeros(value.shape[1])
-    backward_sweep(prices, *tables, value, floor_k, terminal_j)
+    price = prices + model.aux_power_w
+    sing_v = np.empty((n, 2))
+    sing_p = np.empty((n, 2))
+    sing_val = np.empty((n, 2))
+    if singular:
+        singular_speeds(model, price, value.shape[1], float(bias), sing_v, sing_p)
+    else:
+        sing_v[:] = 0.0
+        sing_p[:] = -1.0
+    backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v, sing_p, sing_val, int(max_targets),
+                   float(bias))
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)
-    price = prices + model.aux_power_w
     done, energy, time, tie_cost = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j),
-                                                   modes, targets, speeds)
-    return modes, targets, speeds, done, energy, time, tie_cost
+                                                   modes, targets, speeds, sing_v, sing_p, sing_val)
+    start_j = interp_aug(value[0], value_position(model.envelope_ms[0] ** 2, model.initial_speed_ms ** 2,
+                                                  value.shape[1] - 1, float(bias)), sing_p[0], sing_val[0])
+    return modes, targets, speeds, done, energy, time, tie_cost, start_j
 
 
 def speed_floor_nodes(model, floor_ms: np.ndarray, n_speeds: int, bias: float) -> np.ndarray:

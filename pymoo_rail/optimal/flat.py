@@ -27,7 +27,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
-from pymoo_rail.model import Case
+from pymoo_rail.model import GRAVITY_MS2, Case
 
 
 @dataclass(frozen=True)
@@ -44,29 +44,41 @@ class FlatTrackOptimum:
     energy_kwh: float
 
 
-def _check_flat(case: Case) -> None:
+def _check_flat(case: Case, level: bool = True) -> float:
+    """The line's one gradient (per mille); raises unless the closed form applies."""
     line, train = case.line, case.train
-    if any(g[2] != 0.0 for g in line.gradients) or line.curves or line.tunnels or line.neutral_sections:
-        raise ValueError(f"case '{case.name}': the closed form needs level track without curves, tunnels "
-                         "or neutral sections")
+    grades = {g[2] for g in line.gradients}
+    if len(grades) != 1 or (level and grades != {0.0}) or line.curves or line.tunnels or line.neutral_sections:
+        raise ValueError(f"case '{case.name}': the closed form needs {'level track' if level else 'one gradient'} "
+                         "without curves, tunnels or neutral sections")
     if train.regen_efficiency != 0.0 and (train.regen_min_speed_kmh != 0.0 or train.regen_max_force_kn is not None
                                           or train.regen_max_power_kw is not None):
         raise ValueError(f"case '{case.name}': the closed form with regeneration assumes that all braking "
                          "regenerates (no regen caps, no cut-off speed)")
+    return grades.pop()
 
 
 def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
-    """The optimal traction-hold-coast-brake run of a level-track case taking ``running_time_s``.
+    """The optimal traction-hold-coast-brake run of a level (or constant-gradient) case taking ``running_time_s``.
+
+    On a single constant gradient the gradient force ``G = m g i`` adds to the resistance: it
+    does not depend on the speed, so the hold speed ``V`` is the level one (``psi(V) = v^2 R'(v)``),
+    and the switching conditions hold with ``R + G``. Needs ``R(v) + G > 0`` (coasting decelerates
+    at every speed up to the hold speed; otherwise holding is by braking at ``W``, another structure).
 
     The hold speed stays below every speed limit (``lambda`` is searched only up to the limit); the
     train's acceleration and deceleration caps, regenerative braking (all braking electric), the
     auxiliary power and the boundary speeds are honoured. Raises ``ValueError`` when the case is not
     level, or when no hold speed fits the time.
     """
-    _check_flat(case)
+    permille = _check_flat(case, level=False)
     train = case.train
     m = train.effective_mass_kg
     a, b, c = train.resistance.coefficients_si(train.mass_kg)
+    a += train.mass_kg * GRAVITY_MS2 * permille / 1000.0  # the gradient force, independent of the speed
+    if a <= 0.0:
+        raise ValueError(f"case '{case.name}': on {permille:g} per mille coasting accelerates at low speed; the "
+                         "closed form needs R(v) + G > 0")
     eta = train.traction_efficiency
     eta_b = train.regen_efficiency
     aux = train.aux_power_kw * 1000.0

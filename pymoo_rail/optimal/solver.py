@@ -15,6 +15,7 @@ the same physics and energy accounting as any optimiser's result.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -122,12 +123,18 @@ class OptimalSolver:
     speed_floor_ms : array (n_nodes,), optional
         Lowest speed allowed at each grid node (0: none): a journey's minimum speeds at its timing
         points (:meth:`set_speed_floor`).
+    singular : bool
+        Add, for every price of time tried, the speeds at which holding is optimal (Pontryagin's
+        singular arcs: ``V`` by partial traction, ``W`` by regenerative braking, see
+        ``dp.singular_speeds``) as states of the DP at every position, so that it holds them exactly
+        instead of at the nearest speed nodes (``docs/optimal.md``). False: the speed grid alone.
     """
 
     def __init__(self, case: Case, dx_m: float | None = None, n_speeds: int = DEFAULT_N_SPEEDS,
                  max_targets: int = DEFAULT_MAX_TARGETS, time_tol_s: float = DEFAULT_TIME_TOL_S,
                  top_bias: float = DEFAULT_TOP_BIAS, tie_j: float = DEFAULT_TIE_J, certify: bool = True,
-                 price_shape: np.ndarray | None = None, speed_floor_ms: np.ndarray | None = None):
+                 price_shape: np.ndarray | None = None, speed_floor_ms: np.ndarray | None = None,
+                 singular: bool = True):
         if isinstance(n_speeds, bool) or not isinstance(n_speeds, (int, np.integer)) or n_speeds < 3:
             raise ValueError(f"n_speeds = {n_speeds!r}: must be an integer >= 3")
         if isinstance(max_targets, bool) or not isinstance(max_targets, (int, np.integer)) or max_targets < 1:
@@ -138,6 +145,7 @@ class OptimalSolver:
         if not (isinstance(tie_j, (int, float)) and math.isfinite(tie_j) and tie_j >= 0.0):
             raise ValueError(f"tie_j = {tie_j!r}: must be a finite number of joules >= 0")
         self.tie_j = float(tie_j)
+        self.singular = bool(singular)
         self.case = case
         self.simulator = Simulator(case, dx_m)
         self.n_speeds = int(n_speeds)
@@ -224,13 +232,13 @@ class OptimalSolver:
         self.n_solves += 1
         prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, self.tie_j,
-                       self._value, self._floor_k, self._terminal_j)
+                       self._value, self._floor_k, self._terminal_j, self.singular)
         solution = self._record(lambda_w, run)
         self._history.append(solution)
         return solution
 
     def _record(self, lambda_w: float, run: tuple) -> _Solve:
-        modes, targets, speeds, done, energy, time, tie_cost = run
+        modes, targets, speeds, done, energy, time, tie_cost, value_j = run
         if done < modes.shape[0]:
             x = self.simulator.grid.position_m[done]
             raise InfeasibleCaseError("line", self.case.name,
@@ -240,10 +248,7 @@ class OptimalSolver:
                                       f"the solver's run arrives at {speeds[-1] * KMH_PER_MS:.3f} km/h: the end speed "
                                       "asked for is out of reach", self.case.name)
         program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
-        model = self.simulator.model
-        value_j = float(dp.interp_value(self._value[0], model.envelope_ms[0] ** 2, model.initial_speed_ms ** 2,
-                                        self.top_bias))
-        return _Solve(lambda_w, program, speeds, energy, time, value_j, tie_cost_j=tie_cost)
+        return _Solve(lambda_w, program, speeds, energy, time, float(value_j), tie_cost_j=tie_cost)
 
     def _adjust(self, solution: _Solve, target: float) -> _Solve | None:
         """Move the run's last switch into the final coast until it takes the requested time.
@@ -485,7 +490,8 @@ class OptimalSolver:
         if self._coarse is None:
             self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
                                          self.time_tol_s, self.top_bias, self.tie_j, certify=False,
-                                         price_shape=self.price_shape, speed_floor_ms=self.speed_floor_ms)
+                                         price_shape=self.price_shape, speed_floor_ms=self.speed_floor_ms,
+                                         singular=self.singular)
             self._coarse.simulator = self.simulator  # same grid and model: share them
             self._coarse._min_time_s = self._min_time_s
         # the two grids compared through their dual functions at the run's price, min E + lambda T:
@@ -560,8 +566,8 @@ class OptimalSolver:
         lam = solution.lambda_w
         prices = lam if self.price_shape is None else lam * self.price_shape
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, 0.0,
-                       self._value, self._floor_k, self._terminal_j)
-        _, _, _, done, energy, time, _ = run
+                       self._value, self._floor_k, self._terminal_j, self.singular)
+        _, _, _, done, energy, time, _, _ = run
         if done < self.simulator.grid.n_nodes - 1:
             return 0.0
         mean_price = lam if self.price_shape is None else lam * float(np.mean(self.price_shape))
@@ -599,7 +605,8 @@ class OptimalSolver:
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
                                    f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
-                                  self.top_bias, self.tie_j, self.certify, self.price_shape, self.speed_floor_ms)
+                                  self.top_bias, self.tie_j, self.certify, self.price_shape, self.speed_floor_ms,
+                                  self.singular)
             tr = finer.profile(running_time_s, solution.lambda_w)
             self.last_bound_parts = finer.last_bound_parts
             return tr
@@ -651,7 +658,8 @@ def optimal_profile(case: Case, running_time_s: float, **settings) -> Trajectory
     return OptimalSolver(case, **settings).profile(running_time_s)
 
 
-def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
+def optimal_front(case: Case, running_times, *, progress: Callable[[int, int], None] | None = None,
+                  **settings) -> pd.DataFrame:
     """Minimum net energy at each running time: the energy / running-time front of the case.
 
     Parameters
@@ -659,6 +667,8 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
     case : Case
     running_times : sequence of float
         Requested running times (s), each at least :func:`min_running_time`.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after each running time is solved (for a progress bar).
     **settings
         As for :func:`optimal_profile`.
 
@@ -691,4 +701,6 @@ def optimal_front(case: Case, running_times, **settings) -> pd.DataFrame:
                      "lambda_kwh_per_s": slope,
                      "energy_at_request_kwh": e.net_kwh + slope * (tr.running_time_s - float(t)),
                      "energy_bound_kwh": tr.summary.get("energy_bound_kwh", math.nan)})
+        if progress is not None:
+            progress(len(rows), len(times))
     return pd.DataFrame(rows)

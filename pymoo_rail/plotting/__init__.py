@@ -4,6 +4,7 @@ Every function returns a matplotlib ``Figure``; :func:`save_figure` writes it (P
 from the suffix). matplotlib is imported when a figure is made, not at import time.
 """
 
+from pymoo_rail.plotting.advice import plot_advised_run
 from pymoo_rail.plotting.comparison import plot_boxplots
 from pymoo_rail.plotting.convergence import convergence_frame, history_curve, plot_convergence, plot_history
 from pymoo_rail.plotting.fronts import plot_front, plot_fronts, plot_study_fronts, representative_runs
@@ -12,6 +13,6 @@ from pymoo_rail.plotting.profiles import Trace, as_trace, plot_speed_profile, pl
 from pymoo_rail.plotting.study import plot_study
 from pymoo_rail.plotting.style import OBJECTIVE_LABELS, REGIME_COLORS, save_figure
 
-__all__ = ["plot_front", "plot_fronts", "plot_study_fronts", "representative_runs", "plot_speed_profile",
+__all__ = ["plot_advised_run", "plot_front", "plot_fronts", "plot_study_fronts", "representative_runs", "plot_speed_profile",
            "plot_speed_time", "Trace", "as_trace", "plot_convergence", "convergence_frame", "plot_history",
            "history_curve", "plot_boxplots", "plot_study", "save_figure", "OBJECTIVE_LABELS", "REGIME_COLORS", "plot_timed_run"]

@@ -208,11 +208,13 @@ def representative_runs(results: pd.DataFrame, problem: str, indicator: str | No
 
 
 def plot_study_fronts(results: pd.DataFrame, problem: str, reference=None, objectives: Sequence[str] | None = None,
-                      indicator: str | None = None, ax=None):
+                      indicator: str | None = None, ax=None, trusted: bool = False):
     """The median run's front of each algorithm on one problem of a study.
 
     The true front is drawn when the problem knows one (rebuilt from its stored spec), or
-    ``reference`` when given (e.g. ``optimal_front`` for rail problems).
+    ``reference`` when given (e.g. ``optimal_front`` for rail problems). A spec that names code to
+    import (``"module:factory"``) is rebuilt only when ``trusted``; otherwise its true front is left
+    out with a warning, and nothing the results name is imported.
     """
     runs = representative_runs(results, problem, indicator)
     fronts = {row["algorithm"]: row["F"][row["CV"] <= 0] for _, row in runs.iterrows()}
@@ -220,7 +222,7 @@ def plot_study_fronts(results: pd.DataFrame, problem: str, reference=None, objec
     if not fronts:
         raise ValueError(f"no feasible front on problem {problem!r}")
     if reference is None and "problem_spec" in runs.columns:
-        reference = _true_front_of(runs.iloc[0]["problem_spec"])
+        reference = _true_front_of(runs.iloc[0]["problem_spec"], trusted)
     if objectives is None and "problem_spec" in runs.columns:
         names = runs.iloc[0]["problem_spec"].get("objectives")
         if isinstance(names, list) and len(names) == next(iter(fronts.values())).shape[1]:
@@ -230,16 +232,17 @@ def plot_study_fronts(results: pd.DataFrame, problem: str, reference=None, objec
                        reference_label="true front" if reference is not None else "", title=title, ax=ax)
 
 
-def _true_front_of(spec: dict):
+def _true_front_of(spec: dict, trusted: bool):
     from pymoo_rail.experiments.metrics import true_front
     from pymoo_rail.experiments.registry import build_problem
     from pymoo_rail.experiments.spec import ProblemSpec, StudyError
 
     try:
-        problem = build_problem(ProblemSpec.from_dict(spec))
+        problem = build_problem(ProblemSpec.from_dict(spec), trusted)
     except (StudyError, ValueError, ImportError, OSError) as err:  # a spec that no longer builds (module or case
-        # gone): the fronts are still worth drawing, without the true one
-        warnings.warn(f"the true front of problem {spec.get('name')!r} is not drawn: {err}", stacklevel=3)
+        # gone) or is not trusted: the fronts are still worth drawing, without the true one
+        name = spec.get("problem") if isinstance(spec, dict) else spec
+        warnings.warn(f"the true front of problem {name!r} is not drawn: {err}", stacklevel=3)
         return None
     pf = true_front(problem)
     return pf if pf is not None and pf.shape[1] >= 2 else None

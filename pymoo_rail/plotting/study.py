@@ -25,11 +25,12 @@ def _history_indicators(results: pd.DataFrame) -> list[str]:
 
 
 def plot_study(results: pd.DataFrame, directory: str | Path, indicators: Sequence[str] | None = None,
-               dpi: int = 150) -> list[Path]:
+               dpi: int = 150, trusted: bool = False) -> list[Path]:
     """Box plots per indicator, convergence curves, and the median fronts of each problem.
 
     Files: ``box_<indicator>.png``, ``convergence_<indicator>.png``, ``front_<problem>.png``
-    (problems with 2 or 3 objectives). Returns the paths written.
+    (problems with 2 or 3 objectives). Returns the paths written. ``trusted``: rebuild problems
+    given as ``"module:factory"`` for their true fronts (see :func:`plot_study_fronts`).
     """
     from pymoo_rail.experiments.results import indicator_columns
 
@@ -50,6 +51,6 @@ def plot_study(results: pd.DataFrame, directory: str | Path, indicators: Sequenc
         for problem, group in results.groupby("problem", sort=True):
             if 2 <= int(group["n_obj"].iloc[0]) <= 3 and group["feasible"].any():
                 safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in str(problem))
-                written.append(save_figure(plot_study_fronts(results, problem), directory / f"front_{safe}.png",
+                written.append(save_figure(plot_study_fronts(results, problem, trusted=trusted), directory / f"front_{safe}.png",
                                            dpi=dpi))
     return written

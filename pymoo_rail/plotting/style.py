@@ -6,16 +6,10 @@ from pathlib import Path
 from typing import Sequence
 
 from pymoo_rail.atomic import atomic_path
+from pymoo_rail.problems.objectives import objective_labels
 
-# axis labels with units for the rail objectives (pymoo_rail.problems.OBJECTIVES) and indicators
-OBJECTIVE_LABELS = {
-    "energy": "energy (kWh)",
-    "running_time": "running time (s)",
-    "time_error": "time error |T - T_plan| (s)",
-    "accel_variation": "total variation of acceleration (m/s²)",
-    "jerk": "jerk: total variation of acceleration (m/s²)",
-    "stop_error": "stop error (m)",
-}
+# axis labels with units of the rail objectives (the objective table) and of the indicators
+OBJECTIVE_LABELS = objective_labels()
 INDICATOR_LABELS = {
     "igd": "IGD", "gd": "GD (mean distance)", "gd_vv": "GD (Van Veldhuizen)", "hv": "hypervolume (normalised)",
     "spacing": "spacing (Schott)", "f_best": "best objective value", "error": "error to the optimum",

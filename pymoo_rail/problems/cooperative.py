@@ -45,7 +45,9 @@ from pymoo_rail.sim.pacing import DEFAULT_TIME_TOL_S, PacedRuns, PacedSpeedCodes
 # Chen et al. (2017) sections 4.2-4.4.
 SEED_001_OFFSETS_S = (-45.0, 0.0, 45.0, 90.0, 135.0)
 CONSTRAINTS = ("separation", "time")
-ENCODINGS = ("speed_codes", "subsections")
+SHAPE_ENCODINGS = ("speed_codes", "subsections")
+"""Shape encodings of one train here, each paced to its planned time (:mod:`pymoo_rail.sim.pacing`); the
+single-train encodings of ``SpeedProfileProblem`` are another family (:mod:`pymoo_rail.problems.encodings`)."""
 
 
 def finite_number(name: str, value, *, positive: bool = False, nonneg: bool = False) -> float:
@@ -84,8 +86,8 @@ class PacedTrain:
         """A train on ``case``; ``encoding`` is ``"speed_codes"`` (sections of at most ``max_section_m``)
         or ``"subsections"`` (the paper's, braking distances scaled by ``service_decel_ms2`` and
         ``brake_range_factor``)."""
-        if encoding not in ENCODINGS:
-            raise ValueError(f"encoding = {encoding!r} is unknown (known: {', '.join(ENCODINGS)})")
+        if encoding not in SHAPE_ENCODINGS:
+            raise ValueError(f"encoding = {encoding!r} is unknown (known: {', '.join(SHAPE_ENCODINGS)})")
         simulator = Simulator(case, dx_m)
         simulator.check_planned_time()  # raises, naming planned_time_s, when the run cannot be on time
         if encoding == "speed_codes":
@@ -106,19 +108,6 @@ class PacedTrain:
     def clocked(self, program: np.ndarray, departure_s: float) -> coop.ClockedRun:
         """The traced run of one program at ``departure_s``."""
         return coop.clocked_run(self.simulator.model, self.simulator.run(program), departure_s, self.start_m)
-
-
-def check_vectors(X, n_var: int, names=None) -> np.ndarray:
-    """Decision vectors (N, n_var) as floats; a ``ValueError`` naming the first bad entry (by ``names``)."""
-    X = np.atleast_2d(np.asarray(X, dtype=float))
-    if X.ndim != 2 or X.shape[1] != n_var:
-        raise ValueError(f"decision vectors have shape {X.shape}: this problem has n_var = {n_var}")
-    bad = np.argwhere(~np.isfinite(X))
-    if bad.size:
-        r, c = (int(i) for i in bad[0])
-        name = names[c] if names is not None else c
-        raise ValueError(f"decision vector {r}, variable {name} = {X[r, c]}: must be finite")
-    return X
 
 
 @dataclass(frozen=True, eq=False)

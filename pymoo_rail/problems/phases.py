@@ -44,7 +44,8 @@ from pymoo.core.problem import Problem
 
 from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case
-from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning, canonical_objective, weighted_sum_settings
+from pymoo_rail.problems.objectives import canonical_objective, check_objectives
+from pymoo_rail.problems.speed_profile import ConstantObjectiveWarning, weighted_sum_settings
 
 PHASE_NAMES = ("traction", "cruise", "coast", "brake")
 PHASE_OBJECTIVES = ("energy", "accel_variation", "stop_error", "time_error")  # "jerk": alias of accel_variation
@@ -203,13 +204,7 @@ class KinematicPhasesProblem(Problem):
                  weights: Sequence[float] | None = None, scales: Sequence[float] | None = None,
                  accelerations_ms2: Sequence[float] = MENG_ACCELERATIONS_MS2, n_bits: int = 16,
                  min_phase_s: float = 2.0, binary: bool = True, **kwargs):
-        objectives = (objectives,) if isinstance(objectives, str) else tuple(objectives)
-        for name in objectives:
-            if canonical_objective(name) not in PHASE_OBJECTIVES:
-                raise ValueError(f"objective {name!r} is unknown (known: {', '.join(PHASE_OBJECTIVES)}, "
-                                 "jerk = accel_variation)")
-        if not objectives or len(set(objectives)) != len(objectives):
-            raise ValueError(f"objectives = {objectives!r}: give at least one, without repeats")
+        objectives = check_objectives(objectives, known=PHASE_OBJECTIVES)
         if not isinstance(n_bits, (int, np.integer)) or not 2 <= n_bits <= 52:
             raise ValueError(f"n_bits = {n_bits!r} must be an integer in [2, 52]")
         if not (np.isfinite(min_phase_s) and min_phase_s >= 0):

@@ -291,8 +291,45 @@ def n_times_for(case: Case) -> int:
     return DEFAULT_N_TIMES if case.line.length_m <= LONG_LINE_M else LONG_LINE_N_TIMES
 
 
-def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = None) -> CertifiedFront:
+Progress = Callable[[int, int], None]
+"""A progress callback: ``progress(done, total)`` in solves of the exact solver (``total`` may grow)."""
+PROGRESS_DELAY_S = 2.0
+"""A front computed in a terminal shows a progress bar once it has taken this long."""
+
+
+def front_progress_bar(case_name: str):
+    """A tqdm bar on standard error for a front's solves, shown after :data:`PROGRESS_DELAY_S` s.
+
+    Returns ``(bar, progress)``: close ``bar`` when done; pass ``progress`` to :func:`compute_front`.
+    """
+    import sys
+
+    from tqdm import tqdm
+
+    bar = tqdm(total=1, desc=f"certified front of {case_name} (exact solver)", unit="solve",
+               delay=PROGRESS_DELAY_S, file=sys.stderr, dynamic_ncols=True, leave=False)
+
+    def progress(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done - bar.n)
+
+    return bar, progress
+
+
+def _wants_progress(progress: bool | Progress | None) -> bool:
+    import sys
+
+    if progress is None:  # a terminal sees the bar; a test, a pipe or a notebook does not
+        return bool(getattr(sys.stderr, "isatty", lambda: False)())
+    return bool(progress) and not callable(progress)
+
+
+def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = None,
+                  progress: Progress | None = None) -> CertifiedFront:
     """Compute a case's certified front with the exact solver (no cache; see :func:`certified_front`).
+
+    ``progress(done, total)`` is called after every solve (``total``: the sweep, the solves alone
+    and, for a two-grid certificate, the coarse sweep).
 
     Every node is solved twice: in one sweep over the running times (each solve warm-started from
     the last) and alone. The lower run at the requested time is kept, and the node's bound is raised
@@ -306,8 +343,17 @@ def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = N
 
     t_min = min_running_time(case, dx_m)
     times = front_times(t_min, case.planned_time_s, n_times or n_times_for(case))
-    sweep = optimal_front(case, times, dx_m=dx_m)
-    alone = pd.concat([optimal_front(case, [t], dx_m=dx_m) for t in sweep["requested_time_s"]], ignore_index=True)
+    n = len(times)
+    total = [2 * n]  # the sweep and the solves alone; a two-grid certificate adds a coarse sweep
+
+    def stage(first: int):
+        if progress is None:
+            return None
+        return lambda done, _: progress(first + done, total[0])
+
+    sweep = optimal_front(case, times, dx_m=dx_m, progress=stage(0))
+    alone = pd.concat([optimal_front(case, [t], dx_m=dx_m, progress=stage(n + k))
+                       for k, t in enumerate(sweep["requested_time_s"])], ignore_index=True)
     use_alone = (alone["energy_at_request_kwh"] < sweep["energy_at_request_kwh"]).to_numpy()
     fine = sweep.copy()
     fine.loc[use_alone] = alone.loc[use_alone]
@@ -316,7 +362,9 @@ def compute_front(case: Case, dx_m: float | None = None, n_times: int | None = N
         bound = fine["energy_bound_kwh"].to_numpy(dtype=float)
         certificate = "solver"
     else:
-        coarse = optimal_front(case, times, dx_m=dx_m, n_speeds=DEFAULT_N_SPEEDS // COARSE_FACTOR)
+        total[0] = 3 * n
+        coarse = optimal_front(case, times, dx_m=dx_m, n_speeds=DEFAULT_N_SPEEDS // COARSE_FACTOR,
+                               progress=stage(2 * n))
         bound = np.abs(fine["energy_at_request_kwh"].to_numpy() - coarse["energy_at_request_kwh"].to_numpy())
         certificate = "two-grid"
     bound = np.maximum.reduce([bound, spread, BOUND_FLOOR_REL * np.abs(fine["energy_kwh"].to_numpy())])
@@ -357,8 +405,14 @@ def forget_fronts() -> None:
 
 
 def certified_front(case: Case, dx_m: float | None = None, n_times: int | None = None,
-                    use_cache: bool = True) -> CertifiedFront:
+                    use_cache: bool = True, progress: bool | Progress | None = None) -> CertifiedFront:
     """The certified front of a case: from memory, the shipped fronts, the user cache, or computed.
+
+    Computing one takes from seconds to about a minute (33 nodes, each solved two or three times).
+    ``progress``: ``None`` (default) shows a progress bar on standard error when it is a terminal
+    and the computation lasts over :data:`PROGRESS_DELAY_S` s (so tests, pipes and notebooks stay
+    quiet); ``True`` shows it whatever standard error is, ``False`` never; a callable is called as
+    ``progress(done, total)`` after each solve instead (e.g. a GUI's own bar).
 
     A computed front is written to the user cache atomically (a reader never sees half a file),
     named ``<case name>-<key>.csv`` where the key is :func:`front_key` (content hash, step, nodes, version).
@@ -384,7 +438,16 @@ def certified_front(case: Case, dx_m: float | None = None, n_times: int | None =
             set_aside(path, str(err).removeprefix(f"{path}: "), "the front will be computed again")
             front = None
     if front is None:
-        front = compute_front(case, step, n_times)
+        if callable(progress):
+            front = compute_front(case, step, n_times, progress)
+        elif _wants_progress(progress):
+            bar, tick = front_progress_bar(case.name)
+            try:
+                front = compute_front(case, step, n_times, tick)
+            finally:
+                bar.close()
+        else:
+            front = compute_front(case, step, n_times)
         safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in case.name)
         atomic_write_text(cache_dir() / f"{safe}-{key}.csv", front.to_csv_text())
     _MEMORY[key] = front

@@ -8,23 +8,25 @@ from typing import Sequence
 import numpy as np
 from pymoo.core.problem import Problem
 
-from pymoo_rail.constants import OBJECTIVES
+from pymoo_rail.control import Tracker
 from pymoo_rail.model import Case
-from pymoo_rail.problems.encodings import ENCODINGS, BrakingOnset, SpeedCodes, SwitchingPoints
-from pymoo_rail.problems.paced_codes import PacedCodes
+from pymoo_rail.problems.encodings import resolve_encoding
+from pymoo_rail.problems.encodings.base import Encoding, EncodingSetup, Runner
+from pymoo_rail.problems.objectives import (
+    OBJECTIVE_TABLE,
+    canonical_objective,
+    check_objectives,
+    get_objective,
+    objective_names,
+)
 from pymoo_rail.sim import Simulator, Trajectory
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.checks import end_speed_violation_ms
 
-# "jerk" is the name Meng et al. (2017) give their comfort figure, sum |a_i - a_(i-1)| (m/s^2): a total
-# variation of acceleration, not a rate of change (m/s^3). "accel_variation" says what it is; "jerk"
-# stays as an alias of the same objective.
-OBJECTIVE_ALIASES = {"jerk": "accel_variation"}
-
-
-def canonical_objective(name: str) -> str:
-    """The objective a name stands for (``"jerk"`` -> ``"accel_variation"``; others unchanged)."""
-    return OBJECTIVE_ALIASES.get(name, name)
+OBJECTIVES = objective_names()
+"""Objective names (and aliases) of :class:`SpeedProfileProblem`: :data:`~pymoo_rail.problems.objectives.OBJECTIVE_TABLE`."""
+OBJECTIVE_ALIASES = {alias: obj.name for obj in OBJECTIVE_TABLE for alias in obj.aliases}
+"""Alias -> objective (``{"jerk": "accel_variation"}``)."""
 
 
 def weighted_sum_settings(weights, scales, objectives: Sequence[str],
@@ -64,7 +66,24 @@ def weighted_sum_settings(weights, scales, objectives: Sequence[str],
     return w, sc
 
 
-DECISION_UNITS = {"speed_codes": "km/h", "switching_points": "m", "braking_onset": "m"}
+# the problem's settings that belong to the encoding, at the values that mean "not given"
+ENCODING_SETTINGS = {"partition": "gradient_limit", "n_sections": None, "max_section_m": None, "floor_kmh": 10.0,
+                     "integer_codes": False, "regimes": None, "decel_range_ms2": None}
+
+
+class TrackedRuns:
+    """A :class:`~pymoo_rail.control.Tracker` as a runner: each program's ideal run, tracked by the controller."""
+
+    def __init__(self, tracker: Tracker):
+        self.tracker = tracker
+
+    def run_batch(self, programs: np.ndarray) -> np.ndarray:
+        """Summaries (N, N_OUT) of the tracked runs of programs."""
+        return self.tracker.run_batch(programs)
+
+    def run(self, program: np.ndarray) -> Trajectory:
+        """The tracked trajectory of one program."""
+        return self.tracker.run_program(program)
 
 
 class DecisionError(ValueError):
@@ -101,22 +120,20 @@ SEED_002_WEIGHTS = {"energy": 0.1, "jerk": 0.2, "stop_error": 0.4, "time_error":
 
 
 def objective_values(summaries: np.ndarray, names: Sequence[str], planned_time_s: float) -> np.ndarray:
-    """Objective columns (N, len(names)) from kernel summaries (N, N_OUT)."""
+    """Objective columns (N, len(names)) from kernel summaries (N, N_OUT), as the objective table says."""
     columns = []
     for name in names:
-        if name == "energy":
-            columns.append(summaries[:, k.OUT_NET_KWH])
-        elif name == "running_time":
-            columns.append(summaries[:, k.OUT_RUNNING_TIME_S])
-        elif name == "time_error":
-            columns.append(np.abs(summaries[:, k.OUT_RUNNING_TIME_S] - planned_time_s))
-        elif canonical_objective(name) == "accel_variation":
-            columns.append(summaries[:, k.OUT_JERK_MS2])
-        elif name == "stop_error":
-            columns.append(summaries[:, k.OUT_STOP_ERROR_M])
-        else:
-            raise ValueError(f"objective {name!r} is unknown (known: {', '.join(OBJECTIVES)})")
+        obj = get_objective(name)
+        values = summaries[:, k.OUT_NAMES.index(obj.kernel_column)]
+        columns.append(np.abs(values - planned_time_s) if obj.off_plan else values)
     return np.column_stack(columns)
+
+
+def weighted_sum_scales(flat_out_summary: np.ndarray, names: Sequence[str], planned_time_s: float) -> dict[str, float]:
+    """Weighted-sum scale of each objective (canonical name) from the flat-out run's summary (N_OUT,)."""
+    values = objective_values(np.atleast_2d(flat_out_summary), names, planned_time_s)[0]
+    return {canonical_objective(name): get_objective(name).default_scale(float(v), planned_time_s)
+            for name, v in zip(names, values)}
 
 
 class ConstantObjectiveWarning(UserWarning):
@@ -144,18 +161,24 @@ class SpeedProfileProblem(Problem):
         Liu (2019) eq. 4-21), ``"accel_variation"`` (comfort: total variation of the
         acceleration, sum of ``|a_i - a_(i-1)|`` over the grid cells, m/s^2; Meng et al. (2017) eq. 5,
         where it is called jerk: ``"jerk"`` is an alias of it, not a rate in m/s^3),
-        ``"stop_error"`` (m, Meng et al. (2017) eq. 6). Several give the Pareto form; one with
+        ``"stop_error"`` (m, Meng et al. (2017) eq. 6), ``"peak_power"`` (the highest electrical
+        traction power drawn, kW: a cell's traction work over its duration, divided by the traction
+        efficiency; :mod:`pymoo_rail.problems.objectives` lists them all). Several give the Pareto form; one with
         ``time_tolerance_s`` gives the constrained form of Liu (2019) 4.4; ``weights`` give the
         weighted sum of Meng et al. (2017) eq. 9.
-    encoding : {"speed_codes", "switching_points", "braking_onset", "paced_speed_codes"}
+    encoding : Encoding or {"speed_codes", "switching_points", "braking_onset", "paced_speed_codes"}
+        An encoding object, as pymoo takes ``sampling=...`` (``SpeedCodes(partition="equal")``,
+        ``SwitchingPoints(regimes=...)``, ``BrakingOnset(...)``, ``PacedCodes(...)``), or its name,
+        resolved by :mod:`pymoo_rail.problems.encodings` with the settings below that it takes.
         Speed codes per section (km/h), regime switching positions (m), or the phases of
         Meng et al. (2017) with the braking onset (m) and deceleration (m/s^2) as decisions (the
-        only one where the stop error varies without ``tracking``); see
-        :mod:`pymoo_rail.problems.encodings`; ``"paced_speed_codes"``: a speed-code shape per
-        section and the running time (s), each shape paced to its time, so every vector is on time
-        (needs ``time_tolerance_s`` or ``time_window_s``; :mod:`pymoo_rail.problems.paced_codes`).
-        An objective that cannot vary under the chosen
-        encoding (the stop error of speed codes) triggers a ``ConstantObjectiveWarning``.
+        only one where the stop error varies without ``tracking``); ``"paced_speed_codes"``: a
+        speed-code shape per section and the running time (s), each shape paced to its time, so
+        every vector is on time (needs ``time_tolerance_s`` or ``time_window_s``). An objective that
+        cannot vary under the chosen encoding (the stop error of speed codes) triggers a
+        ``ConstantObjectiveWarning``. A setting below that the encoding does not take is an error
+        unless it has its default value; beside an encoding object, every setting must keep its
+        default.
     partition : {"gradient_limit", "equal"}
         Sections of the speed-code encoding (Liu (2019) figs. 4-4 and 4-3).
     n_sections : int, optional
@@ -174,7 +197,8 @@ class SpeedProfileProblem(Problem):
     scales : sequence of float, optional
         Normalisation of the weighted sum; by default the flat-out run's energy, 5 % of the planned
         time (time error, Meng et al.'s (2017) punctuality tolerance), the planned time (running time), the
-        flat-out run's jerk, and 0.25 m (stop error, Meng et al.'s (2017) tolerance).
+        flat-out run's jerk and peak power, and 0.25 m (stop error, Meng et al.'s (2017) tolerance)
+        (:meth:`pymoo_rail.problems.objectives.Objective.default_scale`).
     stop_tolerance_m : float or None
         Constraint ``stop_error <= stop_tolerance_m`` (default 0.25 m); ``None`` drops it.
     regimes : sequence of str, optional
@@ -212,42 +236,19 @@ class SpeedProfileProblem(Problem):
     """
 
     def __init__(self, case: Case, objectives: Sequence[str] = ("energy", "time_error"),
-                 encoding: str = "speed_codes", partition: str = "gradient_limit", n_sections: int | None = None,
-                 max_section_m: float | None = None, time_tolerance_s: float | None = None,
-                 weights: Sequence[float] | None = None, scales: Sequence[float] | None = None,
-                 stop_tolerance_m: float | None = 0.25, regimes: Sequence[str] | None = None,
-                 floor_kmh: float = 10.0, dx_m: float | None = None, tracking=None,
-                 control_period_s: float = 0.2, time_window_s=None, integer_codes: bool = False,
+                 encoding: str | Encoding = "speed_codes", partition: str = "gradient_limit",
+                 n_sections: int | None = None, max_section_m: float | None = None,
+                 time_tolerance_s: float | None = None, weights: Sequence[float] | None = None,
+                 scales: Sequence[float] | None = None, stop_tolerance_m: float | None = 0.25,
+                 regimes: Sequence[str] | None = None, floor_kmh: float = 10.0, dx_m: float | None = None,
+                 tracking=None, control_period_s: float = 0.2, time_window_s=None, integer_codes: bool = False,
                  decel_range_ms2: tuple[float, float] | None = None, **kwargs):
-        if isinstance(objectives, str):
-            objectives = (objectives,)
-        objectives = tuple(objectives)
-        if not objectives:
-            raise ValueError("objectives = (): give at least one objective")
-        for name in objectives:
-            if name not in OBJECTIVES:
-                raise ValueError(f"objective {name!r} is unknown (known: {', '.join(OBJECTIVES)})")
-        if len({canonical_objective(name) for name in objectives}) != len(objectives):
-            raise ValueError(f"objectives = {objectives!r} repeats an objective (jerk is an alias of accel_variation)")
-        if encoding == "speed_codes":
-            self.encoding = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh, integer_codes)
-        elif encoding == "switching_points":
-            self.encoding = SwitchingPoints.build(case, tuple(regimes) if regimes is not None else None)
-        elif encoding == "braking_onset":
-            if tracking is not None:
-                raise ValueError("encoding = 'braking_onset' with tracking: the controllers track an ideal "
-                                 "curve that ends at the platform; use speed_codes or switching_points")
-            self.encoding = BrakingOnset.build(case, tuple(regimes) if regimes is not None else None,
-                                               decel_range_ms2, dx_m=dx_m)
-        elif encoding == "paced_speed_codes":
-            if tracking is not None or integer_codes:
-                raise ValueError("encoding = 'paced_speed_codes' with tracking or integer_codes: the pace solve "
-                                 "moves every code together to meet a running time; use speed_codes")
-            # the sections of speed codes; the encoding itself needs the simulator and window (below)
-            sections = SpeedCodes.build(case, partition, n_sections, max_section_m, floor_kmh).boundaries_m
-            self.encoding = None
-        else:
-            raise ValueError(f"encoding = {encoding!r} is unknown (known: {', '.join(ENCODINGS)})")
+        case = case.require_single_run(type(self).__name__)
+        objectives = check_objectives(objectives)
+        encoding = resolve_encoding(encoding, ENCODING_SETTINGS, partition=partition, n_sections=n_sections,
+                                    max_section_m=max_section_m, floor_kmh=floor_kmh, integer_codes=integer_codes,
+                                    regimes=tuple(regimes) if regimes is not None else None,
+                                    decel_range_ms2=decel_range_ms2)
         if time_tolerance_s is not None and not (np.isfinite(time_tolerance_s) and time_tolerance_s > 0):
             raise ValueError(f"time_tolerance_s = {time_tolerance_s!r} must be a positive number")
         if stop_tolerance_m is not None and not (np.isfinite(stop_tolerance_m) and stop_tolerance_m > 0):
@@ -258,27 +259,22 @@ class SpeedProfileProblem(Problem):
         self.time_tolerance_s = time_tolerance_s
         self.stop_tolerance_m = stop_tolerance_m
         self.simulator = Simulator(case, dx_m)
-        self.tracker = None
-        if tracking is not None:
-            from pymoo_rail.control import Tracker  # the tracking layer is optional
-
-            self.tracker = Tracker(case, tracking, control_period_s, dx_m)
+        self.tracker = None if tracking is None else Tracker(case, tracking, control_period_s, dx_m)
         fastest = self.simulator.flat_out()
-        if "time_error" in objectives or time_tolerance_s is not None:
+        if any(get_objective(name).off_plan for name in objectives) or time_tolerance_s is not None:
             self.simulator.check_planned_time()  # raises, naming planned_time_s, when impossible
         self.min_running_time_s = fastest.running_time_s
         self.time_window_s = self._check_window(time_window_s, case)
-        if self.encoding is None:
-            self.encoding = PacedCodes.build(case, self.simulator, sections, self._pacing_window(time_tolerance_s))
+        setup = EncodingSetup(case, self.simulator, dx_m, tracking is not None, self._time_range_s())
+        self.encoding = encoding.bind(setup)
         if tracking is None:
             warn_constant_objectives(objectives, self.encoding)
 
         self.weights = None
         self.scales = None
         if weights is not None:
-            default = {"energy": fastest.energy.net_kwh, "time_error": 0.05 * case.planned_time_s,
-                       "running_time": case.planned_time_s, "accel_variation": max(fastest.accel_variation_ms2, 1e-9),
-                       "stop_error": 0.25}
+            default = weighted_sum_scales(np.array([fastest.summary[name] for name in k.OUT_NAMES]), objectives,
+                                          case.planned_time_s)
             self.weights, self.scales = weighted_sum_settings(weights, scales, objectives, default)
 
         n_obj = 1 if self.weights is not None else len(objectives)
@@ -296,12 +292,7 @@ class SpeedProfileProblem(Problem):
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != self.n_var:
             raise ValueError(f"decision vectors have {X.shape[1]} values: this problem has n_var = {self.n_var}")
-        if isinstance(self.encoding, PacedCodes):  # the pace solve has run every program already
-            return self.encoding.paced(np.ascontiguousarray(X)).summaries
-        programs = self.encoding.programs(np.ascontiguousarray(X))
-        if self.tracker is not None:
-            return self.tracker.run_batch(programs)
-        return self._runner().run_batch(programs)
+        return self.encoding.summaries(np.ascontiguousarray(X), self.runner)
 
     def check_decisions(self, X: np.ndarray) -> np.ndarray:
         """``X`` as a float array (N, n_var) after checking it is finite and inside ``[xl, xu]``.
@@ -311,10 +302,7 @@ class SpeedProfileProblem(Problem):
         DecisionError
             Naming the bad rows, and the first bad variable, value and bounds in the encoding's unit.
         """
-        units = getattr(self.encoding, "units", [DECISION_UNITS.get(self.encoding.name, "")] * self.n_var)
-        if self.encoding.name == "braking_onset":
-            units[-1] = "m/s^2"  # positions, then the service deceleration
-        return check_decisions(X, self.xl, self.xu, units)
+        return check_decisions(X, self.xl, self.xu, self.encoding.units)
 
     def _evaluate(self, x, out, *args, **kwargs):
         s = self.summaries(self.check_decisions(x))
@@ -339,16 +327,13 @@ class SpeedProfileProblem(Problem):
         out["running_time_s"] = s[:, k.OUT_RUNNING_TIME_S]
         out["stop_error_m"] = s[:, k.OUT_STOP_ERROR_M]
 
-    def _pacing_window(self, time_tolerance_s: float | None) -> tuple[float, float]:
-        """Running times paced speed codes may choose: the tolerance window, inside the time window."""
+    def _time_range_s(self) -> tuple[float, float]:
+        """Running times the constraints accept: the tolerance window, inside the time window (infinite: open)."""
         lo, hi = -np.inf, np.inf
-        if time_tolerance_s is not None:
-            lo, hi = self.case.planned_time_s - time_tolerance_s, self.case.planned_time_s + time_tolerance_s
+        if self.time_tolerance_s is not None:
+            lo, hi = self.case.planned_time_s - self.time_tolerance_s, self.case.planned_time_s + self.time_tolerance_s
         if self.time_window_s is not None:
             lo, hi = max(lo, self.time_window_s[0]), min(hi, self.time_window_s[1])
-        if not (np.isfinite(lo) and np.isfinite(hi)):
-            raise ValueError("encoding = 'paced_speed_codes' needs time_tolerance_s or time_window_s: "
-                             "the running times its runs are paced to")
         return lo, hi
 
     def _check_window(self, window, case: Case):
@@ -429,14 +414,12 @@ class SpeedProfileProblem(Problem):
         x = np.asarray(x, dtype=float)
         if x.ndim != 1 or x.shape[0] != self.n_var:
             raise ValueError(f"x must be one decision vector of length n_var = {self.n_var}, got shape {x.shape}")
-        program = self.encoding.programs(self.check_decisions(x[None, :]))[0]
-        if self.tracker is not None:
-            return self.tracker.run_program(program)
-        return self._runner().run(program)
+        return self.encoding.trajectory(self.check_decisions(x[None, :])[0], self.runner)
 
-    def _runner(self):
-        # braking_onset simulates its own (longer) track: the train may stop past the platform
-        return self.encoding if isinstance(self.encoding, BrakingOnset) else self.simulator
+    @property
+    def runner(self) -> Runner:
+        """What runs the decoded programs: the simulator, or the ATO tracker (``tracking=``)."""
+        return self.simulator if self.tracker is None else TrackedRuns(self.tracker)
 
     def describe(self) -> str:
         """One line naming the case, the form, the encoding and the objectives."""

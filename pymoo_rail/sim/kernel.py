@@ -81,11 +81,12 @@ OUT_REACHED = 16
 OUT_ELECTRIC_BRAKE_WORK_J = 17
 OUT_MAX_ABS_ACCEL_MS2 = 18
 OUT_NEUTRAL_TRACTION_J = 19
-N_OUT = 20
+OUT_PEAK_TRACTION_KW = 20
+N_OUT = 21
 OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s", "stop_position_m",
              "stop_error_m", "jerk_ms2", "regime_changes", "limit_excess_ms", "traction_work_j",
              "brake_work_j", "davis_work_j", "line_work_j", "grade_work_j", "final_speed_ms", "reached",
-             "electric_brake_work_j", "max_abs_accel_ms2", "neutral_traction_j")
+             "electric_brake_work_j", "max_abs_accel_ms2", "neutral_traction_j", "peak_traction_kw")
 
 # the three full-force steps of ``full_step`` (public for the DP)
 KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
@@ -176,7 +177,8 @@ TOTAL_TIME, TOTAL_TRACTION_J, TOTAL_BRAKE_J, TOTAL_ELECTRIC_BRAKE_J = 0, 1, 2, 3
 TOTAL_DAVIS_J, TOTAL_LINE_J, TOTAL_GRADE_J, TOTAL_NEUTRAL_TRACTION_J = 4, 5, 6, 7
 TOTAL_ACCEL_VARIATION, TOTAL_PREV_ACCEL, TOTAL_MAX_ABS_ACCEL = 8, 9, 10
 TOTAL_PREV_REGIME, TOTAL_REGIME_CHANGES, TOTAL_LIMIT_EXCESS = 11, 12, 13
-N_TOTALS = 14
+TOTAL_PEAK_TRACTION_W = 14  # the highest mechanical traction power of a cell, F (v0 + v1) / 2
+N_TOTALS = 15
 
 
 @inlined
@@ -185,7 +187,7 @@ def new_totals():
 
     A tuple, not an array: the kernels rebind it every cell and Numba keeps it in registers.
     """
-    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300)
+    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300, 0.0)
 
 
 @inlined
@@ -240,13 +242,16 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
         u1 = 0.0
     v1 = math.sqrt(u1)
     (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
-     jerk, prev_acc, max_acc, prev_regime, changes, excess) = totals
+     jerk, prev_acc, max_acc, prev_regime, changes, excess, peak_w) = totals
     time_s += 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
     brake_n = -f if f < 0.0 else 0.0
     if f > 0.0:
         w_trac += f * d
         if m.neutral[cell] != 0:
             w_neutral += f * d
+        # the cell's mean power, its work over its duration: f d / (2 d / (v + v1))
+        if f * 0.5 * (v + v1) > peak_w:
+            peak_w = f * 0.5 * (v + v1)
     w_brake += brake_n * d
     if brake_n > 0.0:
         share = share_above(v, v1, m.regen_min_speed_ms)
@@ -263,7 +268,7 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
         excess = v1 - m.limit_ms[cell + 1]
     x1 = m.position_m[cell] + d
     totals = (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
-              jerk, a_cell, max_acc, float(regime), changes, excess)
+              jerk, a_cell, max_acc, float(regime), changes, excess, peak_w)
     return v1, stopped, x1, a_cell, totals
 
 
@@ -339,6 +344,7 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
     out[OUT_ELECTRIC_BRAKE_WORK_J] = totals[TOTAL_ELECTRIC_BRAKE_J]
     out[OUT_MAX_ABS_ACCEL_MS2] = totals[TOTAL_MAX_ABS_ACCEL]
     out[OUT_NEUTRAL_TRACTION_J] = totals[TOTAL_NEUTRAL_TRACTION_J]
+    out[OUT_PEAK_TRACTION_KW] = totals[TOTAL_PEAK_TRACTION_W] / m.traction_efficiency / 1000.0
 
 
 @inlined

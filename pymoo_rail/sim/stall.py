@@ -9,11 +9,15 @@ user has to fix instead of a generic ``'line'``:
    10 permille gradient could be climbed or braked on);
 3. a descent steeper than the train can brake on (braking force plus running resistance below
    the downhill pull at some speed up to the limit): it could neither hold a limit nor stop;
-4. traction at standstill below the resistance where the train stalls: a climb too steep, or a
+4. a speed limit (or top speed) below 1 km/h where the train stops: it cannot move under it;
+5. a power cap so low that the traction just above standstill is below the resistance;
+6. traction at standstill below the resistance where the train stalls: a climb too steep, or a
    traction curve too weak on the flat.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -22,6 +26,8 @@ from pymoo_rail.model import GRAVITY_MS2, Case, InfeasibleCaseError, TrackGrid
 
 # below this share of its weight as traction (braking) a train cannot climb (brake on) even 10 permille
 MIN_FORCE_PER_WEIGHT = 0.01
+# a limit below this is no limit a train runs under (the lowest real ones, in yards, are ~5 km/h)
+MIN_LIMIT_KMH = 1.0
 
 
 def _row_at(rows: tuple, start_m: float, end_m: float, key) -> int | None:
@@ -92,12 +98,48 @@ def _mass_cause(case: Case, stop_m: float) -> InfeasibleCaseError | None:
     return None
 
 
-def _traction_cause(case: Case, grid: TrackGrid, stop_m: float) -> InfeasibleCaseError | None:
+def _limit_cause(case: Case, grid: TrackGrid, stop_m: float) -> InfeasibleCaseError | None:
+    train = case.train
+    if train.max_speed_kmh < MIN_LIMIT_KMH:
+        return InfeasibleCaseError("train.max_speed_kmh", train.max_speed_kmh,
+                                   f"is below {MIN_LIMIT_KMH:g} km/h: the train stops at {stop_m:.1f} m", case.name)
+    rows = case.line.speed_limits
+    k = _row_at(rows, stop_m - train.length_m, stop_m + grid.dx_m, key=lambda row: -row[2])
+    if k is not None and rows[k][2] < MIN_LIMIT_KMH:
+        return InfeasibleCaseError(f"line.speed_limits[{k}]", list(rows[k]),
+                                   f"is a limit below {MIN_LIMIT_KMH:g} km/h: the train stops under it at "
+                                   f"{stop_m:.1f} m", case.name)
+    return None
+
+
+def _resistance_kn(case: Case, grid: TrackGrid, stop_m: float, speed_kmh: float) -> float:
+    """Running and line resistance (kN) at ``speed_kmh`` in the cell where the train stopped."""
     train = case.train
     cell = int(np.clip(np.searchsorted(grid.position_m, stop_m, side="right") - 1, 0, grid.grade_force_n.shape[0] - 1))
-    traction_kn = float(train.traction.force_kn(0.0)[0])
-    resist_kn = float(train.resistance.force_kn(0.0, train.mass_t)) + (
+    return float(train.resistance.force_kn(speed_kmh, train.mass_t)) + (
         grid.grade_force_n[cell] + grid.other_force_n[cell]) / 1000.0
+
+
+def _power_cause(case: Case, grid: TrackGrid, stop_m: float) -> InfeasibleCaseError | None:
+    traction = case.train.traction
+    if traction.max_power_kw is None:
+        return None
+    crawl_kmh = MIN_LIMIT_KMH
+    capped_kn = float(traction.force_kn(crawl_kmh)[0])
+    uncapped_kn = float(replace(traction, max_power_kw=None).force_kn(crawl_kmh)[0])
+    resist_kn = _resistance_kn(case, grid, stop_m, crawl_kmh)
+    if not capped_kn < resist_kn <= uncapped_kn:  # the cap, not the curve or a climb, stops the train
+        return None
+    return InfeasibleCaseError(
+        "train.traction.max_power_kw", traction.max_power_kw,
+        f"caps the traction at {crawl_kmh:g} km/h to {capped_kn:.4g} kN, below the resistance ({resist_kn:.4g} kN): "
+        f"the train stops at {stop_m:.1f} m (a power in MW where kW is meant?)", case.name)
+
+
+def _traction_cause(case: Case, grid: TrackGrid, stop_m: float) -> InfeasibleCaseError | None:
+    train = case.train
+    traction_kn = float(train.traction.force_kn(0.0)[0])
+    resist_kn = _resistance_kn(case, grid, stop_m, 0.0)
     if traction_kn > resist_kn:
         return None
     rows = case.line.gradients
@@ -118,8 +160,11 @@ def explain_stall(case: Case, grid: TrackGrid, stop_position_m: float) -> Infeas
 
     Returns (does not raise) an :class:`InfeasibleCaseError` whose field is the entry to fix.
     """
-    for cause in (_neutral_cause(case, grid, stop_position_m), _mass_cause(case, stop_position_m),
-                  _descent_cause(case, grid), _traction_cause(case, grid, stop_position_m)):
+    causes = (lambda: _neutral_cause(case, grid, stop_position_m), lambda: _mass_cause(case, stop_position_m),
+              lambda: _descent_cause(case, grid), lambda: _limit_cause(case, grid, stop_position_m),
+              lambda: _power_cause(case, grid, stop_position_m), lambda: _traction_cause(case, grid, stop_position_m))
+    for find in causes:
+        cause = find()
         if cause is not None:
             return cause
     return InfeasibleCaseError("line", case.name, f"the train stops at {stop_position_m:.1f} m even at full "

@@ -5,7 +5,7 @@ running-time window (:func:`pymoo_rail.problems.reference.default_window`), whos
 the certified front of the exact solver; and ``<case>-single``, energy under
 ``|T - T_plan| <= 1 % of T_plan`` (at least 1 s), whose optimum is the front's least energy in that
 window; its decisions are paced speed codes (a shape per section and the running time inside the
-window, :mod:`pymoo_rail.problems.paced_codes`), so every decision vector is on time.
+window, :mod:`pymoo_rail.problems.encodings.paced_codes`), so every decision vector is on time.
 ``metro-a-4obj`` is the four-objective metro form of Meng et al. (2017) (energy, time error, jerk,
 stop error) with ``encoding="braking_onset"``, so that the stop error varies: no exact front
 exists; a best-known front is offered, labelled as such. :data:`SUITE_VERSION` says which forms
@@ -19,6 +19,7 @@ from functools import lru_cache
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.model import Case
+from pymoo_rail.problems.encodings import encoding_settings
 from pymoo_rail.problems.reference import PUNCTUAL_TOLERANCE_REL, punctual_tolerance_s
 
 TOLERANCE_REL = PUNCTUAL_TOLERANCE_REL
@@ -71,7 +72,7 @@ CASES: tuple[SuiteCase, ...] = (
 )
 
 SINGLE_ENCODING = "paced_speed_codes"
-"""Encoding of the ``-single`` forms (:mod:`pymoo_rail.problems.paced_codes`)."""
+"""Encoding of the ``-single`` forms (:mod:`pymoo_rail.problems.encodings.paced_codes`)."""
 SUITE_VERSION = "2"
 """Version of the suite's problem forms; bumped whenever a form changes what an optimiser searches.
 
@@ -159,6 +160,10 @@ def get_problem(name: str, **kwargs):
         # under which the stop error varies (speed codes always stop at the platform)
         settings.update(objectives=METRO_4OBJ_OBJECTIVES, encoding=METRO_4OBJ_ENCODING)
     settings.update(kwargs)
+    if isinstance(settings["encoding"], str):  # the sections above are for the encodings that have sections
+        taken = encoding_settings(settings["encoding"])
+        settings = {k: v for k, v in settings.items() if k not in ("partition", "max_section_m") or k in taken
+                    or k in kwargs}
     problem = SpeedProfileProblem(case, **settings)
     problem.suite_name = name
     problem.suite_version = SUITE_VERSION

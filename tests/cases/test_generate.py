@@ -10,7 +10,7 @@ import pytest
 from pymoo_rail.cases import KINDS, generate_case
 from pymoo_rail.cases.generate import case_checksum
 from pymoo_rail.model import CaseError
-from pymoo_rail.model.toml_io import case_from_dict, case_to_dict
+from pymoo_rail.model import case_from_dict, case_to_dict
 from pymoo_rail.sim import Simulator
 
 # sha256 of the generated content: a change of the generator (or of numpy's default_rng streams)

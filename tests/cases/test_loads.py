@@ -52,3 +52,13 @@ def test_integer_codes_with_pymoo_integer_operators():
     assert np.all(X == np.round(X))
     with pytest.raises(ValueError, match="whole km/h"):
         p.evaluate(np.full((1, p.n_var), 50.5))
+
+
+def test_a_multi_leg_case_is_refused_by_a_single_run_problem_with_the_leg_api_named():
+    case = load_case("cooperative-pair")
+    with pytest.raises(CaseError) as raised:
+        SpeedProfileProblem(case)
+    message = str(raised.value)
+    assert raised.value.field == "run.legs" and raised.value.value == 2
+    assert "case.leg(k)" in message and "Journey" in message and "SpeedProfileProblem" in message
+    assert SpeedProfileProblem(case.leg(0)).n_var > 0  # one leg is a single run

@@ -18,8 +18,8 @@ from pymoo_rail.cases.ttobench import (
     from_ttobench,
     read_track,
     read_train,
-    to_ttobench,
 )
+from pymoo_rail.cases.ttobench_writer import to_ttobench
 from pymoo_rail.model import CaseError
 from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs
 from pymoo_rail.sim.physics import build_kernel_model, electric_braking_capped, max_braking
@@ -228,7 +228,7 @@ def test_pneumatic_braking_maps_to_total_braking_with_electric_regen_caps():
         assert total == pytest.approx(100e3 + electric, rel=2e-5)
         assert electric_braking_capped(model, v, total) == pytest.approx(electric, rel=1e-12)
     # ... and it goes back to the same TTOBench values
-    from pymoo_rail.cases.ttobench import train_to_json
+    from pymoo_rail.cases.ttobench_writer import train_to_json
     out = train_to_json(case.train, "x")
     assert out["max pn braking force"]["value"] == pytest.approx(100.0, rel=1e-12)
     assert out["max reg braking force"]["value"] == 260.0 and out["max reg braking power"]["value"] == 4333.0

@@ -1,11 +1,10 @@
-"""Disturbed tracking (mass, adhesion, measurement noise, traction lag) and controller tuning."""
+"""Disturbed tracking (mass, adhesion, measurement noise, traction lag)."""
 
 import numpy as np
 import pytest
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.control import PID, Disturbance, draw_disturbances, track, track_disturbed
-from pymoo_rail.control.tuning import ControllerTuningProblem, controller_from_gains
 from pymoo_rail.sim import Simulator
 
 
@@ -50,13 +49,3 @@ def test_draws_are_reproducible_and_in_range():
         Disturbance(mass_factor=0.0)
     with pytest.raises(ValueError, match="unknown keys"):
         draw_disturbances(2, 0, {"wind": (0, 1)})
-
-
-def test_tuning_problem_scores_gains(metro):
-    case, ref = metro
-    p = ControllerTuningProblem(case, "pid", reference=ref, n_train=2)
-    F = p.evaluate(np.array([[0.5, 0.05, 0.0], [0.05, 0.0, 0.0]]))
-    assert F.shape == (2, 1) and np.all(F > 0) and F[0, 0] != F[1, 0]
-    assert controller_from_gains("fuzzy_pid", np.zeros(6) + 0.1).dkd == pytest.approx(0.1)
-    with pytest.raises(ValueError, match="family"):
-        ControllerTuningProblem(case, "lqr", reference=ref)

@@ -90,7 +90,7 @@ def test_a_restriction_ahead_is_kept_and_the_run_is_still_on_time(metro, policy)
     plan = policy.plan
     i = plan.position_m.shape[0] // 5
     rest = policy.replan(plan.position_m[i], plan.speed_ms[i], plan.time_s[i] - 2.0, restriction=restriction)
-    inside = (rest.position_m >= 600.0) & (rest.position_m <= 700.0 + metro.train.length_m)
+    inside = (rest.position_m >= 600.0) & (rest.position_m < 700.0 + metro.train.length_m)
     assert rest.speed_ms[inside].max() * 3.6 <= 50.0 + 1e-6
     assert plan.speed_ms[(plan.position_m >= 600.0) & (plan.position_m <= 700.0)].max() * 3.6 > 50.0
     assert abs(rest.running_time_s - PLANNED_S) <= 0.3

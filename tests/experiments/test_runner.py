@@ -219,12 +219,14 @@ def test_store_ignores_temporary_files_and_cleans_only_those_of_ended_processes(
     (store.runs_dir / f".tmp-{dead_pid}-abc.json.x1").write_text("{half a rec")  # what a kill mid-write leaves
     alive = store.runs_dir / f".tmp-{os.getppid()}-def.json.x2"  # a live process is writing it
     alive.write_text("{being written")
-    store.write({"format": RECORD_FORMAT, "run_id": "0123456789abcdef", "problem": {}, "algorithm": {},
-                 "seed": 1, "budget": {}, "n_var": 1, "n_obj": 1, "front": {}, "indicators": {}})
-    assert store.done_ids() == {"0123456789abcdef"}
-    assert [r["run_id"] for r in store.records()] == ["0123456789abcdef"]
+    run = Study("tmp", [problem("zdt1", n_var=2)], [algorithm("nsga2", pop_size=4)], budget={"n_gen": 1}).runs()[0]
+    record = execute_run(run)
+    assert record["format"] == RECORD_FORMAT
+    store.write(record)
+    assert store.done_ids() == {run.run_id}
+    assert [r["run_id"] for r in store.records()] == [run.run_id]
     store.prepare()
-    assert sorted(p.name for p in store.runs_dir.iterdir()) == sorted(["0123456789abcdef.json", alive.name])
+    assert sorted(p.name for p in store.runs_dir.iterdir()) == sorted([f"{run.run_id}.json", alive.name])
 
 
 def test_results_follow_the_current_study(pool_study_dir):

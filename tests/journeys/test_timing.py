@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pymoo_rail.cases.ttobench import TTOBenchWarning, read_track
-from pymoo_rail.journeys.timing import (
+from pymoo_rail.journeys import (
     TimingError,
     read_timing_points,
     solve_timed_journey,

@@ -5,7 +5,8 @@ import math
 import pytest
 
 from pymoo_rail.cases import list_cases, load_case
-from pymoo_rail.model import CaseError, case_from_dict, case_to_dict, read_case, write_case
+from pymoo_rail.cases import read_case, write_case
+from pymoo_rail.model import CaseError, case_from_dict, case_to_dict
 from tests.conftest import make_case_dict
 
 

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
-import ast
 import copy
 import re
+import sys
 from pathlib import Path
 
 import pytest
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 from pymoo_rail.model import CaseError, case_from_dict, case_keys
 
@@ -65,7 +70,7 @@ def test_documented_defaults_are_the_loaders(key, default):
     if key.startswith("run.legs[]"):
         data["run"]["legs"] = [dict(LEG)]
     value = _attribute(case_from_dict(data), key)
-    expected = None if default.startswith("none") else ast.literal_eval(default.strip("`"))
+    expected = None if default.startswith("none") else tomllib.loads(f"v = {default.strip('`')}")["v"]  # a TOML literal
     if expected == []:
         expected = ()
     assert value == expected, key

@@ -84,3 +84,58 @@ def test_default_step_grows_with_the_line_without_a_jump():
     cells = np.array([L / default_dx_m(case(L)) for L in lengths])
     assert np.all(np.abs(np.diff(cells)) <= 200 + 1e-6)  # continuous: no fivefold drop at one length
     assert cells[lengths >= 10_000].min() >= 8_000 - 1e-6 and cells[lengths <= 40_000].max() <= 10_000 + 1e-6
+
+
+def _naive_cell_means(groups, position_m, train_length_m):
+    """The mean over each cell of w (or of its average over the train) by brute-force quadrature."""
+    fine = np.linspace(position_m[0] - (train_length_m or 0.0), position_m[-1], 400_001)
+    w = np.zeros_like(fine)
+    for rows in groups:
+        for start, end, value in rows:
+            w[(fine >= start) & (fine < end)] += value
+    integral = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * np.diff(fine))])
+    W = lambda x: np.interp(x, fine, integral)  # noqa: E731
+    if train_length_m is None:
+        return (W(position_m[1:]) - W(position_m[:-1])) / np.diff(position_m)
+    xs = np.linspace(0.0, 1.0, 201)
+    means = []
+    for a, b in zip(position_m[:-1], position_m[1:]):
+        heads = a + (b - a) * xs
+        f = (W(heads) - W(heads - train_length_m)) / train_length_m
+        means.append(np.mean(0.5 * (f[1:] + f[:-1])))  # trapezoids on a uniform grid
+    return np.array(means)
+
+
+@pytest.mark.parametrize("train_length_m", [None, 37.0])
+def test_cell_means_of_many_rows_and_overlapping_groups_match_quadrature(train_length_m):
+    from pymoo_rail.model.grid import cell_means
+
+    rng = np.random.default_rng(3)
+    cuts = np.sort(rng.uniform(0.0, 500.0, 300))
+    edges = np.concatenate([[0.0], cuts, [500.0]])
+    tiles = [(a, b, v) for a, b, v in zip(edges[:-1], edges[1:], rng.uniform(-30, 30, edges.size - 1))]
+    loose = [(40.0, 90.0, 2.5), (90.0, 200.0, -1.0), (300.0, 310.0, 4.0)]
+    overlapping = [(10.0, 400.0, 0.5), (100.0, 150.0, 1.5)]  # one group whose rows overlap: summed in order
+    position = np.linspace(0.0, 500.0, 51)
+    got = cell_means([tiles, loose, overlapping], position, train_length_m)
+    want = _naive_cell_means([tiles, loose, overlapping], position, train_length_m)
+    assert np.allclose(got, want, atol=2e-3 * 30)
+    # exact, not approximate: the cells' means integrate to the rows' integral
+    if train_length_m is None:
+        total = sum((b - a) * v for rows in (tiles, loose, overlapping) for a, b, v in rows)
+        assert np.sum(got * np.diff(position)) == pytest.approx(total, rel=1e-12, abs=1e-9)
+
+
+def test_a_line_of_200k_gradient_rows_gives_the_rise_of_its_rows():
+    from dataclasses import replace
+
+    base = make_case()
+    length = base.line.length_m
+    edges = np.linspace(0.0, length, 200_001)
+    permille = np.random.default_rng(1).uniform(-20.0, 20.0, edges.size - 1)
+    line = replace(base.line, gradients=tuple(zip(edges[:-1].tolist(), edges[1:].tolist(), permille.tolist())),
+                   gradient_model="point_mass")
+    grid = build_grid(replace(base, line=line))
+    work_j = np.sum(grid.grade_force_n * np.diff(grid.position_m))
+    rise_m = float(np.sum(np.diff(edges) * permille) / 1000.0)
+    assert work_j == pytest.approx(base.train.mass_kg * GRAVITY_MS2 * rise_m, rel=1e-9, abs=1e-6)

@@ -9,17 +9,20 @@ from __future__ import annotations
 
 import copy
 import math
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pymoo_rail.cases import load_case
+from pymoo_rail.cases import case_path, load_case
 from pymoo_rail.model import CaseError, case_from_dict, case_to_dict
 from pymoo_rail.sim import Simulator
 
 CASE_EXAMPLES = 150
+FILE_EXAMPLES = 100
 DECISION_EXAMPLES = 60
 
 
@@ -73,7 +76,9 @@ def _dotted(path) -> str:
 NUMBER_PATHS = [p for p in _paths(BASE) if not isinstance(_at(BASE, p), list)]
 LIST_PATHS = [p for p in _paths(BASE) if isinstance(_at(BASE, p), list)]
 NEVER_A_NUMBER = [True, False, "80", "1e3", "fast", [1.0], {"v": 1.0}, math.nan, math.inf, -math.inf]
-ODD_NUMBERS = [0, 0.0, -1.0, -1e-9, 1e-12, 1e9, 1e300, -1e300, 1, 7, 10**30]
+# the audit's nonsense among them: 5e-324 t, 1e-300 km/h, 1e30 kW, 0.194 t, +-120 permille, 1e6 km/h
+ODD_NUMBERS = [0, 0.0, -1.0, -1e-9, 1e-12, 1e9, 1e300, -1e300, 1, 7, 10**30, 5e-324, 1e-300, 1e-6, 1e30, 0.194,
+               120.0, -120.0, 1e6, 1e12]
 
 mutations = st.one_of(
     st.tuples(st.just("not a number"), st.sampled_from(NUMBER_PATHS), st.sampled_from(NEVER_A_NUMBER)),
@@ -130,6 +135,54 @@ def test_a_malformed_case_gets_a_named_error_or_loads_exactly_what_was_written(m
         assert err.field and "<" not in err.field, str(err)
     else:
         assert math.isfinite(minimum) and minimum > 0
+
+
+# ---------------------------------------------------------------------------- case files
+
+TEXT = case_path("metro-a").read_text(encoding="utf-8")
+LINES = TEXT.splitlines(keepends=True)
+
+file_damage = st.one_of(
+    st.tuples(st.just("encoding"), st.sampled_from(["latin-1", "utf-16", "utf-16-le", "utf-32", "cp1252"]),
+              st.sampled_from(["ä", "Großräschen", "€", "\u00e9"])),
+    st.tuples(st.just("bom"), st.sampled_from([b"\xef\xbb\xbf", b"\xff\xfe", b"\xfe\xff"]), st.none()),
+    st.tuples(st.just("truncate"), st.integers(0, len(TEXT)), st.none()),
+    st.tuples(st.just("insert bytes"), st.integers(0, len(TEXT)), st.binary(min_size=1, max_size=8)),
+    st.tuples(st.just("nest"), st.integers(1, 200_000), st.sampled_from(["[", "{a = ", "[[", "[{b = "])),
+    st.tuples(st.just("replace line"), st.integers(0, len(LINES) - 1),
+              st.text(st.characters(codec="utf-8"), max_size=30)),
+)
+
+
+def _damaged(damage) -> bytes:
+    kind, where, what = damage
+    if kind == "encoding":
+        return TEXT.replace('name = "metro-a"', f'name = "{what}"').encode(where, errors="replace")
+    if kind == "bom":
+        return where + TEXT.encode()
+    if kind == "truncate":
+        return TEXT.encode()[:where]
+    if kind == "insert bytes":
+        raw = TEXT.encode()
+        return raw[:where] + what + raw[where:]
+    if kind == "nest":
+        closing = "]" if what.startswith("[") and "{" not in what else "}"
+        return (TEXT + f"\nextra = {what * where}1{closing * where}\n").encode()
+    return "".join(LINES[:where] + [what + "\n"] + LINES[where + 1:]).encode()
+
+
+@settings(max_examples=FILE_EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(file_damage)
+def test_a_damaged_case_file_gives_a_case_error_naming_the_file_or_loads(damage):
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "damaged.toml"
+        path.write_bytes(_damaged(damage))
+        try:
+            case = load_case(path)
+        except CaseError as err:
+            assert "damaged.toml" in str(err) and err.field, str(err)
+        else:  # loaded: e.g. a UTF-8 BOM, or a cut after the last line
+            assert case.line.length_m > 0
 
 
 # ---------------------------------------------------------------------------- decisions

@@ -49,9 +49,9 @@ def test_the_certificate_covers_the_finer_grids_where_they_wobble():
 
 def _yizhuang_section(k: int):
     from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
-    from pymoo_rail.journeys import Journey
+    from pymoo_rail.journeys import journey_from_ttobench
 
-    return Journey.from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES).sections[k]
+    return journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES).sections[k]
 
 
 def _at_request_kwh(solver, t: float) -> float:

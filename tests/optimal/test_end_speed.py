@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from pymoo_rail.model import END_SPEED_TOL_MS, CaseError
-from pymoo_rail.model.toml_io import case_from_dict, case_to_dict
+from pymoo_rail.model import case_from_dict, case_to_dict
 from pymoo_rail.optimal import OptimalSolver, min_running_time
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.sim import Simulator

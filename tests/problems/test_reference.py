@@ -163,3 +163,23 @@ def test_a_damaged_cached_front_is_set_aside_and_computed_again(cache, metro, da
     with pytest.raises(ValueError, match=f"{path.name}: column 'energy_kwh'"):
         ref.certified_front(metro, n_times=5)
     ref.forget_fronts()
+
+
+def test_front_computation_reports_progress_and_is_quiet_off_a_terminal(cache, metro, capsys, monkeypatch):
+    """Every solve is reported (a bar in a terminal, a callback for others); tests and pipes see nothing."""
+    from pymoo_rail.optimal import min_running_time
+
+    n = len(ref.front_times(min_running_time(metro, 1.0), metro.planned_time_s, 5))
+    calls = []
+    ref.compute_front(metro, 1.0, 5, progress=lambda done, total: calls.append((done, total)))
+    total = calls[-1][1]
+    assert total in (2 * n, 3 * n)  # sweep and solves alone, and a coarse sweep for a two-grid certificate
+    assert [d for d, _ in calls] == list(range(1, total + 1))  # one call per solve, in order
+    # certified_front: off when standard error is not a terminal (here: captured by pytest)
+    ref.certified_front(metro, 1.0, 5, use_cache=False)
+    assert capsys.readouterr().err == ""
+    # forced on, with the bar's delay at 0 s: the bar names the case and counts the solves
+    monkeypatch.setattr(ref, "PROGRESS_DELAY_S", 0.0)
+    ref.certified_front(metro, 1.0, 5, use_cache=False, progress=True)
+    err = capsys.readouterr().err
+    assert "certified front of metro-a" in err and f"{total}/{total}" in err

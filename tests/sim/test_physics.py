@@ -142,6 +142,7 @@ def test_stall_is_reported_not_nan():
 def _descent_case(descent_permille: float):
     """2 km flat, 2 km of descent, 1 km flat; Davis resistance and regeneration."""
     return make_case(
+        allow_implausible=["gradient"],  # -120 permille: steeper than any adhesion line, on purpose
         train={"regen_efficiency": 0.8, "regen_min_speed_kmh": 5.0,
                "resistance": {"a": 2.0, "b": 0.0, "c": 0.0005, "unit": "kN", "speed_unit": "kmh"},
                "braking": {"max_force_kn": 100.0, "regen_max_force_kn": 60.0}},

@@ -12,7 +12,7 @@ from pymoo_rail.sim import Simulator
 def _variant(edit):
     data = case_to_dict(load_case("metro-a"))  # 1000 m, 332 t, braking 1.1 m/s^2 (about 365 kN)
     edit(data)
-    return case_from_dict(data, "variant")
+    return case_from_dict(data, "variant", allow_implausible=True)  # the simulator's diagnosis behind the bounds
 
 
 def _cause(edit) -> InfeasibleCaseError:
@@ -46,3 +46,13 @@ def test_a_descent_the_train_cannot_brake_on_is_not_called_a_stall():
 def test_a_climb_too_steep_is_named():
     err = _cause(lambda d: d["line"].__setitem__("gradients", [[0.0, 500.0, 0.0], [500.0, 1000.0, 400.0]]))
     assert err.field == "line.gradients[1]" and "too steep" in str(err)
+
+
+def test_a_limit_next_to_zero_is_named_not_the_line():
+    err = _cause(lambda d: d["line"]["speed_limits"][0].__setitem__(2, 1e-300))
+    assert err.field == "line.speed_limits[0]" and "below 1 km/h" in str(err)
+
+
+def test_a_power_cap_next_to_zero_is_named_not_the_line():
+    err = _cause(lambda d: d["train"]["traction"].__setitem__("max_power_kw", 1e-6))
+    assert err.field == "train.traction.max_power_kw" and err.value == 1e-6

@@ -29,7 +29,7 @@ def add_parser(sub) -> None:
 
 
 def _timed_journey(args):
-    from pymoo_rail.journeys.timing import read_timing_points, timed_journey_from_toml, timed_journey_from_ttobench
+    from pymoo_rail.journeys.formats import read_timing_points, timed_journey_from_toml, timed_journey_from_ttobench
 
     if args.journey.endswith(".toml"):
         return timed_journey_from_toml(args.journey)

@@ -15,6 +15,8 @@ from pymoo_rail.cli.arguments import add_command, count, out_dir, say
 from pymoo_rail.cli.case_options import add_case_arguments, case_from_args
 from pymoo_rail.cli.progress import GenerationBar, ticking
 from pymoo_rail.cli.problem_options import add_problem_arguments, algorithm_from_args, problem_from_args
+from pymoo_rail.problems.encodings import encodings_help
+from pymoo_rail.problems.objectives import objectives_help
 
 ORDER = 20
 
@@ -38,11 +40,15 @@ DESCRIPTION = textwrap.dedent("""\
     error are kept inside a running-time window (--time-window; by default the minimum
     running time to 1.3 x planned, the times a timetable planner uses).""")
 
-EPILOG = textwrap.dedent("""\
-    objectives: energy (net kWh), running_time (s), time_error (|T - T_plan|, s),
-                accel_variation (comfort: sum of |a_i - a_(i-1)|, m/s^2; alias jerk),
-                stop_error (m). One objective without a time objective gets the
-                constraint |T - T_plan| <= --time-tolerance (default 1 s).
+EPILOG = "\n".join([
+    "objectives:",
+    textwrap.indent(objectives_help(), "  "),
+    "  One objective without a time objective gets the constraint |T - T_plan| <= --time-tolerance",
+    "  (default 1 s).",
+    "encodings:",
+    textwrap.indent(encodings_help(), "  "),
+    "  --partition and --n-sections set the sections of speed_codes and paced_speed_codes.",
+    ""]) + textwrap.dedent("""\
     algorithms: nsga2, moabc, grnsga2, sms-emoa, age-moea, nsga3, moead (several
                 objectives; moead has no constraint handling: it searches with the
                 constraints as a penalty); abc, de, ga, pso (one objective, e.g. with

@@ -7,8 +7,8 @@ from pathlib import Path
 
 from pymoo_rail.cli.arguments import HelpFormatter, UsageError, add_command, out_dir, say
 from pymoo_rail.cli.case_options import load_case
-from pymoo_rail.cli.commands.study import study_outputs
-from pymoo_rail.constants import OBJECTIVE_COLUMNS
+from pymoo_rail.cli.commands.study import add_trust_argument, study_outputs
+from pymoo_rail.problems.objectives import objective_columns
 
 ORDER = 90
 
@@ -36,6 +36,7 @@ def add_parser(sub) -> None:
     q.add_argument("directory", metavar="DIR", help="study directory written by 'pymoo-rail study'")
     q.add_argument("--out", default=None, metavar="DIR", help="where to write (default: DIR)")
     q.add_argument("--baseline", default=None, metavar="ALGORITHM", help="baseline of the rank-sum tests")
+    add_trust_argument(q)
     q = _add(plot_sub, "front", "a front from front.csv")
     q.add_argument("csv", metavar="CSV", help="front.csv written by 'pymoo-rail optimize'")
     q.add_argument("--x", default=None, metavar="COLUMN", help="column on the x axis (default: first objective)")
@@ -56,7 +57,7 @@ def _objective_of_column(column: str) -> str:
     """Axis label key of a front column: ``f_energy`` -> energy, ``running_time_s`` -> running_time."""
     if column.startswith("f_"):
         return column[2:]
-    for name, col in OBJECTIVE_COLUMNS.items():
+    for name, col in objective_columns().items():
         if column == col:
             return name
     return column
@@ -67,7 +68,7 @@ def _study(args) -> list[Path]:
     if not (directory / "runs").is_dir():
         raise UsageError("DIR", f"{str(directory)!r} is not a study directory (no runs/ folder)")
     out = out_dir(args.out) if args.out else directory
-    return study_outputs(directory, out, args.baseline, plots=True)
+    return study_outputs(directory, out, args.baseline, plots=True, trusted=args.trust)
 
 
 def _front(args, table, csv: Path) -> Path:

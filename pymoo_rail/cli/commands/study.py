@@ -41,15 +41,31 @@ def add_parser(sub) -> None:
                    help="start the runs seed by seed, so a study stopped early has every algorithm on every "
                         "problem for the same seeds (results are the same)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
+    add_trust_argument(p)
 
 
-def study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool) -> list[Path]:
+def add_trust_argument(p) -> None:
+    """``--trust``: allow a study file or results folder to name code to import (``module:callable``)."""
+    p.add_argument("--trust", action="store_true",
+                   help="allow problems, algorithms and operators given as 'package.module:callable' in the "
+                        "study file or results folder: importing them runs their code, so only for files you "
+                        "trust (built-in names need no trust)")
+
+
+def study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool, trusted: bool = False) -> list[Path]:
     """Write the tables (and figures) of the study stored in ``directory`` under ``out``; returns the files."""
     from pymoo_rail.experiments import load_results
+    from pymoo_rail.experiments.registry import UntrustedCodeError
     from pymoo_rail.experiments.stats import write_tables
+    from pymoo_rail.experiments.store import RecordError
     from pymoo_rail.plotting import plot_study
 
-    results = load_results(directory)
+    try:
+        results = load_results(directory, trusted=trusted)
+    except UntrustedCodeError as err:
+        raise UsageError("--trust", f"{directory / 'study.toml'}: {err}") from None
+    except RecordError as err:
+        raise UsageError("DIR", str(err)) from None
     if results.empty:
         raise RuntimeError(f"no stored runs in {directory}")
     algorithms = sorted(results["algorithm"].unique())
@@ -57,13 +73,14 @@ def study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool)
         raise UsageError("--baseline", f"unknown algorithm {baseline!r} (the study has {', '.join(algorithms)})")
     written = write_tables(results, out / "tables", baseline=baseline)
     if plots:
-        written += plot_study(results, out / "figures")
+        written += plot_study(results, out / "figures", trusted=trusted)
     return written
 
 
 def run(args) -> int:
     """Run (or resume) the study file of ``args`` and write its tables; returns the exit code."""
     from pymoo_rail.experiments import ResultStore, read_study, run_study
+    from pymoo_rail.experiments.registry import UntrustedCodeError
     from pymoo_rail.experiments.spec import StudyError
 
     try:
@@ -81,12 +98,14 @@ def run(args) -> int:
         f"{len(study.seeds)} seeds = {len(study.runs())} runs on {where}; results in {out}")
     try:
         report = run_study(study, out, workers=args.workers, scheduler=args.scheduler, progress=not args.quiet,
-                           seed_major=args.seed_major)
+                           seed_major=args.seed_major, trusted=args.trust)
+    except UntrustedCodeError as err:
+        raise UsageError("--trust", f"{args.file}: {err}") from None
     except StudyError as err:
         raise UsageError("--scheduler" if err.field == "scheduler" else "FILE", str(err)) from None
     say(str(report))
     ResultStore(out).remove_idle_locks()  # a finished study leaves no lock files behind
-    written = study_outputs(out, out, baseline, plots=not args.no_plots)
+    written = study_outputs(out, out, baseline, plots=not args.no_plots, trusted=args.trust)
     say(f"wrote {len(written)} tables and figures under {out / 'tables'}"
         + ("" if args.no_plots else f" and {out / 'figures'}"))
     return 0 if not report.failures else 1

@@ -1,15 +1,13 @@
-"""Reading and writing case files (TOML; the format: ``docs/case-format.md``)."""
+"""The case as plain data: the nested tables of ``docs/case-format.md``, to and from a :class:`Case`.
+
+Every file format reads into this structure (:mod:`pymoo_rail.cases.toml_case` parses TOML into
+it) and the fingerprints of runs hash it; the checks name fields by their paths in it.
+"""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
+from collections.abc import Sequence
 from typing import Any
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
 
 from pymoo_rail.model.case import Case, Leg
 from pymoo_rail.constants import KMH_PER_MS
@@ -18,7 +16,7 @@ from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
 
-_TOP = {"name", "source", "description", "run", "train", "line"}
+_TOP = {"name", "source", "description", "allow_implausible", "run", "train", "line"}
 _RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs", "initial_speed_kmh", "final_speed_kmh",
         "final_speed_window_kmh"}
 _LEG = {"start_m", "end_m", "planned_time_s", "dwell_s"}
@@ -68,6 +66,8 @@ def _list(value: Any, field: str, source: str) -> list:
 
 def _rows(value: Any, field: str, source: str) -> tuple[tuple, ...]:
     """An array of arrays (e.g. ``[[start_m, end_m, permille], ...]``), each checked to be an array."""
+    if isinstance(value, list) and all(type(row) is list for row in value):
+        return tuple(map(tuple, value))  # the usual case, at C speed for a line of a million rows
     return tuple(tuple(_list(row, f"{field}[{k}]", source)) for k, row in enumerate(_list(value, field, source)))
 
 
@@ -112,9 +112,16 @@ def _final_speed_ms(run: dict) -> float:
     return _speed_ms(run, "final_speed_kmh")
 
 
-def case_from_dict(data: dict, source: str = "<dict>") -> Case:
-    """Build a :class:`Case` from the parsed TOML structure; every error names the field."""
+def case_from_dict(data: dict, source: str = "<dict>", *, allow_implausible: bool | Sequence[str] | None = None) -> Case:
+    """Build a :class:`Case` from the parsed TOML structure; every error names the field.
+
+    ``allow_implausible`` (``True``, or kinds of bound) replaces the file's own key when given:
+    see :class:`Case`.
+    """
     data = _table(data, "", _TOP, {"name", "run", "train", "line"}, source)
+    allow = data.get("allow_implausible", False) if allow_implausible is None else allow_implausible
+    if not isinstance(allow, (bool, list, tuple)):
+        raise CaseError("allow_implausible", allow, "must be true, false or an array of kinds of bound", source)
     run = _table(data["run"], "run", _RUN, {"planned_time_s"}, source)
     tr = _table(data["train"], "train", _TRAIN,
                 {"mass_t", "length_m", "max_speed_kmh", "resistance", "traction", "braking"}, source)
@@ -152,36 +159,14 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
                     train=train, line=line_obj, planned_time_s=run["planned_time_s"],
                     dwell_s=run.get("dwell_s", 0.0), time_margin_s=run.get("time_margin_s", 0.0), legs=legs,
                     initial_speed_ms=_speed_ms(run, "initial_speed_kmh"),
-                    final_speed_ms=_final_speed_ms(run), final_speed_window_ms=_end_window_ms(run))
+                    final_speed_ms=_final_speed_ms(run), final_speed_window_ms=_end_window_ms(run),
+                    allow_implausible=allow)
     except CaseError as err:
         if err.source is None:
             raise CaseError(err.field, err.value, err.reason, source) from None
         raise
     except (TypeError, ValueError) as err:  # a last resort: every field above is checked by name
         raise CaseError("case", type(err).__name__, f"malformed value: {err}", source) from None
-
-
-def read_case(path: str | Path) -> Case:
-    """Read a case file."""
-    path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as err:
-        raise CaseError("toml", str(path), f"is not valid TOML: {err}", str(path)) from None
-    return case_from_dict(data, source=str(path))
-
-
-def _toml_value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
-    if isinstance(value, (int, float)):
-        return repr(float(value))
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + "}"
-    return "[" + ", ".join(_toml_value(v) for v in value) + "]"
 
 
 def case_to_dict(case: Case) -> dict:
@@ -235,31 +220,8 @@ def case_to_dict(case: Case) -> dict:
             "neutral_sections": [list(r) for r in ln.neutral_sections]}
     if ln.curve_model != "tang2020":  # the default stays out of the file (older files read the same)
         line["curve_model"] = ln.curve_model
-    return {"name": case.name, "source": case.source, "description": case.description, "run": run,
-            "train": train, "line": line}
-
-
-def write_case(case: Case, path: str | Path) -> Path:
-    """Write a case file that :func:`read_case` reads back to an equal case."""
-    data = case_to_dict(case)
-    lines: list[str] = []
-    for key in ("name", "source", "description"):
-        lines.append(f"{key} = {_toml_value(data[key])}")
-
-    def section(title: str, table: dict) -> None:
-        lines.append(f"\n[{title}]")
-        nested = []
-        for k, v in table.items():
-            if isinstance(v, dict):
-                nested.append((k, v))
-            else:
-                lines.append(f"{k} = {_toml_value(v)}")
-        for k, v in nested:
-            section(f"{title}.{k}", v)
-
-    section("run", data["run"])
-    section("train", data["train"])
-    section("line", data["line"])
-    path = Path(path)
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
+    out = {"name": case.name, "source": case.source, "description": case.description}
+    if case.allow_implausible:  # only when set: the files (and fingerprints) of other cases stay as they were
+        out["allow_implausible"] = case.allow_implausible if isinstance(case.allow_implausible, bool) \
+            else list(case.allow_implausible)
+    return {**out, "run": run, "train": train, "line": line}

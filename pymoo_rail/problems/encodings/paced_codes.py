@@ -18,56 +18,74 @@ sections: the certified optimum is the same.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from pymoo_rail.model import Case
+from pymoo_rail.problems.encodings.base import EncodingSetup, ProgramEncoding, bound_field
+from pymoo_rail.problems.encodings.speed_codes import SpeedCodes
 from pymoo_rail.sim import Simulator
 from pymoo_rail.sim.pacing import DEFAULT_TIME_TOL_S, PacedRuns, PacedSpeedCodes, section_limits_ms, solve_pace
 
 
 @dataclass(frozen=True, eq=False)
-class PacedCodes:
+class PacedCodes(ProgramEncoding):
     """Speed-code shapes (fractions of each section's limit) and a running time (s), paced.
+
+    Parameters
+    ----------
+    partition, n_sections, max_section_m, floor_kmh
+        The sections, as for :class:`~pymoo_rail.problems.encodings.SpeedCodes` (whose
+        partition this encoding uses).
+    time_tol_s : float
+        Tolerance of the pace solve (s).
 
     Attributes
     ----------
     codes : PacedSpeedCodes
-        Sections, their limits, and the pacing of a shape.
+        Set by :meth:`bind`: sections, their limits, and the pacing of a shape.
     simulator : Simulator
-        The problem's simulator (the pace solve runs on it).
+        Set by :meth:`bind`: the problem's simulator (the pace solve runs on it).
     xl, xu : numpy.ndarray
-        Bounds: 0 and 1 for the shape, then the running-time window (s) shrunk by the pace
-        solve's tolerance at both ends, so a converged solve lands inside the window.
-    time_tol_s : float
-        Tolerance of the pace solve (s).
+        Set by :meth:`bind`: 0 and 1 for the shape, then the problem's running-time window (s)
+        shrunk by the pace solve's tolerance at both ends, so a converged solve lands inside it.
     """
 
-    codes: PacedSpeedCodes
-    simulator: Simulator
-    xl: np.ndarray
-    xu: np.ndarray
+    partition: str = "gradient_limit"
+    n_sections: int | None = None
+    max_section_m: float | None = None
+    floor_kmh: float = 10.0
     time_tol_s: float = DEFAULT_TIME_TOL_S
+    codes: PacedSpeedCodes | None = bound_field()
+    simulator: Simulator | None = bound_field()
+    xl: np.ndarray | None = bound_field()
+    xu: np.ndarray | None = bound_field()
 
     name = "paced_speed_codes"
     # every run lands on the platform through the braking envelope
     constant_objectives = ("stop_error",)
-    vtype = float
 
-    @classmethod
-    def build(cls, case: Case, simulator: Simulator, boundaries_m: np.ndarray,
-              window_s: tuple[float, float], time_tol_s: float = DEFAULT_TIME_TOL_S) -> PacedCodes:
-        """The paced encoding of ``case`` on the sections ``boundaries_m``, times in ``window_s``.
+    def bind(self, setup: EncodingSetup) -> PacedCodes:
+        """The paced encoding of the setup's case, its running times in the setup's ``time_range_s``.
 
         Raises
         ------
         ValueError
-            Naming the window when it holds no running time the train can run within the solve's
-            tolerance (it must reach above the flat-out time).
+            When the problem tracks its runs, when its constraints leave the running time open
+            (no ``time_tolerance_s`` nor ``time_window_s``), or naming the window when it holds no
+            running time the train can run within the solve's tolerance (it must reach above the
+            flat-out time).
         """
-        bounds = np.asarray(boundaries_m, dtype=float)
-        lo, hi = (float(v) for v in window_s)
+        self.refuse_tracking(setup, "the pace solve moves every code together to meet a running time; "
+                                    "use speed_codes")
+        lo, hi = setup.time_range_s
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise ValueError("encoding = 'paced_speed_codes' needs time_tolerance_s or time_window_s: "
+                             "the running times its runs are paced to")
+        sections = SpeedCodes(self.partition, self.n_sections, self.max_section_m, self.floor_kmh).bind(setup)
+        case, simulator, time_tol_s = setup.case, setup.simulator, self.time_tol_s
+        bounds = sections.boundaries_m
+        window_s = setup.time_range_s
         t_min = simulator.flat_out().running_time_s
         lo = max(lo, t_min) + time_tol_s
         hi = hi - time_tol_s
@@ -77,18 +95,8 @@ class PacedCodes:
         codes = PacedSpeedCodes(boundaries_m=bounds, limits_ms=section_limits_ms(case, bounds),
                                 planned_time_s=float(case.planned_time_s))
         n = codes.n_var
-        return cls(codes=codes, simulator=simulator, xl=np.concatenate([np.zeros(n), [lo]]),
-                   xu=np.concatenate([np.ones(n), [hi]]), time_tol_s=float(time_tol_s))
-
-    @property
-    def n_var(self) -> int:
-        """Number of decision variables (one shape value per section, then the running time)."""
-        return self.xl.shape[0]
-
-    @property
-    def n_sections(self) -> int:
-        """Number of sections (shape values)."""
-        return self.codes.n_var
+        return replace(self, n_sections=n, time_tol_s=float(time_tol_s), codes=codes, simulator=simulator,
+                       xl=np.concatenate([np.zeros(n), [lo]]), xu=np.concatenate([np.ones(n), [hi]]))
 
     @property
     def boundaries_m(self) -> np.ndarray:
@@ -102,6 +110,7 @@ class PacedCodes:
 
     def paced(self, X: np.ndarray) -> PacedRuns:
         """The runs of ``X``: each shape paced to the running time in its last column (pace, program, summary)."""
+        self.bound()
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != self.n_var:
             raise ValueError(f"paced speed codes need {self.n_var} values per run, got {X.shape[1]}")
@@ -111,6 +120,9 @@ class PacedCodes:
         """Kernel programs of ``X`` (see :meth:`paced`)."""
         return self.paced(X).programs
 
-    def fixed(self) -> np.ndarray:
-        """Mask of the genes an algorithm must not change (none)."""
-        return np.zeros(self.n_var, dtype=bool)
+    def summaries(self, X: np.ndarray, runner=None) -> np.ndarray:
+        """Summaries of the paced runs of ``X`` (the pace solve has run every program already).
+
+        ``runner`` is not used: the pace solve runs on this encoding's simulator (the problem's).
+        """
+        return self.paced(np.ascontiguousarray(X)).summaries

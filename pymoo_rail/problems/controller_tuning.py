@@ -18,6 +18,7 @@ from pymoo.core.problem import Problem
 from pymoo_rail.control.controllers import PID, FuzzyPID
 from pymoo_rail.control.disturbances import draw_disturbances, track_disturbed
 from pymoo_rail.model import Case
+from pymoo_rail.problems.speed_profile import SpeedProfileProblem
 from pymoo_rail.sim import Trajectory
 from pymoo_rail.sim import kernel as k
 
@@ -44,8 +45,6 @@ def controller_from_gains(family: str, x: np.ndarray):
 def _table3_reference(case: Case) -> tuple[Trajectory, tuple[float, ...]]:
     from pymoo.algorithms.soo.nonconvex.de import DE
     from pymoo.optimize import minimize
-
-    from pymoo_rail.problems import SpeedProfileProblem
 
     p = SpeedProfileProblem(case, objectives=("energy",), encoding="braking_onset", stop_tolerance_m=None)
 

@@ -1,0 +1,153 @@
+"""The closed-loop study: seeded disturbed runs of every controller on a case, scored fairly.
+
+Each run draws one world (:func:`draw_loop_disturbances`) and drives it with every controller, so
+the controllers meet the same trains, delays and restrictions (paired samples). The energy is
+compared at equal arrival through the plan's price of time: ``cost_kwh = net energy + lambda x
+lateness``, with ``lambda`` the exact plan's price of time (the slope of the energy / running-time
+front at the planned time: what one second of running time is worth in energy there), lateness
+signed (an early arrival is credited at the same price). ``can_be_on_time`` says whether the real
+train, flat out from its late departure with the restriction known, could still arrive on time.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
+from pymoo_rail.control.advice import AdvisedDriving
+from pymoo_rail.control.closed_loop import (
+    CurveTracking,
+    LoopDisturbance,
+    OptimalControls,
+    Recovery,
+    Replanning,
+    closed_loop,
+    real_model,
+)
+from pymoo_rail.control.controllers import PID, FuzzyPID, Hysteresis
+from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction, run_trace
+from pymoo_rail.model import Case
+from pymoo_rail.model.errors import FieldError
+from pymoo_rail.sim.drivers import flat_out_program
+
+STUDY_CONTROLLERS = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis", "recovery", "replanning",
+                     "replanning_hysteresis", "optimal_controls", "advice")
+DECIDE_EVERY_S = 10.0
+# Ranges of a world (uniform), shares of the line length or of the planned time where so named
+WORLD_RANGES = {"mass_factor": (0.9, 1.15), "adhesion_factor": (0.85, 1.0), "speed_noise_kmh": (0.0, 0.5),
+                "traction_lag_s": (0.0, 0.5), "resistance_factor": (0.9, 1.2), "regen_factor": (0.85, 1.0),
+                "delay_share": (0.0, 0.06), "restriction_start_share": (0.3, 0.7),
+                "restriction_length_share": (0.04, 0.08), "announce_before_share": (0.1, 0.25)}
+P_DELAY = 0.5  # share of worlds with a late departure
+P_RESTRICTION = 0.5  # share of worlds with a temporary speed restriction
+RESTRICTION_FACTOR = 0.7  # the restriction's limit against the lowest line limit over its stretch
+
+
+def draw_loop_disturbances(case: Case, n: int, seed: int, planned_time_s: float | None = None) -> list[LoopDisturbance]:
+    """``n`` worlds for ``case`` from :data:`WORLD_RANGES`, reproducible by ``seed``."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise FieldError("n", n, "must be a positive integer")
+    planned = float(case.planned_time_s if planned_time_s is None else planned_time_s)
+    length = float(case.line.length_m)
+    rng = np.random.default_rng(seed)
+    worlds = []
+    for _ in range(n):
+        u = {k: float(rng.uniform(lo, hi)) for k, (lo, hi) in WORLD_RANGES.items()}
+        delay = u["delay_share"] * planned if rng.random() < P_DELAY else 0.0
+        restriction, announce = None, 0.0
+        if rng.random() < P_RESTRICTION:
+            start = round(u["restriction_start_share"] * length)
+            end = min(round(start + max(u["restriction_length_share"] * length, 200.0)), length)
+            lowest = min(kmh for s, e, kmh in case.line.speed_limits if s < end and e > start)
+            limit = max(5.0 * math.floor(RESTRICTION_FACTOR * lowest / 5.0), 20.0)
+            restriction = SpeedRestriction(float(start), float(end), limit)
+            announce = max(start - u["announce_before_share"] * length, 0.0)
+        worlds.append(LoopDisturbance(mass_factor=u["mass_factor"], adhesion_factor=u["adhesion_factor"],
+                                      speed_noise_kmh=u["speed_noise_kmh"], traction_lag_s=u["traction_lag_s"],
+                                      noise_seed=int(rng.integers(2**31)), departure_delay_s=delay,
+                                      resistance_factor=u["resistance_factor"], regen_factor=u["regen_factor"],
+                                      restriction=restriction, announce_m=announce))
+    return worlds
+
+
+def make_loop_controller(name: str, case: Case, policy: OptimalPolicy):
+    """A fresh controller of the study by name (:data:`STUDY_CONTROLLERS`), around ``policy`` and its plan."""
+    plan = policy.plan
+    makers = {
+        "tracking_pid": lambda: CurveTracking(plan, PID(), name=name),
+        "tracking_fuzzy_pid": lambda: CurveTracking(plan, FuzzyPID(), name=name),
+        "tracking_hysteresis": lambda: CurveTracking(plan, Hysteresis(2.0, 4.0), name=name),
+        "recovery": lambda: Recovery(plan, case, PID(), DECIDE_EVERY_S, name=name),
+        "replanning": lambda: Replanning(policy, PID(), DECIDE_EVERY_S, name=name),
+        "replanning_hysteresis": lambda: Replanning(policy, Hysteresis(2.0, 4.0), DECIDE_EVERY_S, name=name),
+        "optimal_controls": lambda: OptimalControls(policy, DECIDE_EVERY_S, name=name),
+        "advice": lambda: AdvisedDriving(policy, DECIDE_EVERY_S, name=name),
+    }
+    if name not in makers:
+        raise FieldError("controller", name, f"is unknown (known: {', '.join(makers)})")
+    return makers[name]()
+
+
+def can_be_on_time(case: Case, disturbance: LoopDisturbance, planned_time_s: float) -> bool:
+    """Whether the real train, flat out from its late departure (the restriction known), arrives by the plan."""
+    model = real_model(case, disturbance)
+    run = run_trace(model, flat_out_program(float(case.line.length_m)))
+    return bool(run.reached and disturbance.departure_delay_s + run.running_time_s <= planned_time_s)
+
+
+def loop_runs(case: Case, n_runs: int, seed: int, controllers=STUDY_CONTROLLERS, policy: OptimalPolicy | None = None,
+              planned_time_s: float | None = None, first_run: int = 0) -> pd.DataFrame:
+    """One row per (world, controller): the closed-loop study of one case.
+
+    Columns: ``case``, ``run`` (world index), ``controller``, ``net_kwh``, ``cost_kwh`` (energy
+    plus the plan's price of time times the lateness), ``lateness_s``, ``stop_error_m``,
+    ``jerk_ms2``, ``advice_changes`` (advice only), ``n_decisions``, ``can_be_on_time``,
+    ``delay_s``, ``restricted``, ``decision_cpu_ms`` (median per decision, re-planning only) and
+    ``cpu_s``. Worlds ``first_run .. first_run + n_runs - 1`` of the seeded draw.
+    """
+    planned = float(case.planned_time_s if planned_time_s is None else planned_time_s)
+    policy = OptimalPolicy(case, planned) if policy is None else policy
+    price_kwh_s = policy.lambda_w / J_PER_KWH
+    worlds = draw_loop_disturbances(case, first_run + n_runs, seed, planned)[first_run:]
+    rows = []
+    for k, world in enumerate(worlds):
+        feasible = can_be_on_time(case, world, planned)
+        for name in controllers:
+            controller = make_loop_controller(name, case, policy)
+            started = _time.process_time()
+            run = closed_loop(case, controller, world, planned_time_s=planned)
+            s = run.summary
+            cpu = getattr(controller, "cpu_s", [])
+            rows.append({"case": case.name, "run": first_run + k, "controller": name, "net_kwh": s["net_kwh"],
+                         "cost_kwh": s["net_kwh"] + price_kwh_s * s["lateness_s"], "lateness_s": s["lateness_s"],
+                         "stop_error_m": s["stop_error_m"], "jerk_ms2": s["jerk_ms2"],
+                         "advice_changes": float(controller.changes(run)) if name == "advice" else math.nan,
+                         "seconds_per_change": (run.running_time_s / max(controller.changes(run), 1)
+                                                if name == "advice" else math.nan),
+                         "n_decisions": s["n_decisions"], "reached": s["reached"], "can_be_on_time": feasible,
+                         "delay_s": world.departure_delay_s, "restricted": world.restriction is not None,
+                         "max_speed_kmh": float(np.max(run.speed_ms) * KMH_PER_MS),
+                         "decision_cpu_ms": float(np.median(cpu) * 1000.0) if cpu else math.nan,
+                         "cpu_s": _time.process_time() - started})
+    return pd.DataFrame(rows)
+
+
+def loop_summary(runs: pd.DataFrame, on_time_s: float = 2.0) -> pd.DataFrame:
+    """Per case and controller: medians, the share on time (within ``on_time_s``) among runs that can be."""
+    rows = []
+    for (case, name), g in runs.groupby(["case", "controller"], sort=False):
+        can = g[g["can_be_on_time"]]
+        rows.append({"case": case, "controller": name, "n": len(g),
+                     "median_cost_kwh": g["cost_kwh"].median(), "median_net_kwh": g["net_kwh"].median(),
+                     "median_lateness_s": g["lateness_s"].median(),
+                     "on_time_share": float((can["lateness_s"].abs() <= on_time_s).mean()) if len(can) else math.nan,
+                     "late_share": float((can["lateness_s"] > on_time_s).mean()) if len(can) else math.nan,
+                     "n_can_be_on_time": len(can), "median_stop_error_m": g["stop_error_m"].median(),
+                     "median_jerk_ms2": g["jerk_ms2"].median(),
+                     "median_seconds_per_change": g["seconds_per_change"].median(),
+                     "median_decision_cpu_ms": g["decision_cpu_ms"].median()})
+    return pd.DataFrame(rows)

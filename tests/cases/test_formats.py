@@ -1,0 +1,44 @@
+"""One reader per format behind load_case: dispatch by suffix, else by content; options reach the reader."""
+
+from __future__ import annotations
+
+import shutil
+import warnings
+
+import pytest
+
+from pymoo_rail.cases import FORMATS, case_path, format_of, from_ttobench, load_case
+from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, TTOBenchWarning
+from pymoo_rail.model import CaseError
+
+
+def test_each_format_is_found_by_suffix_and_by_content(tmp_path):
+    assert format_of(case_path("metro-a")).name == "toml"
+    assert format_of(YIZHUANG_TRACK).name == "ttobench"
+    # without a known suffix the content decides
+    toml_copy = shutil.copy(case_path("metro-a"), tmp_path / "metro-a.case")
+    json_copy = shutil.copy(YIZHUANG_TRACK, tmp_path / "yizhuang.track")
+    assert format_of(toml_copy).name == "toml" and load_case(toml_copy) == load_case("metro-a")
+    assert format_of(json_copy).name == "ttobench"
+    unknown = tmp_path / "notes.txt"
+    unknown.write_text("nothing a reader knows\n")
+    with pytest.raises(CaseError) as raised:
+        format_of(unknown)
+    assert all(f.name in str(raised.value) for f in FORMATS)
+
+
+def test_a_ttobench_track_loads_through_load_case_with_the_readers_options():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TTOBenchWarning)
+        direct = from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, "Tongjinan Rd", "Jinghai Rd", 150.0,
+                               stop_names=YIZHUANG_STOP_NAMES)
+        loaded = load_case(YIZHUANG_TRACK, train=BEIJING_SUBWAY_TRAIN, from_stop="Tongjinan Rd",
+                           to_stop="Jinghai Rd", planned_time_s=150.0, stop_names=YIZHUANG_STOP_NAMES)
+        whole = load_case(YIZHUANG_TRACK, train=BEIJING_SUBWAY_TRAIN, planned_time_s=2000.0)
+    assert loaded == direct
+    assert whole.line.length_m > 20_000  # first to last stop by default
+
+
+def test_reader_options_on_a_built_in_name_are_refused():
+    with pytest.raises(CaseError, match="options"):
+        load_case("yizhuang", train=BEIJING_SUBWAY_TRAIN)
