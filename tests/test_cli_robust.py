@@ -233,3 +233,13 @@ def test_remove_idle_locks_keeps_held_claims_and_unfinished_runs(tmp_path):
     finally:
         holder.release()
     assert sorted(p.name for p in store.locks_dir.iterdir()) == ["held.lock", "unfinished.lock"]
+
+
+def test_the_readme_lists_every_command():
+    from pathlib import Path
+
+    from pymoo_rail.cli.parser import command_modules
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    names = [module.__name__.rsplit(".", 1)[1] for module in command_modules()]
+    assert len(names) >= 10 and [n for n in names if f"| `pymoo-rail {n}" not in readme] == []
