@@ -530,6 +530,9 @@ def _defaults(target: Callable[..., Any]) -> dict[str, Any]:
     return out
 
 
+_POSITIVE_COUNTS = {"pop_size", "n_var", "n_obj", "archive_size", "n_neighbors", "k"}
+
+
 def _is_count(name: str) -> bool:
     return name.startswith("n_") or name.endswith("_size") or name in ("limit", "k")
 
@@ -544,7 +547,7 @@ def _type_mismatch(name: str, default: Any, value: Any) -> str:
     if isinstance(default, bool):
         return "" if is_bool else "must be true or false"
     if isinstance(default, int) and _is_count(name):
-        least = 1 if default > 0 else 0
+        least = 1 if name in _POSITIVE_COUNTS else 0  # local_size = 0: no local search, a real choice
         ok = isinstance(value, int) and not is_bool and value >= least
         return "" if ok else f"must be an integer >= {least}"
     if isinstance(default, (int, float)):
