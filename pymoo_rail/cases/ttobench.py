@@ -59,6 +59,7 @@ from typing import Any, Union
 
 import numpy as np
 
+from pymoo_rail.cases.json_files import load_json_object
 from pymoo_rail.model import Case, CaseError, DavisResistance, ForceCurve, Line, Train
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.line import CURVE_MODELS
@@ -127,21 +128,7 @@ def _warn(field: str, reason: str, source: str) -> None:
 
 def _load(source: Source, what: str) -> tuple[dict, str]:
     """The parsed JSON object and a label for error messages."""
-    if isinstance(source, Mapping):
-        return dict(source), f"<{what} dict>"
-    path = Path(source)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise CaseError("<file>", str(path), f"cannot read the TTOBench {what} file: {err.strerror}",
-                        str(path)) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise CaseError("<file>", str(path), f"is not valid JSON: {err}", str(path)) from None
-    if not isinstance(data, dict):
-        raise CaseError("<file>", str(path), "a TTOBench file must hold a JSON object", str(path))
-    return data, str(path)
+    return load_json_object(source, f"TTOBench {what}")
 
 
 def _number(field: str, value: Any, source: str) -> float:
@@ -720,6 +707,11 @@ def looks_like(head: bytes) -> bool:
     return text.startswith(b"{") and b'"metadata"' in text
 
 
+def read_train_file(path: Source, *, train_length_m: float | None = None) -> Train:
+    """The format registry's train reader: the :class:`Train` of a TTOBench train file."""
+    return read_train(path, train_length_m=train_length_m).train
+
+
 def read_case(track_path: Source, *, train: Source, from_stop: StopRef = 0, to_stop: StopRef = -1,
               planned_time_s: float, allow_implausible: bool | Sequence[str] | None = None, **options) -> Case:
     """The format registry's reader: ``load_case(track.json, train=..., planned_time_s=...)``.
@@ -759,7 +751,7 @@ def case_between(track: TTOBenchTrack, tt_train: TTOBenchTrain, start_m: float, 
                 allow_implausible=allow_implausible)
 
 
-__all__ = ["from_ttobench", "case_between", "read_case", "looks_like", "read_journey", "TTOBenchWarning",
+__all__ = ["from_ttobench", "case_between", "read_case", "read_train_file", "looks_like", "read_journey", "TTOBenchWarning",
            "TUNNEL_MODELS", "CLOTHOID_PIECE_M", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
            "braking_curve", "YIZHUANG_TRACK", "BEIJING_SUBWAY_TRAIN", "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M",
            "TTOBENCH_LICENSE", "TTOBENCH_NOTICE", "LIBRARY_VERSION", "DATA_DIR", "Source", "StopRef"]
