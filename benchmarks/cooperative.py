@@ -34,7 +34,7 @@ from pymoo_rail.experiments.cooperative import (
     savings_table,
     sharing_potential,
 )
-from pymoo_rail.experiments.scripts import add_study_options, lower_priority
+from pymoo_rail.experiments.report import add_study_options, lower_priority
 from pymoo_rail.problems import CooperativeTrainsProblem
 from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S
 from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem

@@ -33,6 +33,7 @@ import csv
 from pathlib import Path
 
 import numpy as np
+from pymoo_rail.experiments.report import significant
 
 BUDGET = 60_000
 POP_SIZE = 200
@@ -135,12 +136,6 @@ def load_rows(csv_path: Path) -> list[dict]:
 # ---------------------------------------------------------------------------------------------
 # Report
 # ---------------------------------------------------------------------------------------------
-
-
-def fmt(x: float) -> str:
-    if not np.isfinite(x):
-        return "nan"
-    return f"{x:.4g}" if abs(x) >= 1e-3 else f"{x:.3e}"
 
 
 def summarise(rows: list[dict]):
@@ -302,10 +297,10 @@ def first_rule_text(out: Path, df, problems) -> list[str]:
         cur = df[(df.problem == p) & (df.algorithm == "GR-NSGA-II") & df.seed.isin(seeds)]
         ref = df[(df.problem == p) & (df.algorithm == "NSGA-II") & df.seed.isin(seeds)]
         cur_acc = pd_mean(cur, "n_accepted")
-        L.append(f"| {p.upper()} | {len(seeds)} | {fmt(o.igd.mean())} / {fmt(o.sp.mean())} / "
+        L.append(f"| {p.upper()} | {len(seeds)} | {significant(o.igd.mean(), missing='nan')} / {significant(o.sp.mean(), missing='nan')} / "
                  f"{o.n_points.mean():.0f} / {o.n_accepted.mean():.0f} | "
-                 f"{fmt(cur.igd.mean())} / {fmt(cur.sp.mean())} / {cur.n_points.mean():.0f} / "
-                 f"{cur_acc:.0f} | {fmt(ref.igd.mean())} / {fmt(ref.sp.mean())} / "
+                 f"{significant(cur.igd.mean(), missing='nan')} / {significant(cur.sp.mean(), missing='nan')} / {cur.n_points.mean():.0f} / "
+                 f"{cur_acc:.0f} | {significant(ref.igd.mean(), missing='nan')} / {significant(ref.sp.mean(), missing='nan')} / "
                  f"{ref.n_points.mean():.0f} |")
     L.append("")
     return L
@@ -324,7 +319,7 @@ def write_report(out: Path, results, problems, algorithms) -> None:
     Without stored runs the report is rebuilt from the committed ``grnsga2_zdt_runs.csv`` by the
     same code (the front figures, which need the fronts, are kept as they are).
     """
-    from pymoo_rail.experiments.scripts import report_runs
+    from pymoo_rail.experiments.report import report_runs
 
     table, fronts, from_records = report_runs(results, run_row, FIELDS, out / RUNS_CSV)
     if from_records:
@@ -387,7 +382,7 @@ def write_report(out: Path, results, problems, algorithms) -> None:
         ours = {}
         for a in MAIN_PAIR:
             s = df[(df.problem == p) & (df.algorithm == a)]
-            ours[a] = f"{fmt(s.delta.mean())} / {fmt(s.gd.mean())}" if len(s) else "-"
+            ours[a] = f"{significant(s.delta.mean(), missing='nan')} / {significant(s.gd.mean(), missing='nan')}" if len(s) else "-"
         st = SEED_TABLE[p]
         L.append(f"| {p.upper()} | {DEB_2002[p][0]} / {DEB_2002[p][1]} | "
                  f"{st['NSGA-II'][0]} / {st['NSGA-II'][1]} | {st['GR-NSGA-II'][0]} / "
@@ -405,7 +400,7 @@ def write_report(out: Path, results, problems, algorithms) -> None:
             cells = []
             for a in algorithms:
                 v = df[(df.problem == p) & (df.algorithm == a)][m].dropna()
-                cells.append(f"{fmt(v.mean())} +- {fmt(v.std())} ({fmt(v.median())})" if len(v) else "-")
+                cells.append(f"{significant(v.mean(), missing='nan')} +- {significant(v.std(), missing='nan')} ({significant(v.median(), missing='nan')})" if len(v) else "-")
             pair = compare(df, p, m, *MAIN_PAIR)
             L.append(f"| {m} | " + " | ".join(cells) + f" | {pair[2] if pair else float('nan'):.2e} |")
             if pair:
@@ -465,7 +460,7 @@ def main(argv=None) -> None:
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
 
-    from pymoo_rail.experiments.scripts import lower_priority
+    from pymoo_rail.experiments.report import lower_priority
 
     lower_priority()  # share the machine politely: niceness at least 10 (not 10 more under `nice`)
     problems = [p.strip() for p in args.problems.split(",") if p.strip()]

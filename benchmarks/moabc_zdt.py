@@ -121,7 +121,7 @@ def report(out: Path, results) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from pymoo_rail.experiments.scripts import count_range, report_runs
+    from pymoo_rail.experiments.report import count_range, report_runs
     from pymoo_rail.plotting import save_figure
     from pymoo_rail.experiments.stats import rank_sum
 
@@ -210,14 +210,14 @@ def report(out: Path, results) -> None:
 
 
 def main() -> None:
-    from pymoo_rail.experiments.scripts import add_study_options
+    from pymoo_rail.experiments.report import add_study_options
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "moabc_zdt", Path(__file__).parent / "reports",
                       runs=30, workers=True)
     args = parser.parse_args()
     from pymoo_rail.experiments import load_results, run_study
-    from pymoo_rail.experiments.scripts import lower_priority
+    from pymoo_rail.experiments.report import lower_priority
 
     study = build_study(args.runs)
     if not args.report_only:

@@ -19,7 +19,7 @@ import numpy as np
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments import load_results, run_study
-from pymoo_rail.experiments.scripts import lower_priority
+from pymoo_rail.experiments.report import lower_priority
 from pymoo_rail.experiments.study_file import read_study
 from pymoo_rail.problems import TimetableProblem
 

@@ -41,6 +41,7 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.experiments.report import fixed
 
 CASE = "yizhuang"
 POP = 40  # colony: 20 employed + 20 onlookers (seed 000 5.2)
@@ -297,12 +298,6 @@ def summary_rows(ch: pd.DataFrame, base: dict, ref: dict | None) -> pd.DataFrame
     return pd.DataFrame(rows)
 
 
-def fmt(v, digits=2):
-    if v is None or (isinstance(v, float) and not np.isfinite(v)):
-        return "-"
-    return f"{v:.{digits}f}"
-
-
 def ranksum(a, b) -> str:
     """p of the two-sided rank-sum test (``pymoo_rail.experiments.stats.rank_sum``), '-' when a side has < 2 runs."""
     from pymoo_rail.experiments.stats import rank_sum
@@ -515,12 +510,12 @@ def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, r
         for _, r in rows.iterrows():
             s = seed_rows.get((r["algorithm"], r["partition"]), (None,) * 4)
             H.append(f"| {r['algorithm']} | {r['partition']} | {r['runs']} ({r['within']}) | "
-                     f"{fmt(r['best_kwh'])} / {fmt(r['mean_kwh'])} / {fmt(r['worst_kwh'])} | {fmt(r['std_kwh'], 3)} | "
-                     f"{fmt(r['best_time_s'])} | {fmt(r['mean_time_s'])} | {fmt(r['min_time_s'])}-{fmt(r['max_time_s'])} | "
-                     f"{fmt(r['save_cruise_best'], 1)} / {fmt(r['save_cruise_mean'], 1)} | "
-                     f"{fmt(r['save_coast_best'], 1)} / {fmt(r['save_coast_mean'], 1)} | "
-                     f"{fmt(r['save_flat_best'], 1)} / {fmt(r['save_flat_mean'], 1)} | {fmt(r['wall_s'], 1)} | "
-                     f"{fmt(s[0])} | {fmt(s[1])} | {fmt(s[2])} | {fmt(s[3])} |")
+                     f"{fixed(r['best_kwh'])} / {fixed(r['mean_kwh'])} / {fixed(r['worst_kwh'])} | {fixed(r['std_kwh'], 3)} | "
+                     f"{fixed(r['best_time_s'])} | {fixed(r['mean_time_s'])} | {fixed(r['min_time_s'])}-{fixed(r['max_time_s'])} | "
+                     f"{fixed(r['save_cruise_best'], 1)} / {fixed(r['save_cruise_mean'], 1)} | "
+                     f"{fixed(r['save_coast_best'], 1)} / {fixed(r['save_coast_mean'], 1)} | "
+                     f"{fixed(r['save_flat_best'], 1)} / {fixed(r['save_flat_mean'], 1)} | {fixed(r['wall_s'], 1)} | "
+                     f"{fixed(s[0])} | {fixed(s[1])} | {fixed(s[2])} | {fixed(s[3])} |")
         return H
 
     L += ["## Table 5-5: single-objective ABC vs MOABC (non-equal partition)", "",
@@ -570,7 +565,7 @@ def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, r
         L.append(f"| {part} | {g['n_front'].mean():.1f} | {g['n_within'].mean():.1f} | "
                  f"{g['front_time_error_min_s'].min():.3f} / {g['front_time_error_max_s'].median():.1f} | "
                  f"{g['front_energy_min_kwh'].min():.2f}-{g['front_energy_max_kwh'].max():.2f} | "
-                 f"{t.notna().sum()} of {len(t)} | {fmt(t.min())} / {fmt(t.mean())} / {fmt(t.max())} |")
+                 f"{t.notna().sum()} of {len(t)} | {fixed(t.min())} / {fixed(t.mean())} / {fixed(t.max())} |")
     L += [""]
 
     L += ["## Exact optimum and gaps", ""]
@@ -582,8 +577,8 @@ def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, r
               "chosen solution is to the optimum at *its own* running time (linear interpolation on a 0.25 s grid).", "",
               "| method | partition | gap best / mean / worst (%) |", "|---|---|---|"]
         for _, r in summ.iterrows():
-            L.append(f"| {r['algorithm']} | {r['partition']} | {fmt(r['gap_best'])} / {fmt(r['gap_mean'])} / "
-                     f"{fmt(r['gap_worst'])} |")
+            L.append(f"| {r['algorithm']} | {r['partition']} | {fixed(r['gap_best'])} / {fixed(r['gap_mean'])} / "
+                     f"{fixed(r['gap_worst'])} |")
         for key, label in (("cruise", "constant cruise (baseline)"), ("coast", "coast point (baseline)")):
             b = base[key]
             gap = 100.0 * (b["energy_kwh"] / float(optimum_at(ref, b["running_time_s"])) - 1.0)
@@ -611,11 +606,11 @@ def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, r
         re_ = r.get("reopt_kwh")
         cr = r.get("cruise_kwh")
         co = r.get("coast_kwh")
-        L.append(f"| {r['variant']} | {fmt(r['same_codes_kwh'])} | {fmt(r['same_codes_time_s'])} | {fmt(re_)} | "
-                 f"{fmt(r.get('reopt_time_s'))} | {fmt(cr)} | "
-                 f"{fmt(saving(cr, re_) if (re_ is not None and cr is not None) else None, 1)} | {fmt(co)} | "
-                 f"{fmt(saving(co, re_) if (re_ is not None and co is not None) else None, 1)} | "
-                 f"{fmt(r.get('flat_out_kwh'))} / {fmt(r.get('flat_out_time_s'))} |")
+        L.append(f"| {r['variant']} | {fixed(r['same_codes_kwh'])} | {fixed(r['same_codes_time_s'])} | {fixed(re_)} | "
+                 f"{fixed(r.get('reopt_time_s'))} | {fixed(cr)} | "
+                 f"{fixed(saving(cr, re_) if (re_ is not None and cr is not None) else None, 1)} | {fixed(co)} | "
+                 f"{fixed(saving(co, re_) if (re_ is not None and co is not None) else None, 1)} | "
+                 f"{fixed(r.get('flat_out_kwh'))} / {fixed(r.get('flat_out_time_s'))} |")
     L += ["", "Seed: existing strategy 21.44 kWh, ABC 19.68 kWh, MOABC 19.55 kWh, all at ~150 s. Section 5.2 "
           "draws the Simulink-tracked curve (hysteresis A = 2, B = 3) next to each recommended curve, but table 5-7 "
           "gives 20.53 kWh at 150.21 s for the MOABC curve tracked with A = 2, B = 3, so 19.55 and 19.68 are most "

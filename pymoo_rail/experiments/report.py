@@ -1,5 +1,5 @@
-"""What every study script shares: the standard options, a polite process priority and the
-per-run table a report is written from.
+"""What every benchmark script shares: the standard options, a polite process priority, the
+per-run table a report is written from, markdown tables, number formats and writing the report.
 
 The scripts in ``benchmarks/`` are thin calls of :func:`pymoo_rail.experiments.run_study`; they take
 the same three options (where the records go, where the report goes, and whether to only rebuild
@@ -11,9 +11,15 @@ is committed, so :func:`report_runs` rebuilds a report from that CSV when the re
 from __future__ import annotations
 
 import argparse
+import math
+import numbers
 import os
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Iterable, Mapping, Sequence
+
+import numpy as np
+
+from pymoo_rail.atomic import atomic_write_text
 
 
 def add_study_options(parser: argparse.ArgumentParser, work_dir: Path, reports_dir: Path, *,
@@ -116,3 +122,101 @@ def report_runs(results, run_row: Callable[[Mapping], dict], columns: Sequence[s
     if missing:
         raise ValueError(f"{committed_csv} lacks the column(s) {', '.join(missing)}: rerun the study to rebuild it")
     return table[list(columns)], {}, False
+
+
+# ------------------------------------------------------------------------------------ numbers
+def _missing(value) -> bool:
+    """None, or a number that is not finite (NaN, +-inf)."""
+    if value is None:
+        return True
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and not math.isfinite(value)
+
+
+def fixed(value, digits: int = 2, missing: str = "-") -> str:
+    """A number with ``digits`` decimals; ``missing`` for None/NaN/inf, yes/no for booleans.
+
+    Integers are written as integers, anything else (a label) as ``str(value)``.
+
+    >>> fixed(3.14159), fixed(float("nan")), fixed(True), fixed(7), fixed(2.5, 0, missing="n/a")
+    ('3.14', '-', 'yes', '7', '2')
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if _missing(value):
+        return missing
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        return f"{float(value):.{digits}f}"
+    return str(value)
+
+
+def significant(value, digits: int = 4, missing: str = "") -> str:
+    """A number with ``digits`` significant digits, in scientific notation below 1e-3 and from 1e5.
+
+    ``missing`` for None/NaN/inf, yes/no for booleans, integers as integers.
+
+    >>> significant(1234.5678), significant(0.00012345), significant(0), significant(None, missing="nan")
+    ('1235', '1.234e-04', '0', 'nan')
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if _missing(value):
+        return missing
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    value = float(value)
+    if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
+        return f"{value:.{digits - 1}e}"
+    return f"{value:.{digits}g}"
+
+
+def mean_std(values, digits: int = 4) -> str:
+    """``"mean +- sample std"`` of the finite values (:func:`significant`), one value alone, "" for none."""
+    v = np.asarray([x for x in values if not _missing(x)], dtype=float)
+    if len(v) == 0:
+        return ""
+    if len(v) == 1:
+        return significant(v[0], digits)
+    return f"{significant(v.mean(), digits)} +- {significant(v.std(ddof=1), 2)}"
+
+
+# ------------------------------------------------------------------------------------ markdown
+def markdown_rows(header: Sequence, rows: Iterable[Sequence]) -> str:
+    """A GitHub markdown table of already formatted cells (``str`` of each)."""
+    lines = ["| " + " | ".join(map(str, header)) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def markdown(table, digits: int = 4, missing: str | None = None) -> str:
+    """A DataFrame as a GitHub markdown table: floats with ``digits`` decimals, the rest by ``str``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table; its columns are the header.
+    digits : int
+        Decimals of float cells.
+    missing : str, optional
+        Cell of a NaN float (default: ``"nan"``, as Python formats it).
+    """
+    def cell(v) -> str:
+        if isinstance(v, (float, np.floating)):
+            return missing if (missing is not None and np.isnan(v)) else f"{v:.{digits}f}"
+        return str(v)
+
+    return markdown_rows(list(table.columns), ([cell(v) for v in row]
+                                               for row in table.astype(object).itertuples(index=False)))
+
+
+# ------------------------------------------------------------------------------------ files
+def write_report(path: str | Path, lines: Sequence[str], newline: bool = True) -> Path:
+    """Write a report's lines (joined by newlines, one more at the end unless ``newline=False``), atomically.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    return atomic_write_text(path, "\n".join(lines) + ("\n" if newline else ""))
