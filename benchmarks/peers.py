@@ -149,8 +149,8 @@ def parse_mseetc_output(stdout: str) -> tuple[float, float]:
         energy, cpu = float(result["energy_kwh"]), float(result["cpu_s"])
     except (json.JSONDecodeError, KeyError, TypeError) as err:
         raise ValueError(f"ms-eetc's last line {lines[-1]!r} is not JSON with energy_kwh and cpu_s") from err
-    if not (energy > 0.0 and cpu > 0.0):
-        raise ValueError(f"ms-eetc's last line {lines[-1]!r}: energy_kwh and cpu_s must be > 0")
+    if not (math.isfinite(energy) and cpu > 0.0):  # net energy < 0 on a line that descends enough
+        raise ValueError(f"ms-eetc's last line {lines[-1]!r}: energy_kwh must be finite and cpu_s > 0")
     return energy, cpu
 
 
@@ -314,14 +314,16 @@ def main_generated(args) -> None:
 
     OptimalSolver(load_case("yizhuang"), n_speeds=20).profile(150.0)  # warm-up: load the Numba cache
     load_at_start = os.getloadavg()[0]
-    seeds = range(args.first_seed, args.first_seed + args.generated)
+    seeds = args.seeds if args.seeds else range(args.first_seed, args.first_seed + args.generated)
     intervals = tuple(args.intervals)
     table = generated_rows(seeds, args.mseetc, args.mseetc_python, intervals, args.repeats)
     from optimal import markdown  # benchmarks/optimal.py (this script's directory is on sys.path)
 
     text = ["# pymoo-rail's exact solver beside ms-eetc on generated lines", "",
-            f"Written by `python benchmarks/peers.py --generated {args.generated} --first-seed {args.first_seed}"
-            f" --intervals {' '.join(map(str, intervals))} --repeats {args.repeats} --mseetc PATH`: lines"
+            "Written by `python benchmarks/peers.py "
+            + (f"--seeds {' '.join(map(str, seeds))}" if args.seeds else
+               f"--generated {args.generated} --first-seed {args.first_seed}")
+            + f" --intervals {' '.join(map(str, intervals))} --repeats {args.repeats} --mseetc PATH`: lines"
             " `pymoo_rail.cases.generate_case(seed, \"intercity\")` without curves, tunnels and neutral sections,"
             " boundary speeds at least 1 m/s (`comparable_case`), at 1.05, 1.2 and 1.5 x the minimum running time."
             " Energies net (kWh), pymoo-rail's moved to the requested time along lambda; `bound_kwh` its"
@@ -344,10 +346,11 @@ def main() -> None:
     parser.add_argument("--breakdown", action="store_true", help="also pymoo-rail's CPU time per solver kernel")
     parser.add_argument("--generated", type=int, default=0, help="instead: N generated intercity lines x 3 times")
     parser.add_argument("--first-seed", type=int, default=0, help="seed of the first generated line")
+    parser.add_argument("--seeds", type=int, nargs="+", help="instead of --generated/--first-seed: these seeds")
     parser.add_argument("--intervals", type=int, nargs="+", default=[300, 1000], help="ms-eetc's N on generated lines")
     parser.add_argument("--repeats", type=int, default=1, help="ms-eetc solves per answer (best CPU time)")
     args = parser.parse_args()
-    if args.generated:
+    if args.generated or args.seeds:
         main_generated(args)
         return
     from pymoo_rail.cases import load_case

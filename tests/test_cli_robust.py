@@ -199,3 +199,37 @@ def test_a_small_job_runs_in_one_thread_and_gives_the_threads_back(capsys, tmp_p
                        "--out", tmp_path, "-q")
     assert code == 0, err
     assert seen == [1] and numba.get_num_threads() == before
+
+
+# ---------------------------------------------------------------- a finished study leaves no lock files
+
+
+def test_a_finished_study_leaves_no_lock_files(capsys, tmp_path):
+    study = tmp_path / "s.toml"
+    study.write_text('name = "mini"\nseeds = 2\n[budget]\nn_gen = 2\n[[problems]]\nproblem = "zdt1"\nn_var = 5\n'
+                     '[[algorithms]]\nalgorithm = "nsga2"\npop_size = 8\n')
+    code, _, err = run(capsys, "study", study, "--workers", 1, "--out", tmp_path / "mini", "-q", "--no-plots")
+    assert code == 0, err
+    assert len(list((tmp_path / "mini" / "runs").glob("*.json"))) == 2
+    assert not (tmp_path / "mini" / "locks").exists()
+
+
+def test_remove_idle_locks_keeps_held_claims_and_unfinished_runs(tmp_path):
+    from filelock import FileLock
+
+    from pymoo_rail.experiments import ResultStore
+
+    store = ResultStore(tmp_path)
+    store.runs_dir.mkdir(parents=True, exist_ok=True)
+    store.locks_dir.mkdir(parents=True, exist_ok=True)
+    for run_id in ("done", "held", "unfinished"):
+        (store.locks_dir / f"{run_id}.lock").touch()
+    for run_id in ("done", "held"):
+        store.path(run_id).write_text("{}")
+    holder = FileLock(store.locks_dir / "held.lock", thread_local=False)
+    holder.acquire()
+    try:
+        assert store.remove_idle_locks() == 1
+    finally:
+        holder.release()
+    assert sorted(p.name for p in store.locks_dir.iterdir()) == ["held.lock", "unfinished.lock"]

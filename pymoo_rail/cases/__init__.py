@@ -17,12 +17,12 @@ from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
-from pymoo_rail.cases.formats import FORMATS, format_of
+from pymoo_rail.cases.formats import FORMATS, call_reader, format_of
 from pymoo_rail.cases.generate import KINDS, generate_case
 from pymoo_rail.cases.toml_case import read_case, write_case
 from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
 from pymoo_rail.cases.ttobench_writer import to_ttobench
-from pymoo_rail.model import Case, CaseError
+from pymoo_rail.model import Case, CaseError, Train
 
 _HERE = Path(__file__).resolve().parent
 
@@ -102,7 +102,8 @@ def load_case(name_or_path: str | Path, load: str | None = None, *,
     if candidate.suffix.lower() in {s for f in FORMATS for s in f.suffixes} or candidate.is_file():
         if not candidate.is_file():
             raise CaseError("path", str(candidate), "no such case file")
-        case = format_of(candidate).read_case(candidate, allow_implausible=allow_implausible, **options)
+        fmt = format_of(candidate)
+        case = call_reader(fmt.read_case, fmt.name, candidate, allow_implausible=allow_implausible, **options)
     elif options:
         raise CaseError("options", sorted(options), f"'{name_or_path}' is a built-in case: it takes no reader "
                                                     "options (they are for files of other formats)")
@@ -113,5 +114,18 @@ def load_case(name_or_path: str | Path, load: str | None = None, *,
     return case if load is None else with_load(case, load)
 
 
+def load_train(path: str | Path, **options) -> Train:
+    """The train of a file in any format of :data:`~pymoo_rail.cases.formats.FORMATS`: the
+    ``[train]`` table of a TOML file (a case, or the train alone), or a TTOBench train file
+    (``train_length_m=`` as in :func:`from_ttobench`). A train meets the plausibility bounds when
+    it joins a case."""
+    path = Path(path)
+    if not path.is_file():
+        raise CaseError("path", str(path), "no such train file")
+    fmt = format_of(path)
+    return call_reader(fmt.read_train, fmt.name, path, **options)
+
+
 __all__ = ["load_case", "generate_case", "KINDS", "list_cases", "case_path", "with_load", "LOADS_T",
-           "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench", "read_case", "write_case", "FORMATS", "format_of"]
+           "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench", "read_case", "write_case", "FORMATS", "format_of",
+           "load_train"]

@@ -13,7 +13,8 @@ from typing import Any
 
 import rtoml
 
-from pymoo_rail.model import Case, CaseError, case_from_dict, case_to_dict
+from pymoo_rail.cases.files import file_bytes
+from pymoo_rail.model import Case, CaseError, Train, case_from_dict, case_to_dict, train_from_dict
 
 SUFFIXES = (".toml",)
 
@@ -45,14 +46,22 @@ def parse_toml(raw: bytes, source: str) -> dict:
         raise CaseError("toml", source, f"is not valid TOML: {err}", source) from None
 
 
+def read_toml(path: str | Path) -> dict:
+    """The TOML document in the file at ``path``; every failure a :class:`CaseError` naming it."""
+    return parse_toml(file_bytes(path), str(path))
+
+
 def read_case(path: str | Path, *, allow_implausible: bool | Sequence[str] | None = None) -> Case:
     """Read a TOML case file (``allow_implausible`` as in :func:`~pymoo_rail.model.case_from_dict`)."""
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as err:
-        raise CaseError("path", str(path), f"cannot be read: {err.strerror or err}", str(path)) from None
-    return case_from_dict(parse_toml(raw, str(path)), source=str(path), allow_implausible=allow_implausible)
+    return case_from_dict(read_toml(path), source=str(path), allow_implausible=allow_implausible)
+
+
+def read_train(path: str | Path) -> Train:
+    """The train of a TOML file with a ``[train]`` table: a case file, or a file with the train alone."""
+    data = read_toml(path)
+    if "train" not in data:
+        raise CaseError("train", None, "is required: a train file holds a [train] table", str(path))
+    return train_from_dict(data["train"], str(path))
 
 
 def looks_like(head: bytes) -> bool:

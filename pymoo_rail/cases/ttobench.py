@@ -720,6 +720,11 @@ def looks_like(head: bytes) -> bool:
     return text.startswith(b"{") and b'"metadata"' in text
 
 
+def read_train_file(path: Source, *, train_length_m: float | None = None) -> Train:
+    """The format registry's train reader: the :class:`Train` of a TTOBench train file."""
+    return read_train(path, train_length_m=train_length_m).train
+
+
 def read_case(track_path: Source, *, train: Source, from_stop: StopRef = 0, to_stop: StopRef = -1,
               planned_time_s: float, allow_implausible: bool | Sequence[str] | None = None, **options) -> Case:
     """The format registry's reader: ``load_case(track.json, train=..., planned_time_s=...)``.
@@ -759,7 +764,7 @@ def case_between(track: TTOBenchTrack, tt_train: TTOBenchTrain, start_m: float, 
                 allow_implausible=allow_implausible)
 
 
-__all__ = ["from_ttobench", "case_between", "read_case", "looks_like", "read_journey", "TTOBenchWarning",
+__all__ = ["from_ttobench", "case_between", "read_case", "read_train_file", "looks_like", "read_journey", "TTOBenchWarning",
            "TUNNEL_MODELS", "CLOTHOID_PIECE_M", "read_track", "read_train", "TTOBenchTrack", "TTOBenchTrain",
            "braking_curve", "YIZHUANG_TRACK", "BEIJING_SUBWAY_TRAIN", "YIZHUANG_STOP_NAMES", "POINT_MASS_LENGTH_M",
            "TTOBENCH_LICENSE", "TTOBENCH_NOTICE", "LIBRARY_VERSION", "DATA_DIR", "Source", "StopRef"]

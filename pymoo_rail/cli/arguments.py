@@ -101,6 +101,11 @@ def count(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
+EXACT_SOLVER_NOTICE = ("compiling the simulator and the exact solver (first run only: Numba compiles the kernels "
+                       "of the simulation and the dynamic programme once and caches them on disk; this takes a "
+                       "while on a small machine) ...")
+"""What a first run of a command that solves exactly compiles (``add_command(compiles=...)``)."""
+
 NOTHING_KEPT = "nothing to resume: run the command again"
 
 
@@ -109,9 +114,10 @@ def add_command(subparsers, name: str, run, *, compiles: bool | str, aliases: tu
     """Add a subcommand whose ``run(args)`` gives the exit code.
 
     ``compiles`` says that the command may compile the simulator's kernels on a first run: the
-    user is told, with this text if it is one (what is compiled and roughly how long it takes). ``interrupted`` says what Ctrl-C keeps (a ``KeyboardInterrupt`` raised with a
-    message says it instead). The parser is remembered as ``args.usage_parser``: a
-    ``UsageError`` names its program.
+    user is told, with this text if it is one (what is compiled and roughly how long it takes).
+    ``interrupted`` says what Ctrl-C keeps (a ``KeyboardInterrupt`` raised with a message says it
+    instead). The parser is remembered as ``args.usage_parser``: a ``UsageError`` names its
+    program.
     """
     p = subparsers.add_parser(name, aliases=list(aliases), formatter_class=HelpFormatter, **kwargs)
     p.set_defaults(run=run, compiles=compiles, usage_parser=p, interrupted=interrupted)

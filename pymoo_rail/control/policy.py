@@ -44,6 +44,9 @@ from pymoo_rail.sim.trajectory import energy_from_summary, summary_dict
 PRICE_RATIO = 1.1
 # Lattice entries kept per line variant (each is n_nodes x n_speeds doubles: 15 MB on 48 km)
 MAX_PRICES_KEPT = 12
+# Line variants (a measured mass, a restriction) kept with their tables and cost-to-go, the
+# case's own included: a closed-loop study meets a new one in every world
+MAX_LINES_KEPT = 4
 # The re-planned run arrives within this of the plan when it can (the moved switch's resolution)
 ARRIVAL_TOL_S = 0.25
 # A re-planned run counts as on time within this of the plan (moving the switch by one cell
@@ -228,6 +231,13 @@ class OptimalPolicy:
     def _terminal(self, model: KernelModel) -> np.ndarray:
         return dp.terminal_cost(model, self.n_speeds, self.bias, self.case.end_speed_window_ms()[0])
 
+    def _forget_lines(self) -> None:
+        """Keep the case's own line and the most recently used others (each holds tables and sweeps)."""
+        nominal = (self.case.train.mass_t, None)
+        others = [key for key in self._lines if key != nominal]
+        for key in others[: max(len(others) - (MAX_LINES_KEPT - 1), 0)]:
+            del self._lines[key]
+
     # ------------------------------------------------------------------ inputs
     def _check_state(self, model: KernelModel, position_m, speed_ms, elapsed_s,
                      before_plan: bool = True) -> tuple[int, float, float]:
@@ -259,6 +269,7 @@ class OptimalPolicy:
                                                                           error=FieldError)
         key = (mass, restriction)
         if key in self._lines:
+            self._lines[key] = self._lines.pop(key)  # most recently used last
             return self._lines[key]
         base_key = (mass, None)
         if base_key not in self._lines:  # a measured mass changes every cell: new model and tables
@@ -269,11 +280,13 @@ class OptimalPolicy:
                                           self._terminal(solver.simulator.model))
         base = self._lines[base_key]
         if restriction is None:
+            self._forget_lines()
             return base
         model = restricted_model(base.model, restriction, float(self.case.train.length_m))
         tables = merged_tables(base.model, base.tables, model, self.n_speeds, self.max_targets, self.bias)
         self._lines[key] = line = _Line(model, tables, base.terminal_j)
         line.last_k = base.last_k
+        self._forget_lines()
         return line
 
     def envelope_ms(self, position_m: float, restriction: SpeedRestriction | None = None,

@@ -76,6 +76,8 @@ def draw_loop_disturbances(case: Case, n: int, seed: int, planned_time_s: float 
 
 def make_loop_controller(name: str, case: Case, policy: OptimalPolicy):
     """A fresh controller of the study by name (:data:`STUDY_CONTROLLERS`), around ``policy`` and its plan."""
+    if name not in STUDY_CONTROLLERS:
+        raise FieldError("controller", name, f"is unknown (known: {', '.join(STUDY_CONTROLLERS)})")
     plan = policy.plan
     makers = {
         "tracking_pid": lambda: CurveTracking(plan, PID(), name=name),
@@ -87,8 +89,6 @@ def make_loop_controller(name: str, case: Case, policy: OptimalPolicy):
         "optimal_controls": lambda: OptimalControls(policy, DECIDE_EVERY_S, name=name),
         "advice": lambda: AdvisedDriving(policy, DECIDE_EVERY_S, name=name),
     }
-    if name not in makers:
-        raise FieldError("controller", name, f"is unknown (known: {', '.join(makers)})")
     return makers[name]()
 
 

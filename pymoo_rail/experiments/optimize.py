@@ -189,7 +189,8 @@ def _without_front(problem, trajectory, err: Exception) -> Optimum:
     gap = trajectory.energy.net_kwh - energy
     return Optimum(f"{reason}; the nearest optimum takes {run.running_time_s:.2f} s "
                    f"({run.running_time_s - t:+.2f} s from the chosen run) and {energy:.3f} kWh: the chosen run is "
-                   f"{gap:+.3f} kWh above it (not certified){_grid_hint(problem)}", None, float(energy), float(gap), None, run)
+                   f"{gap:+.3f} kWh above it (not certified){_grid_hint(problem)}",
+                   None, float(energy), float(gap), None, run)
 
 
 def optimum_at(problem, trajectory, reference: bool = True) -> Optimum:

@@ -504,6 +504,54 @@ def _check_keywords(target: Callable[..., Any], params: Mapping[str, Any], where
             hint = f"did you mean '{close[0]}'? " if close else ""
             raise StudyError(f"{where}.{key}", params[key],
                              f"unknown parameter of {what} ({hint}accepted: {', '.join(sorted(accepted))})")
+    defaults = _defaults(target)
+    for key, value in params.items():
+        reason = _type_mismatch(key, defaults.get(key), value)
+        if reason:
+            raise StudyError(f"{where}.{key}", value, f"{reason} (parameter of {what})")
+
+
+def _defaults(target: Callable[..., Any]) -> dict[str, Any]:
+    """Default values of ``target``'s keywords (and, for a registry factory, of the classes it builds)."""
+    out: dict[str, Any] = {}
+    functions = [klass.__init__ for klass in reversed(target.__mro__) if "__init__" in vars(klass)
+                 and klass is not object] if inspect.isclass(target) else [target]
+    for module, attribute in getattr(target, "forwards_to", ()):
+        try:
+            out.update(_defaults(getattr(importlib.import_module(module), attribute)))
+        except (ImportError, AttributeError):
+            pass
+    for function in functions:
+        try:
+            parameters = inspect.signature(function).parameters.values()
+        except (TypeError, ValueError):
+            continue
+        out.update({p.name: p.default for p in parameters if p.default is not inspect.Parameter.empty})
+    return out
+
+
+def _is_count(name: str) -> bool:
+    return name.startswith("n_") or name.endswith("_size") or name in ("limit", "k")
+
+
+def _type_mismatch(name: str, default: Any, value: Any) -> str:
+    """Why ``value`` cannot stand where the signature's default is ``default`` (empty: it can).
+
+    Only plain defaults say anything: a bool wants a bool, a number a number (a count such as
+    ``pop_size`` or ``n_var`` an integer), a string a string; ``None`` or an object says nothing.
+    """
+    is_bool = isinstance(value, bool)
+    if isinstance(default, bool):
+        return "" if is_bool else "must be true or false"
+    if isinstance(default, int) and _is_count(name):
+        least = 1 if default > 0 else 0
+        ok = isinstance(value, int) and not is_bool and value >= least
+        return "" if ok else f"must be an integer >= {least}"
+    if isinstance(default, (int, float)):
+        return "" if isinstance(value, (int, float)) and not is_bool else "must be a number"
+    if isinstance(default, str) and not isinstance(value, (str, dict)):  # a name, or an operator table
+        return "must be a string"
+    return ""
 
 
 def check_parameters(spec: ProblemSpec | AlgorithmSpec, where: str, trusted: bool = False) -> None:

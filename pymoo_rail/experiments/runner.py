@@ -141,8 +141,10 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
     pf, front_reason = true_front_and_reason(problem)
     history = _History(pf) if run.history else None
     start, start_cpu = time.perf_counter(), time.process_time()
+    # pymoo 0.6.2 calls algorithm.callback unconditionally once given one: pass it only when recording
+    callback = {"callback": history} if history is not None else {}
     res = minimize(problem, algorithm, run.budget.termination, seed=run.seed, verbose=False,
-                   callback=history, copy_algorithm=False)
+                   copy_algorithm=False, **callback)
     wall_time_s = time.perf_counter() - start
     cpu_time_s = time.process_time() - start_cpu
 

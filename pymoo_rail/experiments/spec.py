@@ -321,6 +321,8 @@ class Study:
         object.__setattr__(self, "budget", budget)
         if not isinstance(self.history, bool):
             raise StudyError("history", self.history, "must be true or false")
+        if self.baseline is not None and not isinstance(self.baseline, str):
+            raise StudyError("baseline", self.baseline, "must be the label of one of the study's algorithms")
         if self.baseline is not None and self.baseline not in {a.display for a in algorithms}:
             raise StudyError("baseline", self.baseline,
                              f"is not one of the study's algorithms ({', '.join(a.display for a in algorithms)})")

@@ -364,3 +364,33 @@ class ResultStore:
             except RecordError as err:
                 raise RecordError(err.path, f"{err.reason}; run the study again to set it aside and redo "
                                             "the run") from None
+
+    def remove_idle_locks(self) -> int:
+        """Delete the lock files of stored runs that no process holds, and ``locks/`` once it is empty.
+
+        ``filelock`` leaves a lock file behind on release (deleting it there would race with a
+        process about to take it). Here a lock is deleted only while held, and only for a run
+        whose record is stored: a process that still opened the old file finds the run stored and
+        skips it, so no run is computed twice. Returns how many lock files were deleted.
+        """
+        if not self.locks_dir.is_dir() or self.locks_dir.is_symlink():
+            return 0
+        removed = 0
+        for path in sorted(self.locks_dir.glob("*.lock")):
+            if path.is_symlink() or not path.is_file() or not self.path(path.stem).is_file():
+                continue
+            lock = FileLock(path, thread_local=False)
+            try:
+                lock.acquire(timeout=0)
+            except (Timeout, OSError):
+                continue  # held by a running process, or not ours to take
+            try:
+                path.unlink(missing_ok=True)
+                removed += 1
+            finally:
+                lock.release()
+        try:
+            self.locks_dir.rmdir()  # only if empty
+        except OSError:
+            pass
+        return removed

@@ -39,8 +39,12 @@ def read_study(path: str | Path) -> Study:
         raise StudyError("path", str(path), "no such study file")
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as err:
+        raise StudyError("toml", str(path), f"not UTF-8 text ({err.reason} at byte {err.start})", str(path)) from None
     except tomllib.TOMLDecodeError as err:
         raise StudyError("toml", str(path), f"not valid TOML: {err}", str(path)) from None
+    except RecursionError:
+        raise StudyError("toml", str(path), "nested too deeply to be a study file", str(path)) from None
     return Study.from_dict(data, source=str(path))
 
 

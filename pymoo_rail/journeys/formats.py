@@ -19,7 +19,9 @@ from typing import Sequence
 import numpy as np
 
 from pymoo_rail.cases import list_cases, load_case, ttobench
-from pymoo_rail.cases.toml_case import parse_toml
+from pymoo_rail.cases.files import file_bytes
+from pymoo_rail.cases.formats import HEAD_BYTES, call_reader
+from pymoo_rail.cases.toml_case import read_toml
 from pymoo_rail.cases.ttobench import POINT_MASS_LENGTH_M, TTOBENCH_NOTICE
 from pymoo_rail.cases.ttobench_writer import track_to_json, train_to_json, ttobench_id, write_pair
 from pymoo_rail.model import CaseError
@@ -115,11 +117,7 @@ def timed_journey_from_toml(path: str | Path) -> TimedJourney:
     (a stop has both speeds 0). The rules are those of TTOBench journey files.
     """
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as err:
-        raise CaseError("<file>", str(path), f"cannot read the journey file: {err.strerror or err}", str(path)) from None
-    data = parse_toml(raw, str(path))
+    data = read_toml(path)
     for key in sorted(set(data) - _TOML_TOP):
         raise CaseError(key, data[key], f"unknown key (allowed: {', '.join(sorted(_TOML_TOP))})", str(path))
     for key in ("name", "track", "train", "timing_points"):
@@ -217,14 +215,6 @@ def journey_to_ttobench(journey: Journey, out_dir: str | Path, *, track_id: str 
 # ----------------------------------------------------------------------------------- load_journey
 
 
-def _head(path: Path) -> bytes:
-    try:
-        with path.open("rb") as fh:
-            return fh.read(4096)
-    except OSError as err:
-        raise CaseError("path", str(path), f"cannot be read: {err.strerror or err}", str(path)) from None
-
-
 def _json_keys(path: Path) -> set[str]:
     """The top-level keys of a JSON object file (empty when it is not one)."""
     try:
@@ -264,7 +254,7 @@ class JourneyFormat:
 
 
 JOURNEY_FORMATS: tuple[JourneyFormat, ...] = (
-    JourneyFormat("toml journey", ".toml", lambda p: b"timing_points" in _head(p), _read_toml_journey),
+    JourneyFormat("toml journey", ".toml", lambda p: b"timing_points" in file_bytes(p, HEAD_BYTES), _read_toml_journey),
     JourneyFormat("toml case", ".toml", lambda p: True, _read_case_journey),
     JourneyFormat("ttobench journey", ".json", lambda p: "timing points" in _json_keys(p), _read_ttobench_journey),
     JourneyFormat("ttobench track", ".json", lambda p: "stops" in _json_keys(p), _read_ttobench_track),
@@ -287,6 +277,6 @@ def load_journey(source: str | Path, **options) -> Journey | TimedJourney:
         raise CaseError("path", str(source), "no such journey file or built-in case")
     for fmt in JOURNEY_FORMATS:
         if path.suffix.lower() == fmt.suffix and fmt.matches(path):
-            return fmt.read(path, **options)
+            return call_reader(fmt.read, fmt.name, path, **options)
     known = ", ".join(f"{f.name} ({f.suffix})" for f in JOURNEY_FORMATS)
     raise CaseError("path", str(path), f"is in no known journey format (known: {known})", str(path))

@@ -36,17 +36,23 @@ def _intervals_hold(rows: np.ndarray, length_m: float, *, tile: bool) -> bool:
     return ok and bool(np.all(start[1:] >= end[:-1] - 1e-9))
 
 
-def _float_rows(rows: object, width: int) -> np.ndarray | None:
+def _float_rows(rows: object, width: int) -> tuple[np.ndarray, bool] | None:
     """``rows`` as an (n, width) float array when every row is a list or tuple of ``width`` Python
-    floats or ints, all finite; else None (the caller then checks entry by entry and names the bad one)."""
-    if not isinstance(rows, (list, tuple)) or not all(type(row) in (list, tuple) and len(row) == width
-                                                      for row in rows):
+    floats or ints, all finite, and whether ``rows`` already is a tuple of tuples of floats (kept
+    as it is then); else None (the caller then checks entry by entry and names the bad one)."""
+    if not isinstance(rows, (list, tuple)):
+        return None
+    row_types = set(map(type, rows))
+    if not row_types <= {list, tuple} or not set(map(len, rows)) <= {width}:
         return None
     flat = list(chain.from_iterable(rows))
-    if not set(map(type, flat)) <= {float, int}:
+    types = set(map(type, flat))
+    if not types <= {float, int}:
         return None
     array = np.array(flat, dtype=float).reshape(-1, width)
-    return array if np.isfinite(array).all() else None
+    if not np.isfinite(array).all():
+        return None
+    return array, isinstance(rows, tuple) and row_types <= {tuple} and types <= {float}
 
 
 def _check_intervals(field: str, rows: tuple, length_m: float, *, tile: bool, width: int,
@@ -105,9 +111,11 @@ class Line:
         check_number("line.length_m", self.length_m, positive=True)
         arrays = {}
         for name, _, width in self._ROWS:
-            array = arrays[name] = _float_rows(getattr(self, name), width)
-            if array is not None:  # all plain numbers: converted at once (linear in the rows)
-                object.__setattr__(self, name, tuple(map(tuple, array.tolist())))
+            checked = _float_rows(getattr(self, name), width)
+            arrays[name] = None if checked is None else checked[0]
+            if checked is not None:  # all plain numbers: converted at once (linear in the rows)
+                if not checked[1]:
+                    object.__setattr__(self, name, tuple(map(tuple, checked[0].tolist())))
             else:
                 rows = []
                 for k, row in enumerate(getattr(self, name)):

@@ -123,29 +123,12 @@ def case_from_dict(data: dict, source: str = "<dict>", *, allow_implausible: boo
     if not isinstance(allow, (bool, list, tuple)):
         raise CaseError("allow_implausible", allow, "must be true, false or an array of kinds of bound", source)
     run = _table(data["run"], "run", _RUN, {"planned_time_s"}, source)
-    tr = _table(data["train"], "train", _TRAIN,
-                {"mass_t", "length_m", "max_speed_kmh", "resistance", "traction", "braking"}, source)
-    res = _table(tr["resistance"], "train.resistance", _RESISTANCE, _RESISTANCE, source)
-    braking = tr["braking"]
+    train = train_from_dict(data["train"], source)
     line = _table(data["line"], "line", _LINE, {"length_m", "gradients", "speed_limits"}, source)
-    try:
+
+    def build() -> Case:
         legs = tuple(Leg(**_table(leg, f"run.legs[{k}]", _LEG, {"start_m", "end_m", "planned_time_s"}, source))
                      for k, leg in enumerate(_list(run.get("legs", []), "run.legs", source)))
-        train = Train(
-            name=tr.get("name", ""),
-            mass_t=tr["mass_t"], length_m=tr["length_m"], max_speed_kmh=tr["max_speed_kmh"],
-            rotary_factor=tr.get("rotary_factor", 0.0),
-            max_accel_ms2=tr.get("max_accel_ms2"), max_decel_ms2=tr.get("max_decel_ms2"),
-            traction_efficiency=tr.get("traction_efficiency", 1.0),
-            regen_efficiency=tr.get("regen_efficiency", 0.0),
-            regen_min_speed_kmh=tr.get("regen_min_speed_kmh", 0.0),
-            aux_power_kw=tr.get("aux_power_kw", 0.0),
-            resistance=DavisResistance(res["a"], res["b"], res["c"], res["unit"], res["speed_unit"]),
-            traction=_curve(tr["traction"], "train.traction", _CURVE, source),
-            braking=_curve(braking, "train.braking", _BRAKING, source),
-            regen_max_force_kn=braking.get("regen_max_force_kn"),
-            regen_max_power_kw=braking.get("regen_max_power_kw"),
-        )
         line_obj = Line(
             length_m=line["length_m"], gradients=_rows(line["gradients"], "line.gradients", source),
             speed_limits=_rows(line["speed_limits"], "line.speed_limits", source),
@@ -161,12 +144,48 @@ def case_from_dict(data: dict, source: str = "<dict>", *, allow_implausible: boo
                     initial_speed_ms=_speed_ms(run, "initial_speed_kmh"),
                     final_speed_ms=_final_speed_ms(run), final_speed_window_ms=_end_window_ms(run),
                     allow_implausible=allow)
+
+    return _named(build, "case", source)
+
+
+def _named(build, what: str, source: str):
+    """``build()`` with every error a :class:`CaseError` that names ``source``."""
+    try:
+        return build()
     except CaseError as err:
         if err.source is None:
             raise CaseError(err.field, err.value, err.reason, source) from None
         raise
-    except (TypeError, ValueError) as err:  # a last resort: every field above is checked by name
-        raise CaseError("case", type(err).__name__, f"malformed value: {err}", source) from None
+    except (TypeError, ValueError) as err:  # a last resort: every field is checked by name
+        raise CaseError(what, type(err).__name__, f"malformed value: {err}", source) from None
+
+
+def train_from_dict(data: Any, source: str = "<dict>") -> Train:
+    """Build a :class:`Train` from a case's ``[train]`` table; every error names the field
+    (``train.mass_t``). A train alone meets the plausibility bounds when it joins a case."""
+    tr = _table(data, "train", _TRAIN,
+                {"mass_t", "length_m", "max_speed_kmh", "resistance", "traction", "braking"}, source)
+    res = _table(tr["resistance"], "train.resistance", _RESISTANCE, _RESISTANCE, source)
+    braking = tr["braking"]
+
+    def build() -> Train:
+        return Train(
+            name=tr.get("name", ""),
+            mass_t=tr["mass_t"], length_m=tr["length_m"], max_speed_kmh=tr["max_speed_kmh"],
+            rotary_factor=tr.get("rotary_factor", 0.0),
+            max_accel_ms2=tr.get("max_accel_ms2"), max_decel_ms2=tr.get("max_decel_ms2"),
+            traction_efficiency=tr.get("traction_efficiency", 1.0),
+            regen_efficiency=tr.get("regen_efficiency", 0.0),
+            regen_min_speed_kmh=tr.get("regen_min_speed_kmh", 0.0),
+            aux_power_kw=tr.get("aux_power_kw", 0.0),
+            resistance=DavisResistance(res["a"], res["b"], res["c"], res["unit"], res["speed_unit"]),
+            traction=_curve(tr["traction"], "train.traction", _CURVE, source),
+            braking=_curve(braking, "train.braking", _BRAKING, source),
+            regen_max_force_kn=braking.get("regen_max_force_kn"),
+            regen_max_power_kw=braking.get("regen_max_power_kw"),
+        )
+
+    return _named(build, "train", source)
 
 
 def case_to_dict(case: Case) -> dict:

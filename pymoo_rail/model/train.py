@@ -41,6 +41,8 @@ class Train:
     name: str = ""
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise CaseError("train.name", self.name, f"must be a string, not {type(self.name).__name__}")
         _require("train.mass_t", self.mass_t, positive=True)
         _require("train.length_m", self.length_m, positive=True)
         _require("train.max_speed_kmh", self.max_speed_kmh, positive=True)

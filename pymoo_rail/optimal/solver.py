@@ -37,12 +37,14 @@ from pymoo_rail.sim.kernel import (
     OUT_RUNNING_TIME_S,
 )
 
-SOLVER_VERSION = "1"
+SOLVER_VERSION = "2"
 """Version of the solver's answers: bump it whenever a run the solver returns for a case can change
 (DP, search, certificate, or the simulator that replays the run), so on-disk caches of its runs
 (:func:`pymoo_rail.problems.reference.exact_points`, :func:`pymoo_rail.journeys.section_fronts`)
 stop serving the old rows; bump ``pymoo_rail.problems.reference.FRONT_VERSION`` with it.
-1: the solver of front versions 5 and 6 (rows cached before carried no version)."""
+1: the solver of front versions 5 and 6 (rows cached before carried no version); 2: the singular speeds
+as states and the end speed an equality (the shipped fronts of version 6, rest to rest, move by at
+most 0.0045 kWh, 0.005 %, within their certificates: not recomputed)."""
 DEFAULT_N_SPEEDS = 200
 DEFAULT_MAX_TARGETS = 16
 DEFAULT_TIME_TOL_S = 0.05

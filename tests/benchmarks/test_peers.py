@@ -22,11 +22,14 @@ def test_the_last_json_line_is_the_result():
     peers = _script()
     out = "This is Ipopt version 3.14\nEXIT: Optimal Solution Found.\n" '{"energy_kwh": 441.08, "cpu_s": 3.47}\n\n'
     assert peers.parse_mseetc_output(out) == (441.08, 3.47)
+    # a line that descends enough regenerates more than the train draws: net energy < 0 is a result
+    assert peers.parse_mseetc_output('{"energy_kwh": -16.0, "cpu_s": 2.7}') == (-16.0, 2.7)
 
 
 @pytest.mark.parametrize("out, message", [("", "printed nothing"), ("EXIT: Infeasible\n", "not JSON"),
                                           ('{"energy_kwh": 1.0}', "not JSON"),
-                                          ('{"energy_kwh": -1.0, "cpu_s": 2.0}', "must be > 0")])
+                                          ('{"energy_kwh": NaN, "cpu_s": 2.0}', "must be finite"),
+                                          ('{"energy_kwh": 1.0, "cpu_s": 0.0}', "cpu_s > 0")])
 def test_bad_output_names_what_is_wrong(out, message):
     with pytest.raises(ValueError, match=message):
         _script().parse_mseetc_output(out)

@@ -7,8 +7,9 @@ import warnings
 
 import pytest
 
-from pymoo_rail.cases import FORMATS, case_path, format_of, from_ttobench, load_case
-from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, TTOBenchWarning
+from pymoo_rail.cases import FORMATS, case_path, format_of, from_ttobench, load_case, load_train
+from pymoo_rail.cases.ttobench import (BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, TTOBenchWarning,
+                                       read_train)
 from pymoo_rail.model import CaseError
 
 
@@ -42,3 +43,24 @@ def test_a_ttobench_track_loads_through_load_case_with_the_readers_options():
 def test_reader_options_on_a_built_in_name_are_refused():
     with pytest.raises(CaseError, match="options"):
         load_case("yizhuang", train=BEIJING_SUBWAY_TRAIN)
+
+
+def test_missing_or_unknown_reader_options_are_named():
+    with pytest.raises(CaseError) as raised:
+        load_case(YIZHUANG_TRACK)  # a TTOBench track needs its train and planned time
+    assert raised.value.field == "options" and "train" in str(raised.value)
+    with pytest.raises(CaseError, match="toml reader"):
+        load_case(case_path("metro-a"), train=BEIJING_SUBWAY_TRAIN)
+
+
+def test_load_train_reads_a_case_file_a_train_alone_or_a_ttobench_train(tmp_path):
+    assert load_train(case_path("metro-a")) == load_case("metro-a").train
+    alone = tmp_path / "train.toml"
+    text = case_path("metro-a").read_text(encoding="utf-8")
+    alone.write_text("[train" + text.split("[train", 1)[1].split("[line]")[0], encoding="utf-8")
+    assert load_train(alone) == load_case("metro-a").train
+    assert load_train(BEIJING_SUBWAY_TRAIN) == read_train(BEIJING_SUBWAY_TRAIN).train
+    no_train = tmp_path / "empty.toml"
+    no_train.write_text('name = "x"\n')
+    with pytest.raises(CaseError, match="train"):
+        load_train(no_train)

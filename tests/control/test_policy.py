@@ -156,3 +156,12 @@ def test_restriction_from_text():
 def test_generated_positions_off_the_line_are_refused(policy, position_m):
     with pytest.raises(FieldError, match="'position_m'"):
         policy.replan(position_m, 10.0, 10.0)
+
+
+def test_line_variants_are_kept_within_bounds(metro, policy):
+    from pymoo_rail.control.policy import MAX_LINES_KEPT
+
+    for k in range(MAX_LINES_KEPT + 2):
+        policy.replan(300.0, 15.0, 25.0, mass_t=metro.train.mass_t * (1.0 + 0.01 * (k + 1)))
+    assert len(policy._lines) <= MAX_LINES_KEPT
+    assert (metro.train.mass_t, None) in policy._lines  # the case's own line stays

@@ -48,3 +48,9 @@ def test_an_unknown_journey_is_named(tmp_path):
     odd.write_text('{"metadata": {}}')
     with pytest.raises(CaseError, match="no known journey format"):
         load_journey(odd)
+
+
+def test_a_journey_file_without_its_track_is_named():
+    with pytest.raises(CaseError) as raised:
+        load_journey(JOURNEY, train=KISS)
+    assert raised.value.field == "options" and "track" in str(raised.value)

@@ -161,12 +161,16 @@ def test_a_bad_override_is_named(bad):
         case_from_dict(data)
 
 
-def test_description_and_source_must_be_text():
+def test_description_source_and_train_name_must_be_text():
     for key in ("description", "source"):
         data = dict(copy.deepcopy(BASE), **{key: 5})
         with pytest.raises(CaseError) as raised:
             case_from_dict(data, source="typed.toml")
         assert raised.value.field == key and raised.value.value == 5
+    data = _set(copy.deepcopy(BASE), ("train", "name"), 5)
+    with pytest.raises(CaseError) as raised:
+        case_from_dict(data, source="typed.toml")
+    assert raised.value.field == "train.name" and raised.value.value == 5
 
 
 def test_a_grid_too_large_for_memory_is_refused_before_allocating():

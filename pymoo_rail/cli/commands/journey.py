@@ -4,14 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pymoo_rail.cli.arguments import UsageError, add_command, out_dir, say
+from pymoo_rail.cli.arguments import EXACT_SOLVER_NOTICE, UsageError, add_command, out_dir, say
 
 ORDER = 30
 
 
 def add_parser(sub) -> None:
     """Add ``journey`` to the subcommands."""
-    p = add_command(sub, "journey", run, compiles=True,
+    p = add_command(sub, "journey", run, compiles=EXACT_SOLVER_NOTICE,
                     help="solve a TTOBench journey (timing points) with the exact solver",
                     description="Read a TTOBench journey file, its track and a train, find the least-energy run "
                                 "that meets every timing point, and write into --out: timing.csv (time and speed "

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from pymoo_rail.cli.arguments import UsageError, add_command, out_dir, positive_float, positive_int, say
+from pymoo_rail.cli.arguments import (EXACT_SOLVER_NOTICE, UsageError, add_command, out_dir, positive_float,
+                                      positive_int, say)
 from pymoo_rail.cli.case_options import add_case_arguments, case_from_args
 from pymoo_rail.cli.problem_options import add_grid_argument
 
@@ -11,7 +12,8 @@ ORDER = 40
 
 def add_parser(sub) -> None:
     """Add ``reference`` to the subcommands."""
-    p = add_command(sub, "reference", run, compiles=True, help="the exact minimum-energy front of a case",
+    p = add_command(sub, "reference", run, compiles=EXACT_SOLVER_NOTICE,
+                    help="the exact minimum-energy front of a case",
                     description="Compute the exact minimum-energy run for a range of running times (dynamic "
                                 "programming, pymoo_rail.optimal) and write optimal_front.csv / .png and the "
                                 "optimal run at the planned time (optimal_trajectory.csv, optimal_profile.png).",
