@@ -30,8 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pymoo_rail.experiments.certified import committed_members, member_cases
-from pymoo_rail.experiments.report import lower_priority, markdown, write_report
+from pymoo_rail.experiments.report import committed_members, lower_priority, markdown, member_cases, write_report
 
 REPORTS = Path(__file__).resolve().parent / "reports"
 OTHERS = {"uniform": {"top_bias": 0.0}, "fine": {"n_speeds": 400}}

@@ -35,8 +35,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from pymoo_rail.experiments.certified import committed_members, member_cases
-from pymoo_rail.experiments.report import lower_priority, markdown, write_report as write_text
+from pymoo_rail.experiments.report import committed_members, lower_priority, markdown, member_cases
+from pymoo_rail.experiments.report import write_report as write_text
 
 REPORTS = Path(__file__).resolve().parent / "reports"
 

@@ -220,3 +220,45 @@ def write_report(path: str | Path, lines: Sequence[str], newline: bool = True) -
         ``path``.
     """
     return atomic_write_text(path, "\n".join(lines) + ("\n" if newline else ""))
+
+
+# ------------------------------------------------------------------------------------ committed members
+def committed_members(reports_dir: str | Path):
+    """Every optimiser member the committed study CSVs in ``reports_dir`` hold (``benchmarks/reports``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per member: ``source``, ``case``, ``label`` (run / algorithm), ``seed``, ``member``,
+        ``running_time_s`` and ``energy_kwh``; the cases are named as :func:`member_cases` names them.
+    """
+    import pandas as pd
+
+    reports_dir = Path(reports_dir)
+    rows = []
+    y = pd.read_csv(reports_dir / "yizhuang_seed000.csv")
+    for r in y.itertuples():
+        rows.append(("yizhuang_seed000", "yizhuang", f"{r.algorithm} {r.partition}", r.seed, "best",
+                     r.running_time_s, r.energy_kwh))
+    w = pd.read_csv(reports_dir / "emu_wuguang_runs.csv")
+    for r in w.itertuples():
+        for kind, t, e in (("fastest", r.t_min, r.e_max), ("slowest", r.t_max, r.e_min),
+                           ("punctual", r.punctual_t, r.punctual_e)):
+            rows.append(("emu_wuguang", "wuguang-crh3", f"{r.algorithm} {r.problem}", r.seed, kind, t, e))
+    j = pd.read_csv(reports_dir / "journeys_fronts_simulated.csv")
+    for r in j.itertuples():
+        rows.append(("journeys", f"section {int(r.section)}", r.case, int(r.section), "strategy",
+                     r.running_time_s, r.energy_kwh))
+    return pd.DataFrame(rows, columns=["source", "case", "label", "seed", "member", "running_time_s", "energy_kwh"])
+
+
+def member_cases() -> dict:
+    """The cases the members of :func:`committed_members` ran on, by the names it gives them."""
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
+    from pymoo_rail.journeys import journey_from_ttobench
+
+    journey = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
+    cases = {"yizhuang": load_case("yizhuang"), "wuguang-crh3": load_case("wuguang-crh3")}
+    cases.update({f"section {k}": c for k, c in enumerate(journey.sections)})
+    return cases

@@ -16,7 +16,7 @@ def _script():
 
 
 def test_every_committed_member_is_read():
-    from pymoo_rail.experiments.certified import committed_members
+    from pymoo_rail.experiments.report import committed_members
 
     table = committed_members(SCRIPT.parent / "reports")
     counts = table.groupby("source").size().to_dict()
