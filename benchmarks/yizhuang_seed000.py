@@ -25,7 +25,7 @@ finishes; a restart runs only the missing ones). Run it as::
 Outputs: run records in ``--out`` (default ``out/yizhuang_seed000``, not committed), and in
 ``--reports`` (default ``benchmarks/reports``): ``yizhuang_seed000.md``, ``yizhuang_seed000.csv``
 (one row per run: the chosen solution) and ``yizhuang_seed000_*.png``. The energy-level
-variants and the reference optimum are cached in ``--out`` (``variants.json``, ``reference.csv``).
+variants and the reference optimum are cached in ``--out`` (``variants.csv``, ``reference.csv``, both :class:`pymoo_rail.rowcache.RowCache` files).
 """
 
 from __future__ import annotations
@@ -228,17 +228,23 @@ def energy_level(case, x_best, tolerance_s: float, reopt_seeds=(1, 2, 3, 4, 5)) 
     return rows
 
 
-def cached(path: Path, key: dict, compute):
-    """JSON cache keyed by the inputs, so --report-only does not recompute."""
-    if path.exists():
-        data = json.loads(path.read_text())
-        if data.get("key") == key:
-            return data["value"]
-    from pymoo_rail.atomic import atomic_write_text
+def cached_variants(path: Path, key: dict, compute) -> list[dict]:
+    """The energy variants, kept in the row cache ``path`` under ``key`` so --report-only does not recompute.
 
-    value = compute()
-    atomic_write_text(path, json.dumps({"key": key, "value": value}, indent=1, default=float))
-    return value
+    Stored one value a row (``variant``, ``quantity``, ``value``): a variant has only the values it has.
+    """
+    from pymoo_rail.rowcache import RowCache
+
+    cache = RowCache(path, value_columns=("value",), text_columns=("variant", "quantity"))
+    rows = cache.rows(key)
+    if len(rows) == 0:
+        rows = pd.DataFrame([{"variant": r["variant"], "quantity": name, "value": float(value)}
+                             for r in compute() for name, value in r.items() if name != "variant"])
+        cache.add(rows, key)
+    variants: dict[str, dict] = {}
+    for r in rows.itertuples():
+        variants.setdefault(r.variant, {"variant": r.variant})[r.quantity] = float(r.value)
+    return list(variants.values())
 
 
 # ---------------------------------------------------------------------------------------- reference
@@ -444,8 +450,8 @@ def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, r
     best_abc = best_abc.loc[best_abc["energy_kwh"].idxmin()]
     variants = []
     if energy_variants:
-        variants = cached(out / "variants.json", {"x": best_abc["x"], "tolerance_s": tolerance_s, "v": 4},
-                          lambda: energy_level(case, best_abc["x"], tolerance_s))
+        variants = cached_variants(out / "variants.csv", {"x": json.dumps(best_abc["x"], default=float), "tolerance_s": tolerance_s,
+                                                          "v": 4}, lambda: energy_level(case, best_abc["x"], tolerance_s))
 
     ref = None
     ref_traj = None
