@@ -313,6 +313,124 @@ def pd_mean(frame, column: str) -> float:
     return float(v.mean()) if len(v) else float("nan")
 
 
+def setup_lines() -> list[str]:
+    """The set-up section: budget, settings, indicators, test."""
+    L = []
+    L.append("## Set-up\n")
+    L.append(f"- Budget: {BUDGET:,} evaluations for every algorithm (`(\"n_eval\", {BUDGET})`), "
+             "i.e. the seed's 200 x 300 generations of NSGA-II. The golden-ratio variant spends "
+             "up to 60 of its ~260 evaluations per generation on the local search, so it runs "
+             "~230 generations. pymoo stops after the generation that reaches the budget; the "
+             "measured mean evaluations are in the last table.")
+    L.append("- Population 200. Crossover SBX (eta 15), polynomial mutation (eta 20).")
+    L.append("- `NSGA-II`: the seed's settings, crossover probability 0.9 and mutation probability "
+             "0.01 read as per variable (the seed does not say; with 30 variables this mutates "
+             "0.3 genes per child).")
+    L.append("- `GR-NSGA-II`: `GoldenRatioNSGA2(pop_size=200, local_size=40, pc_max=0.9, "
+             "pm_max=0.1)`, pc in [0.614, 0.9] per mating (eq. 8), pm in [0.054, 0.1] per "
+             "variable (eq. 9); other choices in the class docstring.")
+    L.append("- Ablations: `GR-NSGA-II no LS` (local_size = 0: adaptive pc/pm only) and "
+             "`NSGA-II pm=1/n` (Deb's usual per-variable mutation probability).")
+    L.append(f"- Indicators on the final non-dominated set (`res.F`), true front = "
+             f"`problem.pareto_front({N_PF})` of pymoo:")
+    L.append("  `sp` Schott spacing (seed eqs. 11-12, n - 1, city-block, raw objectives; "
+             "`pymoo_rail.indicators.Spacing`); `delta` Deb's spread; `gd` pymoo GD = mean "
+             "nearest distance to the true front (= Deb's convergence metric Upsilon); "
+             "`gd_vv` the seed's eq. 13, sqrt(sum d_i^2) / n; `igd` pymoo IGD; `hv` "
+             f"hypervolume with reference point ({HV_REF[0]}, {HV_REF[1]}). Smaller is better except hv.")
+    L.append("- p: two-sided Wilcoxon rank-sum (Mann-Whitney U) test of GR-NSGA-II against NSGA-II "
+             "(seed settings), `pymoo_rail.experiments.stats.rank_sum`: scipy's `mannwhitneyu`, exact "
+             "when a side has at most 8 runs and there are no ties, otherwise the normal "
+             "approximation with tie and continuity corrections.\n")
+    return L
+
+
+def seed_table_lines(df, problems) -> list[str]:
+    """Seed 003's table 1 beside Deb et al. 2002 and our runs."""
+    L = []
+    L.append("## Seed 003's table 1 is the NSGA-II paper's table\n")
+    L.append("Seed 003's NSGA-II column (\"SP\" and \"GD\", 10 runs, population 200, 300 "
+             "generations) equals, to every printed digit, the real-coded NSGA-II row of "
+             "Deb et al. 2002 (tables II and III: spread Delta and convergence Upsilon, "
+             "population 100, 250 generations, pm = 1/n). Its NSGA-II numbers are therefore "
+             "copied, not a fresh run, and its \"SP\" column is Deb's Delta rather than the "
+             "Schott spacing of its eq. 11. Here both algorithms run side by side in one "
+             "study with the same budget and seeds.\n")
+    L.append("| problem | Deb 2002 NSGA-II Delta / Upsilon | seed NSGA-II SP / GD | "
+             "seed GR-NSGA-II SP / GD | ours NSGA-II delta / gd | ours GR-NSGA-II delta / gd |")
+    L.append("|---|---|---|---|---|---|")
+    for p in problems:
+        ours = {}
+        for a in MAIN_PAIR:
+            s = df[(df.problem == p) & (df.algorithm == a)]
+            ours[a] = f"{significant(s.delta.mean(), missing='nan')} / {significant(s.gd.mean(), missing='nan')}" if len(s) else "-"
+        st = SEED_TABLE[p]
+        L.append(f"| {p.upper()} | {DEB_2002[p][0]} / {DEB_2002[p][1]} | "
+                 f"{st['NSGA-II'][0]} / {st['NSGA-II'][1]} | {st['GR-NSGA-II'][0]} / "
+                 f"{st['GR-NSGA-II'][1]} | {ours['NSGA-II']} | {ours['GR-NSGA-II']} |")
+    L.append("")
+    return L
+
+
+def results_lines(df, problems, algorithms) -> tuple[list[str], list]:
+    """Per problem, every metric of every algorithm; and the GR vs NSGA-II comparisons."""
+    L = []
+    L.append("## Results (mean +- std, median)\n")
+    verdict = []
+    for p in problems:
+        L.append(f"### {p.upper()}\n")
+        header = "| metric | " + " | ".join(algorithms) + " | p (GR vs NSGA-II) |"
+        L.append(header)
+        L.append("|" + "---|" * (len(algorithms) + 2))
+        for m in METRICS:
+            cells = []
+            for a in algorithms:
+                v = df[(df.problem == p) & (df.algorithm == a)][m].dropna()
+                cells.append(f"{significant(v.mean(), missing='nan')} +- {significant(v.std(), missing='nan')} ({significant(v.median(), missing='nan')})" if len(v) else "-")
+            pair = compare(df, p, m, *MAIN_PAIR)
+            L.append(f"| {m} | " + " | ".join(cells) + f" | {pair[2] if pair else float('nan'):.2e} |")
+            if pair:
+                verdict.append((p, m, *pair))
+        L.append("")
+    return L, verdict
+
+
+def budget_lines(df, problems, algorithms) -> list[str]:
+    """The evaluations, generations, front sizes and CPU time actually used."""
+    L = []
+    L.append("### Budget actually used (means per run: evaluations, generations after the initial "
+             "population, front size, CPU s)\n")
+    L.append("| problem | algorithm | n_eval | n_gen | points | cpu s |")
+    L.append("|---|---|---|---|---|---|")
+    for p in problems:
+        for a in algorithms:
+            s = df[(df.problem == p) & (df.algorithm == a)]
+            if len(s):
+                L.append(f"| {p.upper()} | {a} | {s.n_eval.mean():.0f} | {s.n_gen.mean():.0f} | "
+                         f"{s.n_points.mean():.0f} | {s.cpu_s.mean():.1f} |")
+    L.append("")
+    return L
+
+
+def verdict_lines(df, verdict) -> list[str]:
+    """The verdict table: GR-NSGA-II vs NSGA-II per problem and metric."""
+    L = []
+    L.append("## Verdict: GR-NSGA-II vs NSGA-II (seed settings)\n")
+    L.append("Relative difference of the means, (GR - NSGA-II) / NSGA-II; `better` says whether "
+             "GR-NSGA-II's mean is better; significant = p < 0.05.\n")
+    L.append("| problem | metric | GR better? | difference of means | difference of medians "
+             "| p | significant |")
+    L.append("|---|---|---|---|---|---|---|")
+    for p, m, better, rel, pval in verdict:
+        a_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[0])][m].dropna()
+        b_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[1])][m].dropna()
+        rel_med = (a_v.median() - b_v.median()) / abs(b_v.median()) * 100
+        L.append(f"| {p.upper()} | {m} | {'yes' if better else 'no'} | {pct(rel)} | "
+                 f"{pct(rel_med)} | {pval:.2e} | {'yes' if pval < 0.05 else 'no'} |")
+    L.append("")
+    return L
+
+
 def write_report(out: Path, results, problems, algorithms) -> None:
     """The report, the per-run CSV and the front plots from the stored runs (``load_results``).
 
@@ -340,98 +458,12 @@ def write_report(out: Path, results, problems, algorithms) -> None:
     L.append(f"Runs per problem and algorithm: {n_runs.min()}" +
              (f" to {n_runs.max()}" if n_runs.max() != n_runs.min() else "") +
              " (seeds 1, 2, ...; the same seeds for every algorithm).\n")
-    L.append("## Set-up\n")
-    L.append(f"- Budget: {BUDGET:,} evaluations for every algorithm (`(\"n_eval\", {BUDGET})`), "
-             "i.e. the seed's 200 x 300 generations of NSGA-II. The golden-ratio variant spends "
-             "up to 60 of its ~260 evaluations per generation on the local search, so it runs "
-             "~230 generations. pymoo stops after the generation that reaches the budget; the "
-             "measured mean evaluations are in the last table.")
-    L.append("- Population 200. Crossover SBX (eta 15), polynomial mutation (eta 20).")
-    L.append("- `NSGA-II`: the seed's settings, crossover probability 0.9 and mutation probability "
-             "0.01 read as per variable (the seed does not say; with 30 variables this mutates "
-             "0.3 genes per child).")
-    L.append("- `GR-NSGA-II`: `GoldenRatioNSGA2(pop_size=200, local_size=40, pc_max=0.9, "
-             "pm_max=0.1)`, pc in [0.614, 0.9] per mating (eq. 8), pm in [0.054, 0.1] per "
-             "variable (eq. 9); other choices in the class docstring.")
-    L.append("- Ablations: `GR-NSGA-II no LS` (local_size = 0: adaptive pc/pm only) and "
-             "`NSGA-II pm=1/n` (Deb's usual per-variable mutation probability).")
-    L.append(f"- Indicators on the final non-dominated set (`res.F`), true front = "
-             f"`problem.pareto_front({N_PF})` of pymoo:")
-    L.append("  `sp` Schott spacing (seed eqs. 11-12, n - 1, city-block, raw objectives; "
-             "`pymoo_rail.indicators.Spacing`); `delta` Deb's spread; `gd` pymoo GD = mean "
-             "nearest distance to the true front (= Deb's convergence metric Upsilon); "
-             "`gd_vv` the seed's eq. 13, sqrt(sum d_i^2) / n; `igd` pymoo IGD; `hv` "
-             f"hypervolume with reference point ({HV_REF[0]}, {HV_REF[1]}). Smaller is better except hv.")
-    L.append("- p: two-sided Wilcoxon rank-sum (Mann-Whitney U) test of GR-NSGA-II against NSGA-II "
-             "(seed settings), `pymoo_rail.experiments.stats.rank_sum`: scipy's `mannwhitneyu`, exact "
-             "when a side has at most 8 runs and there are no ties, otherwise the normal "
-             "approximation with tie and continuity corrections.\n")
-
-    L.append("## Seed 003's table 1 is the NSGA-II paper's table\n")
-    L.append("Seed 003's NSGA-II column (\"SP\" and \"GD\", 10 runs, population 200, 300 "
-             "generations) equals, to every printed digit, the real-coded NSGA-II row of "
-             "Deb et al. 2002 (tables II and III: spread Delta and convergence Upsilon, "
-             "population 100, 250 generations, pm = 1/n). Its NSGA-II numbers are therefore "
-             "copied, not a fresh run, and its \"SP\" column is Deb's Delta rather than the "
-             "Schott spacing of its eq. 11. Here both algorithms run side by side in one "
-             "study with the same budget and seeds.\n")
-    L.append("| problem | Deb 2002 NSGA-II Delta / Upsilon | seed NSGA-II SP / GD | "
-             "seed GR-NSGA-II SP / GD | ours NSGA-II delta / gd | ours GR-NSGA-II delta / gd |")
-    L.append("|---|---|---|---|---|---|")
-    for p in problems:
-        ours = {}
-        for a in MAIN_PAIR:
-            s = df[(df.problem == p) & (df.algorithm == a)]
-            ours[a] = f"{significant(s.delta.mean(), missing='nan')} / {significant(s.gd.mean(), missing='nan')}" if len(s) else "-"
-        st = SEED_TABLE[p]
-        L.append(f"| {p.upper()} | {DEB_2002[p][0]} / {DEB_2002[p][1]} | "
-                 f"{st['NSGA-II'][0]} / {st['NSGA-II'][1]} | {st['GR-NSGA-II'][0]} / "
-                 f"{st['GR-NSGA-II'][1]} | {ours['NSGA-II']} | {ours['GR-NSGA-II']} |")
-    L.append("")
-
-    L.append("## Results (mean +- std, median)\n")
-    verdict = []
-    for p in problems:
-        L.append(f"### {p.upper()}\n")
-        header = "| metric | " + " | ".join(algorithms) + " | p (GR vs NSGA-II) |"
-        L.append(header)
-        L.append("|" + "---|" * (len(algorithms) + 2))
-        for m in METRICS:
-            cells = []
-            for a in algorithms:
-                v = df[(df.problem == p) & (df.algorithm == a)][m].dropna()
-                cells.append(f"{significant(v.mean(), missing='nan')} +- {significant(v.std(), missing='nan')} ({significant(v.median(), missing='nan')})" if len(v) else "-")
-            pair = compare(df, p, m, *MAIN_PAIR)
-            L.append(f"| {m} | " + " | ".join(cells) + f" | {pair[2] if pair else float('nan'):.2e} |")
-            if pair:
-                verdict.append((p, m, *pair))
-        L.append("")
-
-    L.append("### Budget actually used (means per run: evaluations, generations after the initial "
-             "population, front size, CPU s)\n")
-    L.append("| problem | algorithm | n_eval | n_gen | points | cpu s |")
-    L.append("|---|---|---|---|---|---|")
-    for p in problems:
-        for a in algorithms:
-            s = df[(df.problem == p) & (df.algorithm == a)]
-            if len(s):
-                L.append(f"| {p.upper()} | {a} | {s.n_eval.mean():.0f} | {s.n_gen.mean():.0f} | "
-                         f"{s.n_points.mean():.0f} | {s.cpu_s.mean():.1f} |")
-    L.append("")
-
-    L.append("## Verdict: GR-NSGA-II vs NSGA-II (seed settings)\n")
-    L.append("Relative difference of the means, (GR - NSGA-II) / NSGA-II; `better` says whether "
-             "GR-NSGA-II's mean is better; significant = p < 0.05.\n")
-    L.append("| problem | metric | GR better? | difference of means | difference of medians "
-             "| p | significant |")
-    L.append("|---|---|---|---|---|---|---|")
-    for p, m, better, rel, pval in verdict:
-        a_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[0])][m].dropna()
-        b_v = df[(df.problem == p) & (df.algorithm == MAIN_PAIR[1])][m].dropna()
-        rel_med = (a_v.median() - b_v.median()) / abs(b_v.median()) * 100
-        L.append(f"| {p.upper()} | {m} | {'yes' if better else 'no'} | {pct(rel)} | "
-                 f"{pct(rel_med)} | {pval:.2e} | {'yes' if pval < 0.05 else 'no'} |")
-    L.append("")
+    L.extend(setup_lines())
+    L.extend(seed_table_lines(df, problems))
+    metric_lines, verdict = results_lines(df, problems, algorithms)
+    L.extend(metric_lines)
+    L.extend(budget_lines(df, problems, algorithms))
+    L.extend(verdict_lines(df, verdict))
     L.extend(verdict_text(df, problems, algorithms))
 
     if set(MAIN_PAIR) <= set(algorithms) and n_runs.min() >= 30:
