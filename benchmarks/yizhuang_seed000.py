@@ -41,7 +41,10 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.control import Hysteresis, track
 from pymoo_rail.experiments.report import fixed
+from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
+from pymoo_rail.plotting.style import new_figure
 
 CASE = "yizhuang"
 POP = 40  # colony: 20 employed + 20 onlookers (seed 000 5.2)
@@ -333,15 +336,21 @@ def _restyle_comparison_lines(ax) -> None:
 
 def figures(case, ch: pd.DataFrame, results: dict, reports: Path, ref_traj, ref: dict | None,
             tolerance_s: float) -> list[str]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from pymoo_rail.control import Hysteresis, track
-    from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
-    from pymoo_rail.plotting.style import new_figure
-
+    """Draw the report's figures (profiles, MOABC front, ABC convergence); their file names."""
     names = []
     # best recommended profile of each algorithm and partition (figs. 5-4, 5-6, 5-7)
+    profile_figures(case, tolerance_s, ref_traj, reports, names, ch)
+
+    # MOABC front (fig. 5-5): the archive of the run with the best choice, and the union over seeds
+    front_figure(results, ch, ref, reports, names, tolerance_s, case)
+
+    # convergence of ABC's best feasible energy over cycles (fig. 5-3)
+    convergence_figure(results, tolerance_s, reports, names)
+    return names
+
+
+def profile_figures(case, tolerance_s, ref_traj, reports, names, ch):
+    """Figs. 5-4, 5-6, 5-7: the best recommended profile of each algorithm and partition, tracked and beside the optimum."""
     for (alg, part), g in ch.dropna(subset=["energy_kwh"]).groupby(["algorithm", "partition"], sort=False):
         b = g.loc[g["energy_kwh"].idxmin()]
         p = make_problem(case, part, tolerance_s)
@@ -364,7 +373,9 @@ def figures(case, ch: pd.DataFrame, results: dict, reports: Path, ref_traj, ref:
         save_figure(fig, reports / name)
         names.append(name)
 
-    # MOABC front (fig. 5-5): the archive of the run with the best choice, and the union over seeds
+
+def front_figure(results, ch, ref, reports, names, tolerance_s, case):
+    """Fig. 5-5: the MOABC archive of the run with the best choice, the union over seeds, the exact optimum."""
     mo = results["MOABC"]
     mo = mo[mo["problem"] == NON_EQUAL]
     chm = ch[(ch["algorithm"] == "MOABC") & (ch["partition"] == NON_EQUAL)].dropna(subset=["energy_kwh"])
@@ -402,7 +413,9 @@ def figures(case, ch: pd.DataFrame, results: dict, reports: Path, ref_traj, ref:
         save_figure(fig, reports / name)
         names.append(name)
 
-    # convergence of ABC's best feasible energy over cycles (fig. 5-3)
+
+def convergence_figure(results, tolerance_s, reports, names):
+    """Fig. 5-3: ABC's best feasible energy over the cycles (median and quartiles of the seeds, best seed)."""
     ab = results["ABC"]
     fig, axes = new_figure(1, 1, figsize=(8.0, 4.6))
     ax = axes[0, 0]
@@ -431,7 +444,6 @@ def figures(case, ch: pd.DataFrame, results: dict, reports: Path, ref_traj, ref:
     name = "yizhuang_seed000_convergence.png"
     save_figure(fig, reports / name)
     names.append(name)
-    return names
 
 
 def write_report(out: Path, reports: Path, seeds, tolerance_s: float, n_equal, reference: bool,
