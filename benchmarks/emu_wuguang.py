@@ -350,10 +350,9 @@ def punctual_choices(results, rows, problems_by_label: dict) -> dict:
 def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path, prefix: str, exact=None,
                  exact_profile=None) -> dict:
     import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
 
     from pymoo_rail.experiments import stats
-    from pymoo_rail.plotting import plot_boxplots, plot_fronts, plot_speed_profile, save_figure
+    from pymoo_rail.plotting import plot_boxplots, plot_fronts, save_figure
 
     label = MAIN_ENCODING
     problem = problems_by_label[label]
@@ -393,6 +392,19 @@ def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path
     ax.axhline(planned, color="0.5", lw=0.8, ls=":")
     paths["fronts_zoom"] = save_figure(fig, out / f"{prefix}_fronts_zoom.png")
 
+    paths["profile"] = profile_figure(chosen, label, exact_profile, planned, exact, problem, out / f"{prefix}_profile.png")
+
+    fig = plot_boxplots(results, "hv_ref")
+    paths["box_hv"] = save_figure(fig, out / f"{prefix}_box_hv.png")
+    return paths
+
+
+def profile_figure(chosen, label, exact_profile, planned, exact, problem, path: Path) -> Path:
+    """Fig. 12: the most punctual GR-NSGA-II and NSGA-II profiles, and the exact optimum when it was solved."""
+    from matplotlib.lines import Line2D
+
+    from pymoo_rail.plotting import plot_speed_profile, save_figure
+
     gr_traj = chosen[label, GR_LABEL]["trajectory"]
     ns_traj = chosen[label, NSGA2_LABEL]["trajectory"]
     others = [ns_traj]
@@ -415,11 +427,7 @@ def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path
                for h, lab in zip(legend.legend_handles, labels)]
     ax.set_ylim(0.0, 420.0)
     ax.legend(handles, labels, fontsize="small", loc="upper center", ncol=3, framealpha=0.9)
-    paths["profile"] = save_figure(fig, out / f"{prefix}_profile.png")
-
-    fig = plot_boxplots(results, "hv_ref")
-    paths["box_hv"] = save_figure(fig, out / f"{prefix}_box_hv.png")
-    return paths
+    return save_figure(fig, path)
 
 
 # ------------------------------------------------------------------------------ report
@@ -502,6 +510,33 @@ def write_report(path: Path, ctx: dict) -> None:
     encodings = [e for e in ENCODINGS if any(r["problem"] == e for r in rows)]
     case, problem = ctx["case"], ctx["problems"][label]
     paths = ctx["paths"]
+    lines = head_lines(ctx, case, problem, label, encodings)
+    lines += encoding_section(enc_rows, ctx["n_var"], ctx["n_fixed"])
+    lines += ["", ctx.get("encoding_note", "").strip(), ""]
+
+    lines += ["## 2. Fronts (figs. 10-11) and table 4", "",
+              f"![fronts]({paths['fronts'].name})", "",
+              f"![fronts overlaid]({paths['fronts_overlay'].name})", "",
+              f"![fronts near 1050 s]({paths['fronts_zoom'].name})", ""]
+    for enc in encodings:
+        lines += [f"Table 4 ({enc}): mean +- std over the runs; the seed's values in the last columns (its line "
+                  "profile differs: only magnitudes compare).", "", table4(rows, enc), ""]
+
+    lines += ["## 3. Does GR-NSGA-II beat NSGA-II? (rank-sum test)", ""]
+    for enc in encodings:
+        lines += [f"**{enc}**", "", tests_table(rows, enc), ""]
+    lines += [f"![hypervolume]({paths['box_hv'].name})", ""]
+
+    lines += table5_lines(encodings, ctx, rows, paths)
+
+    lines += exact_front_lines(ctx)
+    lines += verification_lines(ctx, case)
+    lines += ["## 7. Verdict", "", ctx["verdict"].strip(), ""]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def head_lines(ctx, case, problem, label, encodings):
+    """Title, set-up and section 1 of the report."""
     lines = [
         "# CRH3 EMU on the Wuhan-Guangzhou line: golden-ratio NSGA-II vs NSGA-II (seed 003, 4.2)",
         "",
@@ -560,22 +595,12 @@ def write_report(path: Path, ctx: dict) -> None:
         "alpha = 0.05, `-` worse, `=` no significant difference.",
         "",
     ]
-    lines += encoding_section(enc_rows, ctx["n_var"], ctx["n_fixed"])
-    lines += ["", ctx.get("encoding_note", "").strip(), ""]
+    return lines
 
-    lines += ["## 2. Fronts (figs. 10-11) and table 4", "",
-              f"![fronts]({paths['fronts'].name})", "",
-              f"![fronts overlaid]({paths['fronts_overlay'].name})", "",
-              f"![fronts near 1050 s]({paths['fronts_zoom'].name})", ""]
-    for enc in encodings:
-        lines += [f"Table 4 ({enc}): mean +- std over the runs; the seed's values in the last columns (its line "
-                  "profile differs: only magnitudes compare).", "", table4(rows, enc), ""]
 
-    lines += ["## 3. Does GR-NSGA-II beat NSGA-II? (rank-sum test)", ""]
-    for enc in encodings:
-        lines += [f"**{enc}**", "", tests_table(rows, enc), ""]
-    lines += [f"![hypervolume]({paths['box_hv'].name})", ""]
-
+def table5_lines(encodings, ctx, rows, paths):
+    """Section 4: the most punctual solutions (table 5) and fig. 12."""
+    lines = []
     lines += ["## 4. Most punctual solutions (table 5) and fig. 12", "",
               "The front member closest to 1050 s (ties: lower energy) of each algorithm's median-HV run (the "
               "runs of figs. 10-11), re-simulated; then the mean over all runs.", ""]
@@ -598,7 +623,12 @@ def write_report(path: Path, ctx: dict) -> None:
                         "traction / regen (kWh)", "all runs: energy (kWh)", "all runs: time (s)",
                         "all runs: least E with T <= 1050 s", "seed 003 table 5"], t5), "",
               f"![profile]({paths['profile'].name})", ""]
+    return lines
 
+
+def exact_front_lines(ctx):
+    """Section 5: the exact front (when it was solved)."""
+    lines = []
     if ctx["exact"] is not None:
         ex = ctx["exact"]
         lines += ["## 5. The exact front", "",
@@ -613,6 +643,12 @@ def write_report(path: Path, ctx: dict) -> None:
                              f"{r.traction_kwh:.1f} / {r.regen_kwh:.1f}", f"{r.lambda_kwh_per_s:.3f}",
                              significant(r.neutral_traction_j), significant(r.limit_excess_ms), significant(r.stop_error_m),
                              f"{r.solve_s:.0f}"] for r in ex.itertuples()]), ""]
+    return lines
+
+
+def verification_lines(ctx, case):
+    """Section 6: the checks of every front member."""
+    lines = []
     ver = ctx["verification"]
     lines += ["## 6. Verification of every front member", "",
               f"Each feasible member of every final front ({ver['n_members']} members of {ver['n_runs']} runs, the "
@@ -638,8 +674,7 @@ def write_report(path: Path, ctx: dict) -> None:
         ["stored vs re-simulated running time (s)", significant(ver["time_mismatch_s"]), "0", ver["time_ok"]],
         ["neutral-section genes at their fixed value (10 km/h, coast)", "", "all members", ver["fixed_ok"]],
     ]), "", f"**All {ver['n_members']} members pass: {'yes' if ver['all_ok'] else 'NO'}.**", ""]
-    lines += ["## 7. Verdict", "", ctx["verdict"].strip(), ""]
-    path.write_text("\n".join(lines) + "\n")
+    return lines
 
 
 def verification_summary(rows) -> dict:
