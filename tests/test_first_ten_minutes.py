@@ -227,7 +227,8 @@ def test_first_run_compiles_each_kernel_once(tmp_path):
     # a cold compile of the README's main command (about 15-20 s of CPU): no package kernel is
     # compiled for two signatures (a literal argument, prange's uint64 index) except three tiny
     # helpers: full_step and scaled_step, to which full_step passes it on (their literal kind, which
-    # LLVM folds), and the DP's interp_at (float32 and float64 positions)
+    # LLVM folds), and the DP's interp_at and interp_aug (the same interpolation with the singular
+    # speeds as further nodes), each for float32 (tabulated) and float64 (computed) positions
     import subprocess
     import sys
     from pathlib import Path
@@ -241,4 +242,4 @@ def test_first_run_compiles_each_kernel_once(tmp_path):
     twice = done.stdout.split("more than one signature")[1].splitlines()[1:]
     ours = {line.split(":")[0].strip() for line in twice if line.strip().startswith("pymoo_rail")}
     assert ours <= {"pymoo_rail.sim.kernel.full_step", "pymoo_rail.sim.kernel.scaled_step",
-                    "pymoo_rail.optimal.dp.interp_at"}, done.stdout
+                    "pymoo_rail.optimal.dp.interp_at", "pymoo_rail.optimal.dp.interp_aug"}, done.stdout
