@@ -4,7 +4,8 @@ Seeded worlds per case (:func:`pymoo_rail.control.study.draw_loop_disturbances`:
 speed noise, traction lag, resistance and regeneration errors, a late departure in half of them,
 a temporary speed restriction announced on the way in half of them), each driven by every
 controller of :data:`pymoo_rail.control.study.STUDY_CONTROLLERS`. Energy is compared at equal
-arrival through the exact plan's price of time (``cost_kwh = net energy + lambda x lateness``);
+arrival against the real train's exact optimum at each run's own running time (``gap_pct``) and
+through the exact plan's price of time (``cost_kwh = net energy + lambda x lateness``);
 the lateness, stop error, comfort (acceleration variation) and advice changes are reported beside
 it, with Wilcoxon rank-sum tests of every controller against the best curve-tracking one.
 
@@ -14,8 +15,8 @@ figure ``closed_loop_study.png``; the per-run rows go to ``out/closed_loop_study
 
 Usage: ``python benchmarks/closed_loop_study.py [--runs 200] [--runs-long 200] [--seed 1]
 [--cases yizhuang metro-a wuguang-crh3 ttobench-ref] [--report-only]``. The defaults are the full
-study (200 worlds per case); ``--runs-long`` sets the worlds of the lines over 10 km (about 8 s
-of CPU per world with all seven controllers, against 0.8 s on yizhuang).
+study (200 worlds per case); ``--runs-long`` sets the worlds of the lines over 10 km (about 15 s
+of CPU per world with all eight controllers and the exact optima, against 1.5 s on yizhuang).
 """
 
 from __future__ import annotations
@@ -53,17 +54,17 @@ def planned_time(case) -> float:
 
 
 def tests_table(runs: pd.DataFrame) -> pd.DataFrame:
-    """Each controller against the best curve-tracking one of its case (lowest median cost), paired worlds."""
+    """Each controller against the best curve-tracking one of its case (lowest median gap to the exact optimum)."""
     rows = []
     for case, g in runs.groupby("case", sort=False):
-        medians = g.groupby("controller")["cost_kwh"].median()
+        medians = g.groupby("controller")["gap_pct"].median()
         best = min(TRACKING, key=lambda n: medians.get(n, np.inf))
         base = g[g["controller"] == best]
         for name in STUDY_CONTROLLERS:
             if name == best:
                 continue
             mine = g[g["controller"] == name]
-            for measure in ("cost_kwh", "lateness_abs_s"):
+            for measure in ("gap_pct", "cost_kwh", "lateness_abs_s"):
                 a = mine["lateness_s"].abs() if measure == "lateness_abs_s" else mine[measure]
                 b = base["lateness_s"].abs() if measure == "lateness_abs_s" else base[measure]
                 u, p, verdict = rank_sum(a.to_numpy(), b.to_numpy())
@@ -106,17 +107,31 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
              f"Produced by `benchmarks/closed_loop_study.py --runs {args.runs} --runs-long {args.runs_long} "
              f"--seed {args.seed}`" + (f" in {seconds:.0f} s of CPU." if seconds else " (report rebuilt from the runs)."),
              "Worlds per case: " + ", ".join(f"{c} {n}" for c, n in runs.groupby('case', sort=False)['run'].nunique().items())
-             + ". Energy at equal arrival: `cost_kwh = net energy + lambda x lateness` with the exact plan's price "
-             "of time; on time: within 2 s of the plan, among the worlds where the real train flat out could be.", "",
-             "| case | controller | median cost kWh | median energy kWh | median lateness s | on time (of possible) "
-             "| late | median stop error m | median accel. variation m/s^2 | s per advice change | ms per re-plan |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             + ". Energy at equal arrival, two ways: `gap to exact`, the run's energy above the real train's exact "
+             "optimum at the run's own running time (the exact solver on the world's own model, restriction known "
+             "from the start); `cost_kwh = net energy + lambda x lateness` with the exact plan's price of time. On "
+             "time: within 2 s of the plan, among the worlds where the real train flat out could be.", "",
+             "| case | controller | median gap to exact % | median cost kWh | median energy kWh | median lateness s "
+             "| on time (of possible) | late | median stop error m | median accel. variation m/s^2 "
+             "| s per advice change | ms per re-plan |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in summary.iterrows():
-        lines.append(f"| {r['case']} | {r['controller']} | {fixed(r['median_cost_kwh'], 3, missing='n/a')} | {fixed(r['median_net_kwh'], 3, missing='n/a')} "
+        lines.append(f"| {r['case']} | {r['controller']} | {fixed(r['median_gap_pct'], missing='n/a')} "
+                     f"| {fixed(r['median_cost_kwh'], 3, missing='n/a')} | {fixed(r['median_net_kwh'], 3, missing='n/a')} "
                      f"| {fixed(r['median_lateness_s'], missing='n/a')} | {fixed(100 * r['on_time_share'], 0, missing='n/a')} % of "
                      f"{int(r['n_can_be_on_time'])} | {fixed(100 * r['late_share'], 0, missing='n/a')} % "
                      f"| {fixed(r['median_stop_error_m'], 3, missing='n/a')} | {fixed(r['median_jerk_ms2'], missing='n/a')} "
                      f"| {fixed(r['median_seconds_per_change'], 1, missing='n/a')} | {fixed(r['median_decision_cpu_ms'], 1, missing='n/a')} |")
+    lines += ["", "## Driver advice (1.5 s reaction) against the policy's own controls, world by world", "",
+              "Paired by world: `cost_kwh` of the advised run over that of `optimal_controls` (both re-plan every "
+              "10 s from the same states of the same worlds).", "",
+              "| case | worlds | median extra cost | 90th percentile | worlds over 1 % |", "|---|---|---|---|---|"]
+    for case, g in runs.groupby("case", sort=False):
+        adv = g[g["controller"] == "advice"].set_index("run")["cost_kwh"]
+        opt = g[g["controller"] == "optimal_controls"].set_index("run")["cost_kwh"]
+        extra = 100.0 * (adv / opt.reindex(adv.index) - 1.0)
+        lines.append(f"| {case} | {len(extra)} | {extra.median():+.2f} % | {extra.quantile(0.9):+.2f} % "
+                     f"| {int((extra > 1.0).sum())} |")
     lines += ["", "## Wilcoxon rank-sum tests against the best curve tracking of each case", "",
               "`+`: significantly lower (better) than the tracking controller at p < 0.05, `-`: higher, `=`: no "
               "significant difference.", "",

@@ -309,28 +309,38 @@ class OptimalPolicy:
         # -P_aux), so a train ahead of its plan is not driven faster to save auxiliary energy
         return (self.lambda_w + self.aux_w) * PRICE_RATIO ** k - self.aux_w
 
-    def _value(self, line: _Line, k: int, node: int) -> np.ndarray:
-        """Cost-to-go at lattice price ``k``, valid from ``node`` on (swept over the line ahead only)."""
+    def _entry(self, line: _Line, k: int, node: int) -> tuple:
+        """Cost-to-go at lattice price ``k``, valid from ``node`` on (swept over the line ahead only).
+
+        Returns ``(value, sing_v, sing_p, sing_val)``: the cost-to-go at the speed nodes and at the
+        price's singular speeds (:func:`pymoo_rail.optimal.dp.singular_speeds`), as the solver keeps them.
+        """
         entry = line.values.get(k)
         if entry is not None and entry[0] <= node:
             return entry[1]
         m = line.model
         n = m.position_m.shape[0]
-        value = np.zeros((n, self.n_speeds)) if entry is None else entry[1]
+        arrays = (np.zeros((n, self.n_speeds)), np.zeros((n, 2)), np.full((n, 2), -1.0), np.zeros((n, 2))) \
+            if entry is None else entry[1]
+        value, sing_v, sing_p, sing_val = arrays
         prices = np.full(n - 1 - node, self._price(k))
+        ahead = model_from(m, node, 0.0)
         tables = line.tables[:-1] + (np.ascontiguousarray(line.tables[-1][node:]),)
-        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), line.terminal_j)
+        dp.singular_speeds(ahead, prices + m.aux_power_w, self.n_speeds, self.bias, sing_v[node:], sing_p[node:])
+        dp.backward_sweep(ahead, prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), line.terminal_j,
+                          sing_v[node:], sing_p[node:], sing_val[node:], self.max_targets, self.bias)
         self.n_sweeps += 1
-        line.values[k] = (node, value)
+        line.values[k] = (node, arrays)
         if len(line.values) > MAX_PRICES_KEPT:  # forget the price farthest from this one
             far = max(line.values, key=lambda j: abs(j - k))
             del line.values[far]
-        return value
+        return arrays
 
     def _cost_to_go(self, line: _Line, k: int, node: int, speed_ms: float) -> float:
         m = line.model
-        return float(dp.interp_value(self._value(line, k, node)[node], m.envelope_ms[node] ** 2, speed_ms ** 2,
-                                     self.bias))
+        value, _, sing_p, sing_val = self._entry(line, k, node)
+        where = dp.value_position(m.envelope_ms[node] ** 2, speed_ms ** 2, self.n_speeds - 1, self.bias)
+        return float(dp.interp_aug(value[node], where, sing_p[node], sing_val[node]))
 
     def _run_time_between(self, line: _Line, k: int, node: int, speed_ms: float) -> float:
         """Running time of the optimal rest of the run between prices k and k + 1: dV/dlambda."""
@@ -385,18 +395,21 @@ class OptimalPolicy:
         its moved last switch, meets the time.
         """
         model = model_from(line.model, node, speed_ms)
-        value = self._value(line, k, node)[node:]
+        value, sing_v, sing_p, sing_val = (a[node:] for a in self._entry(line, k, node))
         price_w = self._price(k)
         if share > 0.0:
-            value = (1.0 - share) * value + share * self._value(line, k + 1, node)[node:]
+            # the singular speeds differ between the prices: the mixed run keeps to the speed nodes
+            value = (1.0 - share) * value + share * self._entry(line, k + 1, node)[0][node:]
             price_w = (1.0 - share) * price_w + share * self._price(k + 1)
+            sing_v, sing_p, sing_val = np.zeros_like(sing_v), np.full_like(sing_p, -1.0), np.zeros_like(sing_val)
         n = model.position_m.shape[0]
         modes = np.zeros(n - 1, dtype=np.int64)
         targets = np.zeros(n - 1)
         speeds = np.zeros(n)
         price = np.full(n - 1, price_w + model.aux_power_w)
         done = dp.forward_rollout(model, price, np.ascontiguousarray(value), self.max_targets, self.bias, self.tie_j,
-                                  modes, targets, speeds)[0]
+                                  modes, targets, speeds, np.ascontiguousarray(sing_v), np.ascontiguousarray(sing_p),
+                                  np.ascontiguousarray(sing_val))[0]
         if done < n - 1:
             raise FieldError("speed_ms", speed_ms, f"leaves no way to the platform from {model.position_m[0]:.1f} m")
         return np.column_stack([model.position_m[1:], modes.astype(float), targets])

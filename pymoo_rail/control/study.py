@@ -2,10 +2,11 @@
 
 Each run draws one world (:func:`draw_loop_disturbances`) and drives it with every controller, so
 the controllers meet the same trains, delays and restrictions (paired samples). The energy is
-compared at equal arrival through the plan's price of time: ``cost_kwh = net energy + lambda x
-lateness``, with ``lambda`` the exact plan's price of time (the slope of the energy / running-time
-front at the planned time: what one second of running time is worth in energy there), lateness
-signed (an early arrival is credited at the same price). ``can_be_on_time`` says whether the real
+compared at equal arrival in two ways: against the real train's exact optimum at the run's own
+running time (``gap_pct``: the exact solver on the world's own model, restriction known from the
+start), and through the plan's price of time, ``cost_kwh = net energy + lambda x lateness``, with
+``lambda`` the exact plan's price of time (the slope of the energy / running-time front at the
+planned time), lateness signed (an early arrival is credited at the same price). ``can_be_on_time`` says whether the real
 train, flat out from its late departure with the restriction known, could still arrive on time.
 """
 
@@ -32,6 +33,7 @@ from pymoo_rail.control.controllers import PID, FuzzyPID, Hysteresis
 from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction, run_trace
 from pymoo_rail.model import Case
 from pymoo_rail.model.errors import FieldError
+from pymoo_rail.optimal import OptimalSolver
 from pymoo_rail.sim.drivers import flat_out_program
 
 STUDY_CONTROLLERS = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis", "recovery", "replanning",
@@ -99,15 +101,41 @@ def can_be_on_time(case: Case, disturbance: LoopDisturbance, planned_time_s: flo
     return bool(run.reached and disturbance.departure_delay_s + run.running_time_s <= planned_time_s)
 
 
+def exact_energies_kwh(case: Case, disturbance: LoopDisturbance, running_times_s) -> list[float]:
+    """The real train's exact minimum energy at each running time (kWh; NaN where there is none).
+
+    The exact solver on the disturbed world's own model (mass, adhesion, resistance, regeneration,
+    the restriction known from the start: what a clairvoyant planner could do), each run moved to
+    the time asked along its price of time (it is within 0.5 s of it).
+    """
+    solver = OptimalSolver(case, certify=False)
+    solver.simulator.model = real_model(case, disturbance)  # before any solve: tables from this model
+    fastest = solver.min_running_time_s()
+    out = []
+    for t in running_times_s:
+        if not np.isfinite(t) or t < fastest - 1e-6:
+            out.append(math.nan)
+            continue
+        try:
+            run = solver.profile(max(float(t), fastest))
+        except (ValueError, RuntimeError):  # beyond the slowest run the grid represents
+            out.append(math.nan)
+            continue
+        out.append(run.energy.net_kwh + run.summary["lambda_w"] / J_PER_KWH * (run.running_time_s - float(t)))
+    return out
+
+
 def loop_runs(case: Case, n_runs: int, seed: int, controllers=STUDY_CONTROLLERS, policy: OptimalPolicy | None = None,
-              planned_time_s: float | None = None, first_run: int = 0) -> pd.DataFrame:
+              planned_time_s: float | None = None, first_run: int = 0, exact: bool = True) -> pd.DataFrame:
     """One row per (world, controller): the closed-loop study of one case.
 
     Columns: ``case``, ``run`` (world index), ``controller``, ``net_kwh``, ``cost_kwh`` (energy
     plus the plan's price of time times the lateness), ``lateness_s``, ``stop_error_m``,
     ``jerk_ms2``, ``advice_changes`` (advice only), ``n_decisions``, ``can_be_on_time``,
     ``delay_s``, ``restricted``, ``decision_cpu_ms`` (median per decision, re-planning only) and
-    ``cpu_s``. Worlds ``first_run .. first_run + n_runs - 1`` of the seeded draw.
+    ``cpu_s``; with ``exact``, ``exact_kwh`` (the real train's exact optimum at the run's own
+    running time, :func:`exact_energies_kwh`) and ``gap_pct`` (energy above it, %). Worlds
+    ``first_run .. first_run + n_runs - 1`` of the seeded draw.
     """
     planned = float(case.planned_time_s if planned_time_s is None else planned_time_s)
     policy = OptimalPolicy(case, planned) if policy is None else policy
@@ -132,7 +160,12 @@ def loop_runs(case: Case, n_runs: int, seed: int, controllers=STUDY_CONTROLLERS,
                          "delay_s": world.departure_delay_s, "restricted": world.restriction is not None,
                          "max_speed_kmh": float(np.max(run.speed_ms) * KMH_PER_MS),
                          "decision_cpu_ms": float(np.median(cpu) * 1000.0) if cpu else math.nan,
-                         "cpu_s": _time.process_time() - started})
+                         "running_time_s": run.running_time_s, "cpu_s": _time.process_time() - started})
+        if exact:
+            mine = rows[-len(controllers):]
+            for row, best in zip(mine, exact_energies_kwh(case, world, [r["running_time_s"] for r in mine])):
+                row["exact_kwh"] = best
+                row["gap_pct"] = 100.0 * (row["net_kwh"] / best - 1.0) if best > 0 else math.nan
     return pd.DataFrame(rows)
 
 
@@ -143,6 +176,7 @@ def loop_summary(runs: pd.DataFrame, on_time_s: float = 2.0) -> pd.DataFrame:
         can = g[g["can_be_on_time"]]
         rows.append({"case": case, "controller": name, "n": len(g),
                      "median_cost_kwh": g["cost_kwh"].median(), "median_net_kwh": g["net_kwh"].median(),
+                     "median_gap_pct": g["gap_pct"].median() if "gap_pct" in g else math.nan,
                      "median_lateness_s": g["lateness_s"].median(),
                      "on_time_share": float((can["lateness_s"].abs() <= on_time_s).mean()) if len(can) else math.nan,
                      "late_share": float((can["lateness_s"] > on_time_s).mean()) if len(can) else math.nan,

@@ -160,7 +160,7 @@ def _kinematic_phases(case: Any = "metro-a", **params):
     return KinematicPhasesProblem(_case(case), **_tuples(params))
 
 
-@_forwards("pymoo_rail.control.tuning", "ControllerTuningProblem")
+@_forwards("pymoo_rail.problems.controller_tuning", "ControllerTuningProblem")
 def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
     """``pymoo_rail.problems.controller_tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
     from pymoo_rail.problems.controller_tuning import ControllerTuningProblem

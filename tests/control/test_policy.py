@@ -108,8 +108,7 @@ def test_merged_tables_give_the_cost_to_go_of_fresh_tables(policy):
     values = []
     for tables in (merged, fresh):
         value = np.empty((n, solver.n_speeds))
-        dp.backward_sweep(np.full(n - 1, policy.lambda_w), *tables, value, np.zeros(n, dtype=np.int64),
-                          np.zeros(solver.n_speeds))
+        dp.solve(restricted, tables, policy.lambda_w, solver.max_targets, solver.top_bias, solver.tie_j, value)
         values.append(value)
     np.testing.assert_array_equal(values[0], values[1])
 
