@@ -14,7 +14,6 @@ PACKAGE = Path(__file__).resolve().parents[1] / "pymoo_rail"
 MAX_LINES = 80
 KERNEL_DECORATORS = ("njit", "jit", "vectorize", "guvectorize")
 ALLOWED = {
-    "optimal/flat.py:flat_track_optimum",  # waits on the exact-solver work in progress in pymoo_rail/optimal
     "cases/railjson_infra.py:read_infra",  # waits on the railjson reader work in progress (landed at 91 lines)
 }
 
