@@ -151,12 +151,7 @@ SEED_TABLE_3_5 = {("sphere", 30, 3000, "ABC"): (6.551810e-16, 8.063285e-16, 1.08
 
 def report(out: Path, df, curves: dict) -> None:
     """Report, per-run CSV and figures from :func:`load_runs`."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from pymoo_rail.experiments.report import count_range
-    from pymoo_rail.plotting import save_figure
 
     exported = df.assign(best=df.best.map(lambda v: repr(float(v))))  # every digit of the best value
     exported.sort_values(["run", "function", "dim", "iterations", "algorithm"], kind="stable").to_csv(
@@ -192,6 +187,20 @@ def report(out: Path, df, curves: dict) -> None:
         "Sphere rows.",
         "",
     ]
+    lines += function_tables(df)
+    lines += _observations(df)
+
+    figures = convergence_figures(curves, out)
+
+    lines += ["## Convergence (median over runs of the best-so-far value)", ""]
+    lines += [f"![{f}]({f})" for f in figures]
+    (out / "abc_functions.md").write_text("\n".join(lines) + "\n")
+    print(f"wrote {out / 'abc_functions.md'}")
+
+
+def function_tables(df):
+    """Per function, the table of every dimension, budget and algorithm."""
+    lines = []
     for function in FUNCTIONS:
         lines += [f"## {function.capitalize()}", "",
                   "| D | iter | alg | min | mean | median | max | time s | n_eval | seed min | seed mean | seed max | seed time s |",
@@ -213,7 +222,16 @@ def report(out: Path, df, curves: dict) -> None:
                     f"{a.n_eval.mean():.0f} | {fmt(s[0])} | {fmt(s[1])} | {fmt(s[2])} | {fmt(s[3])} |"
                 )
         lines.append("")
-    lines += _observations(df)
+    return lines
+
+
+def convergence_figures(curves, out: Path) -> list[str]:
+    """Median best-so-far curves: the algorithms per function and dimension, and ABC's dimensions on Sphere; the file names."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import save_figure
 
     figures = []
 
@@ -258,11 +276,7 @@ def report(out: Path, df, curves: dict) -> None:
     fig.tight_layout()
     save_figure(fig, out / "abc_functions_sphere_dims.png", dpi=110)
     figures.append("abc_functions_sphere_dims.png")
-
-    lines += ["## Convergence (median over runs of the best-so-far value)", ""]
-    lines += [f"![{f}]({f})" for f in figures]
-    (out / "abc_functions.md").write_text("\n".join(lines) + "\n")
-    print(f"wrote {out / 'abc_functions.md'}")
+    return figures
 
 
 def _observations(df) -> list[str]:

@@ -97,54 +97,11 @@ def main(argv=None) -> None:
                                        ignore_index=True)) for e, s_ in zip(exact, sim)]
 
     # how far the fronts lie from the exact ones, on the common time range
-    gaps = []
-    for k, (fe, fs, ff, fc) in enumerate(zip(exact, sim, fine, combined)):
-        t_lo = max(f.running_time_s.iloc[0] for f in (fe, fs, ff))
-        t_hi = min(f.running_time_s.iloc[-1] for f in (fe, fs, ff))
-        t = np.linspace(t_lo, t_hi, 200)
-        e = front_energy(fe, t)
-
-        def rel(f):
-            return 100 * (front_energy(f, t) - e) / np.abs(e)
-
-        gaps.append({"section": k, "label": journey.section_label(k), "range s": f"{t_lo:.1f}-{t_hi:.1f}",
-                     "31x31 mean %": np.mean(rel(fs)), "31x31 min %": np.min(rel(fs)),
-                     "31x31 max %": np.max(rel(fs)), "61x61 mean %": np.mean(rel(ff)),
-                     "combined mean %": np.mean(rel(fc)), "combined min %": np.min(rel(fc))})
-    gaps = pd.DataFrame(gaps)
+    gaps = front_gaps(exact, sim, fine, combined, journey)
 
     lo = np.array([f.running_time_s.iloc[0] for f in exact])
     hi = np.array([f.running_time_s.iloc[-1] for f in exact])
-    rows, cross = [], []
-    for s in SUPPLEMENTS:
-        total = lo.sum() * (1 + s)
-        if total > hi.sum():
-            continue
-        best = allocate_running_time(journey, total, fronts=exact)
-        equal = rule_energy(journey, total, exact, "equal")
-        prop = rule_energy(journey, total, exact, "proportional")
-        rows.append({"supplement %": 100 * s, "trip time s": journey.trip_time_s(total),
-                     "optimal kWh": best.energy_kwh, "equal kWh": equal, "proportional kWh": prop,
-                     "saving vs equal kWh": equal - best.energy_kwh,
-                     "saving vs equal %": 100 * (equal - best.energy_kwh) / equal,
-                     "price Wh/s": 1000 * best.price_kwh_per_s, "marginal violation": best.marginal_violation()})
-        # every split run on the combined fronts (the closest estimate of the optimal fronts)
-        row = {"supplement %": 100 * s,
-               "optimal on combined kWh": allocate_running_time(journey, total, fronts=combined).energy_kwh}
-        for name, fr in (("split from exact fronts", exact), ("split from simulated fronts", sim)):
-            try:
-                split = allocate_running_time(journey, total, fronts=fr).running_times_s
-                row[name + " kWh"] = on_fronts(combined, split)
-            except CaseError:
-                row[name + " kWh"] = float("nan")
-        try:
-            row["equal split kWh"] = on_fronts(combined, supplement_split(journey, total, fronts=combined)
-                                               .running_times_s)
-        except CaseError:
-            row["equal split kWh"] = float("nan")
-        cross.append(row)
-    table = pd.DataFrame(rows)
-    cross = pd.DataFrame(cross)
+    table, cross = supplement_tables(journey, exact, sim, combined, lo, hi)
 
     # DE with the budget repair against the exact split at the 30-minute trip
     from pymoo.algorithms.soo.nonconvex.de import DE
@@ -163,48 +120,7 @@ def main(argv=None) -> None:
                         "evaluations": res.algorithm.evaluator.n_eval, "time s": time.perf_counter() - t0})
     de = pd.DataFrame(de_rows)
 
-    # plots
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from pymoo_rail.plotting import save_figure
-
-    widest_equal = lo.sum() + len(exact) * (hi - lo).min()
-    sweep_t = np.linspace(lo.sum(), min(hi.sum(), widest_equal), 60)
-    opt_e = np.array([allocate_running_time(journey, t, fronts=exact).energy_kwh for t in sweep_t])
-    eq_e = np.array([rule_energy(journey, t, exact, "equal") for t in sweep_t])
-    pr_e = np.array([rule_energy(journey, t, exact, "proportional") for t in sweep_t])
-    trip_min = np.array([journey.trip_time_s(t) for t in sweep_t]) / 60
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
-    ax = axes[0]
-    ax.plot(trip_min, opt_e, label="energy-optimal split")
-    ax.plot(trip_min, eq_e, "--", label="equal supplement")
-    ax.plot(trip_min, pr_e, ":", label="proportional supplement")
-    ax.set_xlabel("trip time incl. 12 x 30 s dwells (min)")
-    ax.set_ylabel("net energy of the line (kWh)")
-    ax.set_title("Yizhuang line, 13 sections (exact fronts)")
-    ax.legend()
-    ax = axes[1]
-    ax.plot(trip_min, eq_e - opt_e, "--", label="equal supplement")
-    ax.plot(trip_min, pr_e - opt_e, ":", label="proportional supplement")
-    ax.set_xlabel("trip time incl. dwells (min)")
-    ax.set_ylabel("extra energy over the optimal split (kWh)")
-    ax.set_title("cost of a rule-of-thumb split")
-    ax.legend()
-    ax = axes[2]
-    x = np.arange(journey.n_sections)
-    ax.bar(x - 0.2, best.table.supplement_s, 0.4, label="energy-optimal")
-    ax.bar(x + 0.2, equal.table.supplement_s, 0.4, label="equal")
-    ax.set_xticks(x, [f"{k}" for k in x])
-    ax.set_xlabel("section (0 = Songjiazhuang -> Xiaocun)")
-    ax.set_ylabel("running-time supplement over flat-out (s)")
-    ax.set_title(f"split of a {TRIP_TIME_S / 60:.0f}-min trip")
-    ax.legend(loc="lower right")
-    for a in axes:
-        a.grid(alpha=0.3)
-    fig.tight_layout()
-    save_figure(fig, args.out / "journeys.png", dpi=110)
+    journeys_figure(lo, exact, hi, journey, best, equal, args.out / "journeys.png")
 
     per_section = best.table[["section", "label", "length_m", "min_time_s", "running_time_s", "supplement_s",
                               "energy_kwh"]].assign(equal_supplement_s=equal.table.supplement_s,
@@ -281,6 +197,104 @@ numbers.
 """
     (args.out / "journeys.md").write_text(report, encoding="utf-8")
     print(report)
+
+
+def front_gaps(exact, sim, fine, combined, journey):
+    """Per section: how far the simulated fronts (31 x 31, 61 x 61, combined) lie above the exact one."""
+    gaps = []
+    for k, (fe, fs, ff, fc) in enumerate(zip(exact, sim, fine, combined)):
+        t_lo = max(f.running_time_s.iloc[0] for f in (fe, fs, ff))
+        t_hi = min(f.running_time_s.iloc[-1] for f in (fe, fs, ff))
+        t = np.linspace(t_lo, t_hi, 200)
+        e = front_energy(fe, t)
+
+        def rel(f):
+            return 100 * (front_energy(f, t) - e) / np.abs(e)
+
+        gaps.append({"section": k, "label": journey.section_label(k), "range s": f"{t_lo:.1f}-{t_hi:.1f}",
+                     "31x31 mean %": np.mean(rel(fs)), "31x31 min %": np.min(rel(fs)),
+                     "31x31 max %": np.max(rel(fs)), "61x61 mean %": np.mean(rel(ff)),
+                     "combined mean %": np.mean(rel(fc)), "combined min %": np.min(rel(fc))})
+    return pd.DataFrame(gaps)
+
+
+def supplement_tables(journey, exact, sim, combined, lo, hi):
+    """Per total supplement: the line's energy under the optimal, equal and proportional splits; and the
+    split computed on each kind of front, run on the combined fronts."""
+    rows, cross = [], []
+    for s in SUPPLEMENTS:
+        total = lo.sum() * (1 + s)
+        if total > hi.sum():
+            continue
+        best = allocate_running_time(journey, total, fronts=exact)
+        equal = rule_energy(journey, total, exact, "equal")
+        prop = rule_energy(journey, total, exact, "proportional")
+        rows.append({"supplement %": 100 * s, "trip time s": journey.trip_time_s(total),
+                     "optimal kWh": best.energy_kwh, "equal kWh": equal, "proportional kWh": prop,
+                     "saving vs equal kWh": equal - best.energy_kwh,
+                     "saving vs equal %": 100 * (equal - best.energy_kwh) / equal,
+                     "price Wh/s": 1000 * best.price_kwh_per_s, "marginal violation": best.marginal_violation()})
+        # every split run on the combined fronts (the closest estimate of the optimal fronts)
+        row = {"supplement %": 100 * s,
+               "optimal on combined kWh": allocate_running_time(journey, total, fronts=combined).energy_kwh}
+        for name, fr in (("split from exact fronts", exact), ("split from simulated fronts", sim)):
+            try:
+                split = allocate_running_time(journey, total, fronts=fr).running_times_s
+                row[name + " kWh"] = on_fronts(combined, split)
+            except CaseError:
+                row[name + " kWh"] = float("nan")
+        try:
+            row["equal split kWh"] = on_fronts(combined, supplement_split(journey, total, fronts=combined)
+                                               .running_times_s)
+        except CaseError:
+            row["equal split kWh"] = float("nan")
+        cross.append(row)
+    return pd.DataFrame(rows), pd.DataFrame(cross)
+
+
+def journeys_figure(lo, exact, hi, journey, best, equal, path: Path) -> None:
+    """Energy against trip time, the cost of the rules of thumb, and the split of one trip."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import save_figure
+
+    widest_equal = lo.sum() + len(exact) * (hi - lo).min()
+    sweep_t = np.linspace(lo.sum(), min(hi.sum(), widest_equal), 60)
+    opt_e = np.array([allocate_running_time(journey, t, fronts=exact).energy_kwh for t in sweep_t])
+    eq_e = np.array([rule_energy(journey, t, exact, "equal") for t in sweep_t])
+    pr_e = np.array([rule_energy(journey, t, exact, "proportional") for t in sweep_t])
+    trip_min = np.array([journey.trip_time_s(t) for t in sweep_t]) / 60
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
+    ax = axes[0]
+    ax.plot(trip_min, opt_e, label="energy-optimal split")
+    ax.plot(trip_min, eq_e, "--", label="equal supplement")
+    ax.plot(trip_min, pr_e, ":", label="proportional supplement")
+    ax.set_xlabel("trip time incl. 12 x 30 s dwells (min)")
+    ax.set_ylabel("net energy of the line (kWh)")
+    ax.set_title("Yizhuang line, 13 sections (exact fronts)")
+    ax.legend()
+    ax = axes[1]
+    ax.plot(trip_min, eq_e - opt_e, "--", label="equal supplement")
+    ax.plot(trip_min, pr_e - opt_e, ":", label="proportional supplement")
+    ax.set_xlabel("trip time incl. dwells (min)")
+    ax.set_ylabel("extra energy over the optimal split (kWh)")
+    ax.set_title("cost of a rule-of-thumb split")
+    ax.legend()
+    ax = axes[2]
+    x = np.arange(journey.n_sections)
+    ax.bar(x - 0.2, best.table.supplement_s, 0.4, label="energy-optimal")
+    ax.bar(x + 0.2, equal.table.supplement_s, 0.4, label="equal")
+    ax.set_xticks(x, [f"{k}" for k in x])
+    ax.set_xlabel("section (0 = Songjiazhuang -> Xiaocun)")
+    ax.set_ylabel("running-time supplement over flat-out (s)")
+    ax.set_title(f"split of a {TRIP_TIME_S / 60:.0f}-min trip")
+    ax.legend(loc="lower right")
+    for a in axes:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110)
 
 
 if __name__ == "__main__":

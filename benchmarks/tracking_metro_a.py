@@ -134,6 +134,15 @@ def main() -> None:
                               flush=True)
 
     # ---- figures like seed 002 figs. 8-10 (the optimised curve: traction phases in the controlled part)
+    tracking_figure(curves, runs, case, out_dir, stem)
+
+    # ---- report
+    write_report(case, args, t_start, curves, rows, stem, out_dir)
+    print(f"wrote {out_dir / (stem + '.md')}")
+
+
+def tracking_figure(curves, runs, case, out_dir, stem):
+    """Figs. 8-10 analogue: speed and control of each controller on the optimised curve, per control period."""
     curve = list(curves)[1]
     ref = curves[curve]
     fig, axes = plt.subplots(3, 2, figsize=(13, 10))
@@ -162,7 +171,9 @@ def main() -> None:
     fig.tight_layout()
     save_figure(fig, out_dir / f"{stem}.png", dpi=100)
 
-    # ---- report
+
+def write_report(case, args, t_start, curves, rows, stem, out_dir):
+    """Write the report: the reference curves, the tracking table per train, controller and period."""
     lines = [f"# PID and adaptive fuzzy PID tracking on {case.name} (seed 002, sections 3.4-3.5)", "",
              f"Produced by `benchmarks/tracking_metro_a.py --case {args.case} --gens {args.gens}` in "
              f"{time.perf_counter() - t_start:.0f} s. Both controllers have the base gains kp = {KP}, ki = {KI}, "
@@ -191,7 +202,6 @@ def main() -> None:
                      f"{r['running_time_s']:.2f} | {r['regime_changes']} |")
     lines += ["", f"![seed 002 figs. 8-10 analogue]({stem}.png)", ""]
     (out_dir / f"{stem}.md").write_text("\n".join(lines))
-    print(f"wrote {out_dir / (stem + '.md')}")
 
 
 if __name__ == "__main__":

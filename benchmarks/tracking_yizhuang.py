@@ -130,6 +130,17 @@ def main() -> None:
                       f"stop {tr.stop_error_m:.3f} m, {row['regime_changes']} regime changes", flush=True)
 
     # ---- figures
+    profiles_figure(references, runs, args, out_dir)
+
+    table_figure(references, runs, args, out_dir)
+
+    # ---- report
+    write_report(args, t_start, references, runs, rows, out_dir)
+    print(f"wrote {out_dir / 'tracking_yizhuang.md'}")
+
+
+def profiles_figure(references, runs, args, out_dir):
+    """The tracked profiles for each B beside the DE-tracked reference."""
     fig, axes = plt.subplots(2, 2, figsize=(12, 7.5), sharex=True, sharey=True)
     ref = references["DE tracked"][0]
     for ax, b in zip(axes.ravel(), B_VALUES):
@@ -148,6 +159,9 @@ def main() -> None:
     fig.tight_layout()
     save_figure(fig, out_dir / "tracking_yizhuang_profiles.png", dpi=110)
 
+
+def table_figure(references, runs, args, out_dir):
+    """Table 5-7 as a figure: energy and running time against B, ours beside the seed's."""
     fig, (ax_e, ax_t) = plt.subplots(1, 2, figsize=(11, 4))
     for name in references:
         e = [runs[name, args.period, b].energy.net_kwh for b in B_VALUES]
@@ -166,7 +180,9 @@ def main() -> None:
     fig.tight_layout()
     save_figure(fig, out_dir / "tracking_yizhuang_table.png", dpi=110)
 
-    # ---- report
+
+def write_report(args, t_start, references, runs, rows, out_dir):
+    """Write the report: the references, table 5-7 beside the seed's, every tracked run."""
     lines = ["# Hysteresis tracking on yizhuang (seed 000, table 5-7)", "",
              f"Produced by `benchmarks/tracking_yizhuang.py --gens {args.gens} --seeds "
              f"{' '.join(map(str, args.seeds))} --period {args.period}` in "
@@ -197,7 +213,6 @@ def main() -> None:
                      f"{r['regime_changes']} | {r['speed_error_rms_kmh']:.2f} | {r['speed_error_max_kmh']:.2f} |")
     lines += ["", "![profiles](tracking_yizhuang_profiles.png)", "", "![table](tracking_yizhuang_table.png)", ""]
     (out_dir / "tracking_yizhuang.md").write_text("\n".join(lines))
-    print(f"wrote {out_dir / 'tracking_yizhuang.md'}")
 
 
 if __name__ == "__main__":

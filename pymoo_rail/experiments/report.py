@@ -132,6 +132,17 @@ def _missing(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and not math.isfinite(value)
 
 
+def _not_a_float(value, missing: str) -> str | None:
+    """The cell of a boolean (yes/no), a missing number (``missing``) or an integer; None for anything else."""
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if _missing(value):
+        return missing
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    return None
+
+
 def fixed(value, digits: int = 2, missing: str = "-") -> str:
     """A number with ``digits`` decimals; ``missing`` for None/NaN/inf, yes/no for booleans.
 
@@ -140,12 +151,9 @@ def fixed(value, digits: int = 2, missing: str = "-") -> str:
     >>> fixed(3.14159), fixed(float("nan")), fixed(True), fixed(7), fixed(2.5, 0, missing="n/a")
     ('3.14', '-', 'yes', '7', '2')
     """
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
-    if _missing(value):
-        return missing
-    if isinstance(value, numbers.Integral):
-        return str(int(value))
+    plain = _not_a_float(value, missing)
+    if plain is not None:
+        return plain
     if isinstance(value, numbers.Real):
         return f"{float(value):.{digits}f}"
     return str(value)
@@ -159,12 +167,9 @@ def significant(value, digits: int = 4, missing: str = "") -> str:
     >>> significant(1234.5678), significant(0.00012345), significant(0), significant(None, missing="nan")
     ('1235', '1.234e-04', '0', 'nan')
     """
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
-    if _missing(value):
-        return missing
-    if isinstance(value, numbers.Integral):
-        return str(int(value))
+    plain = _not_a_float(value, missing)
+    if plain is not None:
+        return plain
     value = float(value)
     if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
         return f"{value:.{digits - 1}e}"

@@ -1,0 +1,37 @@
+"""pymoo_rail.experiments.report: the number formats and tables every benchmark report is written with."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.experiments.report import fixed, markdown, markdown_rows, mean_std, significant, write_report
+
+
+def test_fixed_writes_decimals_and_says_what_is_missing():
+    assert fixed(3.14159) == "3.14" and fixed(np.float64(2.5), 0) == "2"
+    assert fixed(None) == fixed(float("nan")) == fixed(math.inf) == "-"
+    assert fixed(float("nan"), missing="n/a") == "n/a"
+    assert fixed(np.True_) == "yes" and fixed(False) == "no"
+    assert fixed(np.int64(7)) == "7" and fixed("label") == "label"
+
+
+def test_significant_switches_to_scientific_notation_outside_1e_3_to_1e5():
+    assert significant(1234.5678) == "1235" and significant(0.5) == "0.5" and significant(0) == "0"
+    assert significant(0.00012345) == "1.234e-04" and significant(123456.0) == "1.235e+05"
+    assert significant(float("nan")) == "" and significant(None, missing="nan") == "nan"
+    assert mean_std([1.0, 2.0, 3.0, None, float("nan")]) == "2 +- 1" and mean_std([2.5]) == "2.5"
+    assert mean_std([]) == ""
+
+
+def test_markdown_formats_float_cells_only(tmp_path):
+    frame = pd.DataFrame({"case": ["a", "b"], "runs": [3, 4], "energy kWh": [1.23456, float("nan")]})
+    assert markdown(frame, 2).splitlines() == ["| case | runs | energy kWh |", "|---|---|---|",
+                                               "| a | 3 | 1.23 |", "| b | 4 | nan |"]
+    assert markdown(frame, 1, missing="-").splitlines()[-1] == "| b | 4 | - |"
+    assert markdown_rows(["x", "y"], [[1, "z"]]) == "| x | y |\n|---|---|\n| 1 | z |"
+    path = write_report(tmp_path / "r.md", ["# title", "", "text"])
+    assert path.read_text() == "# title\n\ntext\n"
+    assert write_report(tmp_path / "s.md", ["a", "b"], newline=False).read_text() == "a\nb"
