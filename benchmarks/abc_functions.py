@@ -155,7 +155,7 @@ def report(out: Path, df, curves: dict) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from pymoo_rail.experiments.scripts import count_range
+    from pymoo_rail.experiments.report import count_range
     from pymoo_rail.plotting import save_figure
 
     exported = df.assign(best=df.best.map(lambda v: repr(float(v))))  # every digit of the best value
@@ -280,7 +280,7 @@ def _observations(df) -> list[str]:
 
 
 def main() -> None:
-    from pymoo_rail.experiments.scripts import add_study_options
+    from pymoo_rail.experiments.report import add_study_options
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "abc_functions", Path(__file__).parent / "reports",
@@ -289,7 +289,7 @@ def main() -> None:
     workers = max(1, min(args.workers, 2))
     if not args.report_only:
         from pymoo_rail.experiments import run_study
-        from pymoo_rail.experiments.scripts import lower_priority
+        from pymoo_rail.experiments.report import lower_priority
 
         lower_priority()  # be gentle on the shared 2-core machine
         for (dim, iterations), study in build_studies(args.runs).items():

@@ -12,23 +12,18 @@ Usage: ``python benchmarks/certificate.py`` (about a minute of CPU). Writes
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pandas as pd
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from pymoo_rail.cases import load_case
+from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
+from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.journeys import journey_from_ttobench
+from pymoo_rail.experiments.report import markdown, write_report
+from pymoo_rail.optimal import OptimalSolver
 
-from benchmarks.optimal import markdown  # noqa: E402
-from pymoo_rail.cases import load_case  # noqa: E402
-from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK  # noqa: E402
-from pymoo_rail.constants import J_PER_KWH  # noqa: E402
-from pymoo_rail.journeys import journey_from_ttobench  # noqa: E402
-from pymoo_rail.optimal import OptimalSolver  # noqa: E402
-
-REPORT = ROOT / "benchmarks" / "reports" / "certificate.md"
+REPORT = Path(__file__).resolve().parent / "reports" / "certificate.md"
 VARIANTS = ({"n_speeds": 100}, {"n_speeds": 400}, {"n_speeds": 800}, {"tie_j": 0.0})
 
 
@@ -64,7 +59,7 @@ def main() -> None:
             "nodes, `tie_j` = 100 J) and its certificate with its parts, beside finer grids and the run without the "
             "tie rule, all moved to the default run's time along the front's slope. The certificate is the grid part "
             "plus the floor plus the largest of the other three.", "", markdown(table), ""]
-    REPORT.write_text("\n".join(text))
+    write_report(REPORT, text, newline=False)
     print("\n".join(text))
 
 

@@ -24,23 +24,15 @@ Writes ``benchmarks/reports/certificate_coverage.md``.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from pymoo_rail.experiments.report import committed_members, lower_priority, markdown, member_cases, write_report
 
-from benchmarks.optimal import markdown  # noqa: E402
-from benchmarks.reference_check import case_objects, members  # noqa: E402
-
-from pymoo_rail.experiments.scripts import lower_priority  # noqa: E402
-
-REPORTS = ROOT / "benchmarks" / "reports"
+REPORTS = Path(__file__).resolve().parent / "reports"
 OTHERS = {"uniform": {"top_bias": 0.0}, "fine": {"n_speeds": 400}}
 
 
@@ -50,7 +42,7 @@ def compare(table: pd.DataFrame) -> pd.DataFrame:
 
     from pymoo_rail.optimal import ReferenceAtTime
 
-    cases = case_objects()
+    cases = member_cases()
     rows = []
     for name, group in tqdm(list(table.groupby("case", sort=False)), desc="cases", unit="case"):
         times = np.sort(group["running_time_s"].round(3).unique())
@@ -106,7 +98,7 @@ def main(argv=None) -> int:
     parser.add_argument("--limit", type=int, default=None, help="only the first N member times of each case")
     args = parser.parse_args(argv)
     lower_priority()
-    table = members()
+    table = committed_members(REPORTS)
     if args.limit is not None:
         table = table.groupby("case", sort=False).head(args.limit)
     cpu0 = time.process_time()
@@ -122,7 +114,7 @@ def main(argv=None) -> int:
             "the default by more than the default's certificate; *worst margin* = certificate - difference.", "",
             f"Times compared: {int(np.isfinite(result['default_kwh']).sum())}; misses: **{misses}**; "
             f"CPU {cpu:.0f} s.", "", *lines, "", markdown(s), ""]
-    (args.out / "certificate_coverage.md").write_text("\n".join(text))
+    write_report(args.out / "certificate_coverage.md", text, newline=False)
     print("\n".join(text))
     return 1 if misses else 0
 

@@ -36,6 +36,7 @@ from pymoo_rail.control.study import STUDY_CONTROLLERS, loop_runs, loop_summary 
 from pymoo_rail.experiments.stats import rank_sum  # noqa: E402
 from pymoo_rail.plotting import save_figure  # noqa: E402
 from pymoo_rail.sim import Simulator  # noqa: E402
+from pymoo_rail.experiments.report import fixed
 
 REPORTS = Path(__file__).parent / "reports"
 OUT = Path(__file__).parents[1] / "out" / "closed_loop_study"
@@ -96,10 +97,6 @@ def figure(runs: pd.DataFrame, path: Path) -> None:
     save_figure(fig, path, dpi=80)
 
 
-def fmt(x, digits=2) -> str:
-    return "n/a" if pd.isna(x) else f"{x:.{digits}f}"
-
-
 def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
     summary = loop_summary(runs)
     summary.to_csv(REPORTS / "closed_loop_study_summary.csv", index=False, float_format="%.6g")
@@ -118,12 +115,12 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
              "| s per advice change | ms per re-plan |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in summary.iterrows():
-        lines.append(f"| {r['case']} | {r['controller']} | {fmt(r['median_gap_pct'])} "
-                     f"| {fmt(r['median_cost_kwh'], 3)} | {fmt(r['median_net_kwh'], 3)} "
-                     f"| {fmt(r['median_lateness_s'])} | {fmt(100 * r['on_time_share'], 0)} % of "
-                     f"{int(r['n_can_be_on_time'])} | {fmt(100 * r['late_share'], 0)} % "
-                     f"| {fmt(r['median_stop_error_m'], 3)} | {fmt(r['median_jerk_ms2'])} "
-                     f"| {fmt(r['median_seconds_per_change'], 1)} | {fmt(r['median_decision_cpu_ms'], 1)} |")
+        lines.append(f"| {r['case']} | {r['controller']} | {fixed(r['median_gap_pct'], missing='n/a')} "
+                     f"| {fixed(r['median_cost_kwh'], 3, missing='n/a')} | {fixed(r['median_net_kwh'], 3, missing='n/a')} "
+                     f"| {fixed(r['median_lateness_s'], missing='n/a')} | {fixed(100 * r['on_time_share'], 0, missing='n/a')} % of "
+                     f"{int(r['n_can_be_on_time'])} | {fixed(100 * r['late_share'], 0, missing='n/a')} % "
+                     f"| {fixed(r['median_stop_error_m'], 3, missing='n/a')} | {fixed(r['median_jerk_ms2'], missing='n/a')} "
+                     f"| {fixed(r['median_seconds_per_change'], 1, missing='n/a')} | {fixed(r['median_decision_cpu_ms'], 1, missing='n/a')} |")
     lines += ["", "## Driver advice (1.5 s reaction) against the policy's own controls, world by world", "",
               "Paired by world: `cost_kwh` of the advised run over that of `optimal_controls` (both re-plan every "
               "10 s from the same states of the same worlds).", "",
@@ -140,8 +137,8 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
               "| case | controller | against | measure | median | median of tracking | p | verdict |",
               "|---|---|---|---|---|---|---|---|"]
     for _, r in tests.iterrows():
-        lines.append(f"| {r['case']} | {r['controller']} | {r['against']} | {r['measure']} | {fmt(r['median'], 3)} "
-                     f"| {fmt(r['median_against'], 3)} | {fmt(r['p_value'], 4)} | {r['verdict']} |")
+        lines.append(f"| {r['case']} | {r['controller']} | {r['against']} | {r['measure']} | {fixed(r['median'], 3, missing='n/a')} "
+                     f"| {fixed(r['median_against'], 3, missing='n/a')} | {fixed(r['p_value'], 4, missing='n/a')} | {r['verdict']} |")
     lines += ["", "![energy against lateness](closed_loop_study.png)", ""]
     text = "\n".join(lines)
     (REPORTS / "closed_loop_study.md").write_text(text, encoding="utf-8")

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from pymoo_rail.cases import load_case
-from pymoo_rail.experiments.scripts import lower_priority
+from pymoo_rail.experiments.report import lower_priority
 from pymoo_rail.problems.cooperative_baseline import exact_baseline
 from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem, nested_minimize
 

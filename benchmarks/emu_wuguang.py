@@ -60,12 +60,11 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from pymoo_rail.experiments.fronts import choose_member
+from pymoo_rail.sim.checks import check_run
+from pymoo_rail.experiments.report import markdown_rows, mean_std, significant
 
-from pymoo_rail.experiments.fronts import choose_member  # noqa: E402
-from pymoo_rail.sim.checks import check_run  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 CASE = "wuguang-crh3"
 OBJECTIVES = ("energy", "running_time")
@@ -277,34 +276,6 @@ def analyse(results, problems_by_label: dict, verify: bool = True, exact=None):
 # ------------------------------------------------------------------------------ formatting
 
 
-def fmt(value, digits: int = 4) -> str:
-    if value is None or (isinstance(value, float) and np.isnan(value)):
-        return ""
-    if isinstance(value, (bool, np.bool_)):
-        return "yes" if value else "no"
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    value = float(value)
-    if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e5):
-        return f"{value:.{digits - 1}e}"
-    return f"{value:.{digits}g}"
-
-
-def mean_std(values) -> str:
-    v = np.asarray([x for x in values if x is not None and np.isfinite(x)], dtype=float)
-    if len(v) == 0:
-        return ""
-    if len(v) == 1:
-        return fmt(v[0])
-    return f"{fmt(v.mean())} +- {fmt(v.std(ddof=1), 2)}"
-
-
-def md_table(header, rows) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-    return "\n".join(lines)
-
-
 def write_csv(path: Path, rows: list[dict]) -> None:
     keys: list[str] = []
     for row in rows:
@@ -379,10 +350,9 @@ def punctual_choices(results, rows, problems_by_label: dict) -> dict:
 def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path, prefix: str, exact=None,
                  exact_profile=None) -> dict:
     import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
 
     from pymoo_rail.experiments import stats
-    from pymoo_rail.plotting import plot_boxplots, plot_fronts, plot_speed_profile, save_figure
+    from pymoo_rail.plotting import plot_boxplots, plot_fronts, save_figure
 
     label = MAIN_ENCODING
     problem = problems_by_label[label]
@@ -422,6 +392,19 @@ def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path
     ax.axhline(planned, color="0.5", lw=0.8, ls=":")
     paths["fronts_zoom"] = save_figure(fig, out / f"{prefix}_fronts_zoom.png")
 
+    paths["profile"] = profile_figure(chosen, label, exact_profile, planned, exact, problem, out / f"{prefix}_profile.png")
+
+    fig = plot_boxplots(results, "hv_ref")
+    paths["box_hv"] = save_figure(fig, out / f"{prefix}_box_hv.png")
+    return paths
+
+
+def profile_figure(chosen, label, exact_profile, planned, exact, problem, path: Path) -> Path:
+    """Fig. 12: the most punctual GR-NSGA-II and NSGA-II profiles, and the exact optimum when it was solved."""
+    from matplotlib.lines import Line2D
+
+    from pymoo_rail.plotting import plot_speed_profile, save_figure
+
     gr_traj = chosen[label, GR_LABEL]["trajectory"]
     ns_traj = chosen[label, NSGA2_LABEL]["trajectory"]
     others = [ns_traj]
@@ -444,11 +427,7 @@ def make_figures(results, rows, chosen: dict, problems_by_label: dict, out: Path
                for h, lab in zip(legend.legend_handles, labels)]
     ax.set_ylim(0.0, 420.0)
     ax.legend(handles, labels, fontsize="small", loc="upper center", ncol=3, framealpha=0.9)
-    paths["profile"] = save_figure(fig, out / f"{prefix}_profile.png")
-
-    fig = plot_boxplots(results, "hv_ref")
-    paths["box_hv"] = save_figure(fig, out / f"{prefix}_box_hv.png")
-    return paths
+    return save_figure(fig, path)
 
 
 # ------------------------------------------------------------------------------ report
@@ -468,7 +447,7 @@ def encoding_section(rows, n_var: dict, n_fixed: dict) -> list[str]:
                              mean_std(r.get("wall_time_s", np.nan) for r in rs)])
     if not enc_rows:
         return out + ["(encoding study not run)"]
-    out.append(md_table(["encoding", "n_var", "fixed genes", "algorithm", "runs",
+    out.append(markdown_rows(["encoding", "n_var", "fixed genes", "algorithm", "runs",
                          "hv (union of this study)", "least E with T <= 1050 s (kWh)", "E min (kWh)",
                          "T min (s)", "wall s"], enc_rows))
     return out
@@ -511,18 +490,18 @@ def table4(rows, enc: str) -> str:
     t4 = []
     for (name, key), (a, b) in measured(rows, enc, TABLE4, lambda item: item[1]):
         sk = SEED_KEYS.get(key)
-        t4.append([name, mean_std(a), mean_std(b), fmt(SEED_TABLE4[NSGA2_LABEL][sk]) if sk else "",
-                   fmt(SEED_TABLE4[GR_LABEL][sk]) if sk else ""])
-    return md_table(["statistic", NSGA2_LABEL, GR_LABEL, f"seed {NSGA2_LABEL}", f"seed {GR_LABEL}"], t4)
+        t4.append([name, mean_std(a), mean_std(b), significant(SEED_TABLE4[NSGA2_LABEL][sk]) if sk else "",
+                   significant(SEED_TABLE4[GR_LABEL][sk]) if sk else ""])
+    return markdown_rows(["statistic", NSGA2_LABEL, GR_LABEL, f"seed {NSGA2_LABEL}", f"seed {GR_LABEL}"], t4)
 
 
 def tests_table(rows, enc: str) -> str:
     st = []
     for (key, lower), (a, b) in measured(rows, enc, TESTED, lambda item: item[0]):
         p, verdict, rel = rank_sum(rows, enc, key, lower)
-        st.append([key, "lower" if lower else "higher", mean_std(a), mean_std(b), difference(key, rel), fmt(p, 3),
+        st.append([key, "lower" if lower else "higher", mean_std(a), mean_std(b), difference(key, rel), significant(p, 3),
                    verdict])
-    return md_table(["indicator", "better", NSGA2_LABEL, GR_LABEL, "GR vs NSGA-II (means)", "p", "verdict"], st)
+    return markdown_rows(["indicator", "better", NSGA2_LABEL, GR_LABEL, "GR vs NSGA-II (means)", "p", "verdict"], st)
 
 
 def write_report(path: Path, ctx: dict) -> None:
@@ -531,6 +510,33 @@ def write_report(path: Path, ctx: dict) -> None:
     encodings = [e for e in ENCODINGS if any(r["problem"] == e for r in rows)]
     case, problem = ctx["case"], ctx["problems"][label]
     paths = ctx["paths"]
+    lines = head_lines(ctx, case, problem, label, encodings)
+    lines += encoding_section(enc_rows, ctx["n_var"], ctx["n_fixed"])
+    lines += ["", ctx.get("encoding_note", "").strip(), ""]
+
+    lines += ["## 2. Fronts (figs. 10-11) and table 4", "",
+              f"![fronts]({paths['fronts'].name})", "",
+              f"![fronts overlaid]({paths['fronts_overlay'].name})", "",
+              f"![fronts near 1050 s]({paths['fronts_zoom'].name})", ""]
+    for enc in encodings:
+        lines += [f"Table 4 ({enc}): mean +- std over the runs; the seed's values in the last columns (its line "
+                  "profile differs: only magnitudes compare).", "", table4(rows, enc), ""]
+
+    lines += ["## 3. Does GR-NSGA-II beat NSGA-II? (rank-sum test)", ""]
+    for enc in encodings:
+        lines += [f"**{enc}**", "", tests_table(rows, enc), ""]
+    lines += [f"![hypervolume]({paths['box_hv'].name})", ""]
+
+    lines += table5_lines(encodings, ctx, rows, paths)
+
+    lines += exact_front_lines(ctx)
+    lines += verification_lines(ctx, case)
+    lines += ["## 7. Verdict", "", ctx["verdict"].strip(), ""]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def head_lines(ctx, case, problem, label, encodings):
+    """Title, set-up and section 1 of the report."""
     lines = [
         "# CRH3 EMU on the Wuhan-Guangzhou line: golden-ratio NSGA-II vs NSGA-II (seed 003, 4.2)",
         "",
@@ -589,22 +595,12 @@ def write_report(path: Path, ctx: dict) -> None:
         "alpha = 0.05, `-` worse, `=` no significant difference.",
         "",
     ]
-    lines += encoding_section(enc_rows, ctx["n_var"], ctx["n_fixed"])
-    lines += ["", ctx.get("encoding_note", "").strip(), ""]
+    return lines
 
-    lines += ["## 2. Fronts (figs. 10-11) and table 4", "",
-              f"![fronts]({paths['fronts'].name})", "",
-              f"![fronts overlaid]({paths['fronts_overlay'].name})", "",
-              f"![fronts near 1050 s]({paths['fronts_zoom'].name})", ""]
-    for enc in encodings:
-        lines += [f"Table 4 ({enc}): mean +- std over the runs; the seed's values in the last columns (its line "
-                  "profile differs: only magnitudes compare).", "", table4(rows, enc), ""]
 
-    lines += ["## 3. Does GR-NSGA-II beat NSGA-II? (rank-sum test)", ""]
-    for enc in encodings:
-        lines += [f"**{enc}**", "", tests_table(rows, enc), ""]
-    lines += [f"![hypervolume]({paths['box_hv'].name})", ""]
-
+def table5_lines(encodings, ctx, rows, paths):
+    """Section 4: the most punctual solutions (table 5) and fig. 12."""
+    lines = []
     lines += ["## 4. Most punctual solutions (table 5) and fig. 12", "",
               "The front member closest to 1050 s (ties: lower energy) of each algorithm's median-HV run (the "
               "runs of figs. 10-11), re-simulated; then the mean over all runs.", ""]
@@ -622,12 +618,17 @@ def write_report(path: Path, ctx: dict) -> None:
                        mean_std(r.get("punctual_e", np.nan) for r in rs),
                        mean_std(r.get("punctual_t", np.nan) for r in rs),
                        mean_std(r.get("e_at_plan", np.nan) for r in rs), f"{se} at {stt}"])
-    lines += [md_table(["encoding", "algorithm", "run (seed)", "energy (kWh)", "running time (s)",
+    lines += [markdown_rows(["encoding", "algorithm", "run (seed)", "energy (kWh)", "running time (s)",
                         "exact optimum at that time (kWh)",
                         "traction / regen (kWh)", "all runs: energy (kWh)", "all runs: time (s)",
                         "all runs: least E with T <= 1050 s", "seed 003 table 5"], t5), "",
               f"![profile]({paths['profile'].name})", ""]
+    return lines
 
+
+def exact_front_lines(ctx):
+    """Section 5: the exact front (when it was solved)."""
+    lines = []
     if ctx["exact"] is not None:
         ex = ctx["exact"]
         lines += ["## 5. The exact front", "",
@@ -635,13 +636,19 @@ def write_report(path: Path, ctx: dict) -> None:
                   f"{int(ex['n_speeds'].iloc[0])} speed nodes), each run replayed in the simulator, so it obeys the "
                   "same limits, neutral sections and energy accounting as the optimisers' runs; `lambda` is the slope "
                   "-dE/dT, the energy one more second of running time saves.", "",
-                  md_table(["requested (s)", "running time (s)", "net energy (kWh)", "traction / regen (kWh)",
+                  markdown_rows(["requested (s)", "running time (s)", "net energy (kWh)", "traction / regen (kWh)",
                             "lambda (kWh/s)", "neutral traction (J)", "limit excess (m/s)", "stop error (m)",
                             "solve (s)"],
                            [[f"{r.requested_time_s:g}", f"{r.running_time_s:.2f}", f"{r.energy_kwh:.2f}",
                              f"{r.traction_kwh:.1f} / {r.regen_kwh:.1f}", f"{r.lambda_kwh_per_s:.3f}",
-                             fmt(r.neutral_traction_j), fmt(r.limit_excess_ms), fmt(r.stop_error_m),
+                             significant(r.neutral_traction_j), significant(r.limit_excess_ms), significant(r.stop_error_m),
                              f"{r.solve_s:.0f}"] for r in ex.itertuples()]), ""]
+    return lines
+
+
+def verification_lines(ctx, case):
+    """Section 6: the checks of every front member."""
+    lines = []
     ver = ctx["verification"]
     lines += ["## 6. Verification of every front member", "",
               f"Each feasible member of every final front ({ver['n_members']} members of {ver['n_runs']} runs, the "
@@ -656,19 +663,18 @@ def write_report(path: Path, ctx: dict) -> None:
               "- the stored objectives equal the re-simulated energy and running time;",
               "- the genes of the sections inside the neutral sections (speed codes) still hold their fixed value.",
               ""]
-    lines += [md_table(["check", "worst value over all members", "required", "result"], [
-        ["neutral traction work (J)", fmt(ver["neutral_traction_j_max"]), "0", ver["neutral_ok"]],
-        ["largest force in a neutral section (N)", fmt(ver["neutral_force_n_max"]), "<= 0", ver["force_ok"]],
-        ["kernel limit excess (m/s)", fmt(ver["limit_excess_ms_max"]), "<= 0", ver["limit_ok"]],
-        ["independent limit excess over the train length (m/s)", fmt(ver["independent_excess_ms_max"]), "<= 0",
+    lines += [markdown_rows(["check", "worst value over all members", "required", "result"], [
+        ["neutral traction work (J)", significant(ver["neutral_traction_j_max"]), "0", ver["neutral_ok"]],
+        ["largest force in a neutral section (N)", significant(ver["neutral_force_n_max"]), "<= 0", ver["force_ok"]],
+        ["kernel limit excess (m/s)", significant(ver["limit_excess_ms_max"]), "<= 0", ver["limit_ok"]],
+        ["independent limit excess over the train length (m/s)", significant(ver["independent_excess_ms_max"]), "<= 0",
          ver["independent_ok"]],
-        ["stop error (m)", fmt(ver["stop_error_m_max"]), "<= 0.25", ver["stop_ok"]],
-        ["stored vs re-simulated energy (kWh)", fmt(ver["energy_mismatch_kwh"]), "0", ver["energy_ok"]],
-        ["stored vs re-simulated running time (s)", fmt(ver["time_mismatch_s"]), "0", ver["time_ok"]],
+        ["stop error (m)", significant(ver["stop_error_m_max"]), "<= 0.25", ver["stop_ok"]],
+        ["stored vs re-simulated energy (kWh)", significant(ver["energy_mismatch_kwh"]), "0", ver["energy_ok"]],
+        ["stored vs re-simulated running time (s)", significant(ver["time_mismatch_s"]), "0", ver["time_ok"]],
         ["neutral-section genes at their fixed value (10 km/h, coast)", "", "all members", ver["fixed_ok"]],
     ]), "", f"**All {ver['n_members']} members pass: {'yes' if ver['all_ok'] else 'NO'}.**", ""]
-    lines += ["## 7. Verdict", "", ctx["verdict"].strip(), ""]
-    path.write_text("\n".join(lines) + "\n")
+    return lines
 
 
 def verification_summary(rows) -> dict:
@@ -701,7 +707,7 @@ def verdict_text(rows) -> str:
             p, verdict, rel = rank_sum(rows, enc, key, lower)
             word = {"+": "better (significant)", "-": "worse (significant)",
                     "=": "not significantly different"}.get(verdict, "untested")
-            parts.append(f"{name}: GR-NSGA-II {word}, means differ by {difference(key, rel)} (p = {fmt(p, 3)})")
+            parts.append(f"{name}: GR-NSGA-II {word}, means differ by {difference(key, rel)} (p = {significant(p, 3)})")
         lines.append(f"- Measured on {enc}: " + "; ".join(parts) + ".")
     return "\n".join(lines)
 
@@ -780,7 +786,7 @@ def main(argv=None) -> int:
                             args.local_size)
     enc_dir, main_dir = args.work / "encodings", args.work / "main"
     if args.resolution:
-        from benchmarks.optimal import markdown
+        from pymoo_rail.experiments.report import markdown
 
         print(markdown(resolution(load_results(main_dir, study=main_study))), flush=True)
         return 0

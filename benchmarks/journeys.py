@@ -27,17 +27,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK  # noqa: E402
-from pymoo_rail.journeys import (  # noqa: E402
+from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
+from pymoo_rail.journeys import (
     BudgetRepair,
     journey_from_ttobench,
     RunningTimeAllocationProblem,
@@ -48,24 +45,11 @@ from pymoo_rail.journeys import (  # noqa: E402
     strategy_front,
     supplement_split,
 )
-from pymoo_rail.model import CaseError  # noqa: E402
+from pymoo_rail.experiments.report import markdown
+from pymoo_rail.model import CaseError
 
 SUPPLEMENTS = (0.0, 0.03, 0.05, 0.075, 0.10, 0.15, 0.20, 0.25)
 TRIP_TIME_S = 1800.0
-
-
-def markdown(df: pd.DataFrame, floatfmt: str = ".2f") -> str:
-    cols = list(df.columns)
-    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for row in df.astype(object).itertuples(index=False):
-        cells = []
-        for v in row:
-            if isinstance(v, (float, np.floating)):
-                cells.append("-" if np.isnan(v) else format(v, floatfmt))
-            else:
-                cells.append(str(v))
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines)
 
 
 def rule_energy(journey, total, fronts, rule):
@@ -259,7 +243,7 @@ second on the steepest section).
 Supplement = total running time over the sum of the sections' flat-out times. "-" = the rule gives
 some section more time than its front covers.
 
-{markdown(table)}
+{markdown(table, 2, missing="-")}
 
 ## Every split run on the combined fronts
 
@@ -268,7 +252,7 @@ The combined fronts are the lower hull of the exact solver's and the strategy se
 closest one here). Each split below is computed on the fronts named and then run on the combined
 fronts: how much a split suffers from the errors of the fronts it was computed on.
 
-{markdown(cross)}
+{markdown(cross, 2, missing="-")}
 
 ## The {TRIP_TIME_S / 60:.0f}-minute trip, section by section (exact fronts)
 
@@ -276,13 +260,13 @@ Optimal split {best.energy_kwh:.2f} kWh against {equal.energy_kwh:.2f} kWh for t
 ({100 * (equal.energy_kwh - best.energy_kwh) / equal.energy_kwh:.2f} % saved), marginal price
 {1000 * best.price_kwh_per_s:.1f} Wh per second of running time.
 
-{markdown(per_section)}
+{markdown(per_section, 2, missing="-")}
 
 ## pymoo DE on the same problem (`RunningTimeAllocationProblem` + `BudgetRepair`)
 
 DE(pop_size=40), {args.de_gens} generations, against the exact {best.energy_kwh:.4f} kWh:
 
-{markdown(de, ".4f")}
+{markdown(de, 4, missing="-")}
 
 ## Simulated and combined fronts against the exact ones
 
@@ -291,7 +275,7 @@ common to the fronts. Positive = more energy than the exact solver's front. Xiao
 Jiugong (section 2) crosses zero net energy (downhill with regen), which inflates its relative
 numbers.
 
-{markdown(gaps, ".3f")}
+{markdown(gaps, 3, missing="-")}
 
 ![energy against trip time](journeys.png)
 """

@@ -25,15 +25,12 @@ Writes ``benchmarks/reports/metro_controllers.md``, ``metro_controllers.csv`` an
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from pymoo_rail.experiments.report import add_study_options, lower_priority
 
-from pymoo_rail.experiments.scripts import add_study_options, lower_priority
+ROOT = Path(__file__).resolve().parents[1]
 
 REPORTS = ROOT / "benchmarks" / "reports"
 METRICS = {"control_error_rms_kmh": "tracking error rms km/h", "jerk_ms2": "jerk (sum of abs da) m/s^2",

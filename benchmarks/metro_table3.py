@@ -26,19 +26,16 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 import warnings
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
 from pymoo_rail.constants import KMH_PER_MS
-from pymoo_rail.experiments.scripts import add_study_options, lower_priority
+from pymoo_rail.experiments.report import add_study_options, fixed, lower_priority
+
+ROOT = Path(__file__).resolve().parents[1]
 
 REPORTS = ROOT / "benchmarks" / "reports"
 STUDIES = (ROOT / "examples" / "metro_table3.toml", ROOT / "examples" / "metro_weights.toml")
@@ -107,14 +104,6 @@ def best_runs(results) -> list[dict]:
     return rows
 
 
-def fmt(v, digits=2):
-    if isinstance(v, (bool, np.bool_)):
-        return "yes" if v else "no"
-    if isinstance(v, (float, np.floating)):
-        return f"{v:.{digits}f}" if math.isfinite(v) else "-"
-    return str(v)
-
-
 def write_report(out: Path, table3, weights) -> None:
     import matplotlib
 
@@ -157,7 +146,7 @@ def write_report(out: Path, table3, weights) -> None:
          "## Table 3", "",
          "| run | " + " | ".join(cols) + " |", "|---|" + "---:|" * len(cols)]
     for name, row in rows.items():
-        L.append(f"| {name} | " + " | ".join(fmt(row.get(c, float("nan"))) for c in cols) + " |")
+        L.append(f"| {name} | " + " | ".join(fixed(row.get(c, float("nan"))) for c in cols) + " |")
     L += ["", f"Weighted sum f over the {len(fs)} seeds: best {fs.min():.4f}, median {np.median(fs):.4f}, "
           f"worst {fs.max():.4f}; the 1 m grid optimum is {grid_f:.4f} (comfort contributes the constant "
           f"0.2 to every f). CPU per run: median {np.median([r['cpu_time_s'] for r in runs3]):.2f} s.", ""]

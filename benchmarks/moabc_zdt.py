@@ -111,19 +111,78 @@ def plot_first_fronts(fronts: dict, path: Path) -> None:
     save_figure(fig, path, dpi=110)
 
 
+def igd_median_rows(df) -> list[str]:
+    """One row per algorithm: its median IGD on each problem."""
+    lines = []
+    for a in ALGORITHMS:
+        cells = []
+        for p in PROBLEMS:
+            v = df[(df.problem == p) & (df.algorithm == a)].IGD
+            cells.append(f"{v.median():.4g}" if len(v) else "-")
+        lines.append(f"| {a} | " + " | ".join(cells) + " |")
+    lines.append("")
+    return lines
+
+
+def problem_tables(df) -> list[str]:
+    """Per problem, every indicator of every algorithm with its rank-sum mark against NSGA-II."""
+    from pymoo_rail.experiments.stats import rank_sum
+
+    lines = []
+    for p in PROBLEMS:
+        lines += [f"## {p}", "",
+                  "| algorithm | runs | n_eval | " + " | ".join(
+                      f"{i} mean | {i} median | {i} std | W" for i in INDICATORS) + " | time s |",
+                  "|---|---|---|" + "---|---|---|---|" * len(INDICATORS) + "---|"]
+        base = df[(df.problem == p) & (df.algorithm == "NSGA2")]
+        for a in ALGORITHMS:
+            g = df[(df.problem == p) & (df.algorithm == a)]
+            if len(g) == 0:
+                continue
+            cells = []
+            for ind in INDICATORS:
+                v = g[ind].astype(float)
+                mark = ""
+                if a != "NSGA2" and len(base) > 1 and len(g) > 1:
+                    mark = rank_sum(v, base[ind].astype(float), lower_better=LOWER_IS_BETTER[ind])[2]
+                cells.append(f"{v.mean():.4g} | {v.median():.4g} | {v.std(ddof=1) if len(v) > 1 else 0:.2g} | {mark}")
+            lines.append(f"| {a} | {len(g)} | {g.n_eval.mean():.0f} | " + " | ".join(cells)
+                         + f" | {g.time_s.mean():.2f} |")
+        lines.append("")
+    return lines
+
+
+def plot_igd_boxes(df, path: Path) -> None:
+    """Box plots of the IGD of every algorithm, one panel per problem."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from pymoo_rail.plotting import save_figure
+
+    fig, axes = plt.subplots(1, 4, figsize=(18, 4))
+    for ax, p in zip(axes, PROBLEMS):
+        present = [a for a in ALGORITHMS if ((df.problem == p) & (df.algorithm == a)).any()]
+        if not present:  # a reduced study
+            ax.set_axis_off()
+            continue
+        data = [df[(df.problem == p) & (df.algorithm == a)].IGD.astype(float).values for a in present]
+        ax.boxplot(data)
+        ax.set_xticks(range(1, len(present) + 1), [a.replace("MOABC-", "MOABC\n") for a in present])
+        ax.set_yscale("log")
+        ax.set_title(f"{p}: IGD")
+        ax.tick_params(axis="x", labelsize=7)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110)
+
+
 def report(out: Path, results) -> None:
     """Report, per-run CSV and figures from the stored runs (``load_results``).
 
     Without stored runs the report is rebuilt from the committed ``moabc_zdt.csv`` by the same
     code (the IGD box plot is redrawn; the front figure, which needs the fronts, is kept).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from pymoo_rail.experiments.scripts import count_range, report_runs
-    from pymoo_rail.plotting import save_figure
-    from pymoo_rail.experiments.stats import rank_sum
+    from pymoo_rail.experiments.report import count_range, report_runs
 
     df, fronts, from_records = report_runs(results, run_row, FIELDS, out / RUNS_CSV)
     if from_records:
@@ -159,65 +218,26 @@ def report(out: Path, results) -> None:
         "| algorithm | " + " | ".join(PROBLEMS) + " |",
         "|---|" + "---|" * len(PROBLEMS),
     ]
-    for a in ALGORITHMS:
-        cells = []
-        for p in PROBLEMS:
-            v = df[(df.problem == p) & (df.algorithm == a)].IGD
-            cells.append(f"{v.median():.4g}" if len(v) else "-")
-        lines.append(f"| {a} | " + " | ".join(cells) + " |")
-    lines.append("")
+    lines += igd_median_rows(df)
 
-    for p in PROBLEMS:
-        lines += [f"## {p}", "",
-                  "| algorithm | runs | n_eval | " + " | ".join(
-                      f"{i} mean | {i} median | {i} std | W" for i in INDICATORS) + " | time s |",
-                  "|---|---|---|" + "---|---|---|---|" * len(INDICATORS) + "---|"]
-        base = df[(df.problem == p) & (df.algorithm == "NSGA2")]
-        for a in ALGORITHMS:
-            g = df[(df.problem == p) & (df.algorithm == a)]
-            if len(g) == 0:
-                continue
-            cells = []
-            for ind in INDICATORS:
-                v = g[ind].astype(float)
-                mark = ""
-                if a != "NSGA2" and len(base) > 1 and len(g) > 1:
-                    mark = rank_sum(v, base[ind].astype(float), lower_better=LOWER_IS_BETTER[ind])[2]
-                cells.append(f"{v.mean():.4g} | {v.median():.4g} | {v.std(ddof=1) if len(v) > 1 else 0:.2g} | {mark}")
-            lines.append(f"| {a} | {len(g)} | {g.n_eval.mean():.0f} | " + " | ".join(cells)
-                         + f" | {g.time_s.mean():.2f} |")
-        lines.append("")
-
+    lines += problem_tables(df)
     plot_first_fronts(fronts, out / "moabc_zdt_fronts.png")
 
-    fig, axes = plt.subplots(1, 4, figsize=(18, 4))
-    for ax, p in zip(axes, PROBLEMS):
-        present = [a for a in ALGORITHMS if ((df.problem == p) & (df.algorithm == a)).any()]
-        if not present:  # a reduced study
-            ax.set_axis_off()
-            continue
-        data = [df[(df.problem == p) & (df.algorithm == a)].IGD.astype(float).values for a in present]
-        ax.boxplot(data)
-        ax.set_xticks(range(1, len(present) + 1), [a.replace("MOABC-", "MOABC\n") for a in present])
-        ax.set_yscale("log")
-        ax.set_title(f"{p}: IGD")
-        ax.tick_params(axis="x", labelsize=7)
-    fig.tight_layout()
-    save_figure(fig, out / "moabc_zdt_igd.png", dpi=110)
+    plot_igd_boxes(df, out / "moabc_zdt_igd.png")
     lines += ["![fronts](moabc_zdt_fronts.png)", "", "![IGD](moabc_zdt_igd.png)", ""]
     (out / "moabc_zdt.md").write_text("\n".join(lines) + "\n")
     print(f"wrote {out / 'moabc_zdt.md'}")
 
 
 def main() -> None:
-    from pymoo_rail.experiments.scripts import add_study_options
+    from pymoo_rail.experiments.report import add_study_options
 
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "moabc_zdt", Path(__file__).parent / "reports",
                       runs=30, workers=True)
     args = parser.parse_args()
     from pymoo_rail.experiments import load_results, run_study
-    from pymoo_rail.experiments.scripts import lower_priority
+    from pymoo_rail.experiments.report import lower_priority
 
     study = build_study(args.runs)
     if not args.report_only:

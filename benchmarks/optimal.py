@@ -26,19 +26,9 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
+from pymoo_rail.experiments.report import markdown
 
 REPORT = Path(__file__).resolve().parent / "reports" / "optimal.md"
-
-
-def markdown(table: pd.DataFrame, digits: int = 4) -> str:
-    """A DataFrame as a GitHub markdown table (no extra dependency)."""
-    def cell(v):
-        if isinstance(v, (float, np.floating)):
-            return f"{v:.{digits}f}"
-        return str(v)
-    lines = ["| " + " | ".join(map(str, table.columns)) + " |", "|" + "---|" * len(table.columns)]
-    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in table.itertuples(index=False)]
-    return "\n".join(lines)
 
 
 def level_case():

@@ -333,8 +333,7 @@ def main_generated(args) -> None:
             *generated_summary(table, intervals), "", markdown(table.drop(columns=["features"])), "",
             "Features of the lines:", "",
             *[f"- seed {s}: {f}" for s, f in table.groupby("seed")["features"].first().items()], ""]
-    report = HERE / "reports" / "peers_generated.md"
-    report.write_text("\n".join(text))
+    args.report.write_text("\n".join(text))
     print("\n".join(text))
 
 
@@ -349,6 +348,8 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", help="instead of --generated/--first-seed: these seeds")
     parser.add_argument("--intervals", type=int, nargs="+", default=[300, 1000], help="ms-eetc's N on generated lines")
     parser.add_argument("--repeats", type=int, default=1, help="ms-eetc solves per answer (best CPU time)")
+    parser.add_argument("--report", type=Path, default=HERE / "reports" / "peers_generated.md",
+                        help="where the generated lines' report goes")
     args = parser.parse_args()
     if args.generated or args.seeds:
         main_generated(args)

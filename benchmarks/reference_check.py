@@ -31,51 +31,14 @@ Writes ``benchmarks/reports/reference_check.csv`` (one row per member) and ``ref
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 import pandas as pd
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from pymoo_rail.experiments.report import committed_members, lower_priority, markdown, member_cases
+from pymoo_rail.experiments.report import write_report as write_text
 
-from benchmarks.optimal import markdown  # noqa: E402
-
-from pymoo_rail.experiments.scripts import lower_priority  # noqa: E402
-
-REPORTS = ROOT / "benchmarks" / "reports"
-
-
-def members() -> pd.DataFrame:
-    """Every committed member: ``source``, ``case``, ``label`` (run / algorithm), time and energy."""
-    rows = []
-    y = pd.read_csv(REPORTS / "yizhuang_seed000.csv")
-    for r in y.itertuples():
-        rows.append(("yizhuang_seed000", "yizhuang", f"{r.algorithm} {r.partition}", r.seed, "best",
-                     r.running_time_s, r.energy_kwh))
-    w = pd.read_csv(REPORTS / "emu_wuguang_runs.csv")
-    for r in w.itertuples():
-        for kind, t, e in (("fastest", r.t_min, r.e_max), ("slowest", r.t_max, r.e_min),
-                           ("punctual", r.punctual_t, r.punctual_e)):
-            rows.append(("emu_wuguang", "wuguang-crh3", f"{r.algorithm} {r.problem}", r.seed, kind, t, e))
-    j = pd.read_csv(REPORTS / "journeys_fronts_simulated.csv")
-    for r in j.itertuples():
-        rows.append(("journeys", f"section {int(r.section)}", r.case, int(r.section), "strategy",
-                     r.running_time_s, r.energy_kwh))
-    return pd.DataFrame(rows, columns=["source", "case", "label", "seed", "member", "running_time_s", "energy_kwh"])
-
-
-def case_objects() -> dict:
-    """The cases the members ran on, by the names :func:`members` gives them."""
-    from pymoo_rail.cases import load_case
-    from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
-    from pymoo_rail.journeys import journey_from_ttobench
-
-    journey = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
-    cases = {"yizhuang": load_case("yizhuang"), "wuguang-crh3": load_case("wuguang-crh3")}
-    cases.update({f"section {k}": c for k, c in enumerate(journey.sections)})
-    return cases
+REPORTS = Path(__file__).resolve().parent / "reports"
 
 
 def check(table: pd.DataFrame) -> pd.DataFrame:
@@ -84,7 +47,7 @@ def check(table: pd.DataFrame) -> pd.DataFrame:
 
     from pymoo_rail.optimal import ReferenceAtTime, solved_energy_gap
 
-    cases = case_objects()
+    cases = member_cases()
     parts = []
     for name, group in tqdm(list(table.groupby("case", sort=False)), desc="cases", unit="case"):
         ref = ReferenceAtTime(cases[name])
@@ -125,7 +88,7 @@ def write_report(table: pd.DataFrame, out: Path) -> int:
              "more than the certificate, a defect of the reference.", "",
              f"Members in range: {int(table['in_range'].sum())} of {len(table)}; below the reference beyond the "
              f"certificate: **{n_below}**.", "", markdown(s), ""]
-    (out / "reference_check.md").write_text("\n".join(lines))
+    write_text(out / "reference_check.md", lines, newline=False)
     print("\n".join(lines))
     return n_below
 
@@ -153,7 +116,7 @@ def main(argv=None) -> int:
         table = with_derived_columns(pd.read_csv(csv_path))
     else:
         lower_priority()
-        table = members()
+        table = committed_members(REPORTS)
         if args.limit is not None:
             table = table.groupby("case", sort=False).head(args.limit)
         table = check(table)

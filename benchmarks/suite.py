@@ -63,7 +63,8 @@ def scores(results: pd.DataFrame) -> pd.DataFrame:
     IGD is recomputed here (pymoo's, the same call as the runner's) so that every indicator is
     against the front shipped now, even if a record was written against an earlier front version.
     """
-    from pymoo_rail.experiments.certified import certified_gap, hv_ratio
+    from pymoo_rail.experiments.metrics import hv_ratio
+    from pymoo_rail.problems.reference import certified_gap
     from pymoo_rail.experiments.metrics import front_indicators
     from pymoo_rail.suite import get_problem
 

@@ -1,7 +1,7 @@
 """Trains sharing braking energy in one supply section: 2, 4 and 8 trains (``examples/timetable.toml``).
 
 Runs the study file through ``pymoo_rail.experiments.run_study`` (records in
-``reports/timetable_study/``; finished runs are skipped when run again) and writes
+``out/timetable_study/``, not tracked; finished runs are skipped when run again) and writes
 ``reports/timetable.md``: per number of trains, the least net substation energy found, its saving
 against the reference (every train exactly optimal alone, nothing shared: ``n_trains`` times the
 exact baseline of the line, ``exact_baseline``), what was shared, and the waiting time it costs
@@ -19,7 +19,7 @@ import numpy as np
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments import load_results, run_study
-from pymoo_rail.experiments.scripts import lower_priority
+from pymoo_rail.experiments.report import lower_priority
 from pymoo_rail.experiments.study_file import read_study
 from pymoo_rail.problems import TimetableProblem
 
@@ -33,7 +33,7 @@ def main() -> None:
     args = parser.parse_args()
     lower_priority()
     study = read_study(ROOT.parent / "examples" / "timetable.toml")
-    directory = REPORTS / "timetable_study"
+    directory = ROOT.parent / "out" / "timetable_study"
     run_study(study, directory, workers=args.workers, seed_major=True)
     results = load_results(directory)
 

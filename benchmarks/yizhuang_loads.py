@@ -16,17 +16,14 @@ Writes ``benchmarks/reports/yizhuang_loads.md``.
 from __future__ import annotations
 
 import argparse
-import sys
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from pymoo_rail.experiments.report import add_study_options, lower_priority
 
-from pymoo_rail.experiments.scripts import add_study_options, lower_priority
+ROOT = Path(__file__).resolve().parents[1]
 
 STUDY = ROOT / "examples" / "yizhuang_loads.toml"
 REPORTS = ROOT / "benchmarks" / "reports"

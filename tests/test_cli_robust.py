@@ -233,3 +233,20 @@ def test_remove_idle_locks_keeps_held_claims_and_unfinished_runs(tmp_path):
     finally:
         holder.release()
     assert sorted(p.name for p in store.locks_dir.iterdir()) == ["held.lock", "unfinished.lock"]
+
+
+def test_the_readme_lists_every_command():
+    from pathlib import Path
+
+    from pymoo_rail.cli.parser import command_modules
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    names = [module.__name__.rsplit(".", 1)[1] for module in command_modules()]
+    assert len(names) >= 10 and [n for n in names if f"| `pymoo-rail {n}" not in readme] == []
+
+
+def test_plot_to_a_path_that_cannot_be_written_names_out(capsys, tmp_path):
+    pd.DataFrame({"chosen": [True, False], "f_energy": [12.0, 11.0], "f_time_error": [0.5, 3.0]}).to_csv(
+        tmp_path / "front.csv", index=False)
+    code, _, err = run(capsys, "plot", "front", tmp_path / "front.csv", "--out", "/proc/x/front.png")
+    assert code == 2 and "argument --out" in err and "/proc/x/front.png" in err and "Traceback" not in err

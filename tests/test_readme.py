@@ -111,7 +111,8 @@ def page_script(page: Path, with_slow: bool) -> tuple[str, list[int]]:
             continue
         lines += [""] * (line - 1 - len(lines))  # so that a traceback names the line of the page
         lines += code.splitlines()
-        lines.append(f"print({_SEPARATOR.format(index)!r}, flush=True)")
+        # only the main process: a study's pool workers import the script and must not print separators
+        lines.append(f"if __name__ == '__main__': print({_SEPARATOR.format(index)!r}, flush=True)")
         ran.append(index)
     return "\n".join(lines) + "\n", ran
 

@@ -180,6 +180,39 @@ def _check_int(name: str, value, low: int) -> int:
     return int(value)
 
 
+def _check_probabilities(pc_max, pc_min, pm_max, pm_min) -> tuple[float, float, float, float]:
+    """The crossover and mutation probability bounds, checked; a missing minimum from eqs. 8-9's golden ratios."""
+    pc_max = _check_probability("pc_max", pc_max)
+    pm_max = _check_probability("pm_max", pm_max)
+    pc_min = pc_max * math.exp(-GOLDEN_SHORT) if pc_min is None else pc_min
+    pm_min = pm_max * math.exp(-GOLDEN_LONG) if pm_min is None else pm_min
+    pc_min = _check_probability("pc_min", pc_min)
+    pm_min = _check_probability("pm_min", pm_min)
+    if pc_min > pc_max:
+        raise ValueError(f"pc_min must not exceed pc_max ({pc_max}), got {pc_min!r}")
+    if pm_min > pm_max:
+        raise ValueError(f"pm_min must not exceed pm_max ({pm_max}), got {pm_min!r}")
+    return pc_max, pc_min, pm_max, pm_min
+
+
+def _check_operators(crossover, mutation) -> tuple[Crossover, PolynomialMutation]:
+    """The crossover (2 parents, 2 offspring; default SBX eta 15) and the polynomial mutation (default eta 20)."""
+    crossover = SBX(eta=15) if crossover is None else crossover
+    shape = (getattr(crossover, "n_parents", None), getattr(crossover, "n_offsprings", None))
+    if not isinstance(crossover, Crossover) or shape != (2, 2):
+        raise ValueError(
+            "crossover must be a pymoo Crossover with 2 parents and 2 offspring, "
+            f"got {crossover!r}"
+        )
+    mutation = PM(eta=20) if mutation is None else mutation
+    if not isinstance(mutation, PolynomialMutation):
+        raise ValueError(
+            "mutation must be a pymoo PolynomialMutation (eq. 9 sets its probability), "
+            f"got {mutation!r}"
+        )
+    return crossover, mutation
+
+
 class GoldenRatioNSGA2(NSGA2):
     r"""Golden-ratio NSGA-II of Tang et al. (2020) (Tang, Wang, Yu 2020, section 3.1).
 
@@ -326,35 +359,12 @@ class GoldenRatioNSGA2(NSGA2):
         if n_offsprings is not None:
             n_offsprings = _check_int("n_offsprings", n_offsprings, 1)
 
-        pc_max = _check_probability("pc_max", pc_max)
-        pm_max = _check_probability("pm_max", pm_max)
-        pc_min = pc_max * math.exp(-GOLDEN_SHORT) if pc_min is None else pc_min
-        pm_min = pm_max * math.exp(-GOLDEN_LONG) if pm_min is None else pm_min
-        pc_min = _check_probability("pc_min", pc_min)
-        pm_min = _check_probability("pm_min", pm_min)
-        if pc_min > pc_max:
-            raise ValueError(f"pc_min must not exceed pc_max ({pc_max}), got {pc_min!r}")
-        if pm_min > pm_max:
-            raise ValueError(f"pm_min must not exceed pm_max ({pm_max}), got {pm_min!r}")
-
+        pc_max, pc_min, pm_max, pm_min = _check_probabilities(pc_max, pc_min, pm_max, pm_min)
         if isinstance(t0, bool) or not isinstance(t0, Real) or not (0.0 < t0 < math.inf):
             raise ValueError(f"t0 must be a positive finite temperature, got {t0!r}")
         if isinstance(cooling, bool) or not isinstance(cooling, Real) or not 0.0 < cooling <= 1.0:
             raise ValueError(f"cooling must lie in (0, 1], got {cooling!r}")
-
-        crossover = SBX(eta=15) if crossover is None else crossover
-        shape = (getattr(crossover, "n_parents", None), getattr(crossover, "n_offsprings", None))
-        if not isinstance(crossover, Crossover) or shape != (2, 2):
-            raise ValueError(
-                "crossover must be a pymoo Crossover with 2 parents and 2 offspring, "
-                f"got {crossover!r}"
-            )
-        mutation = PM(eta=20) if mutation is None else mutation
-        if not isinstance(mutation, PolynomialMutation):
-            raise ValueError(
-                "mutation must be a pymoo PolynomialMutation (eq. 9 sets its probability), "
-                f"got {mutation!r}"
-            )
+        crossover, mutation = _check_operators(crossover, mutation)
 
         self.fixed_genes = self._check_fixed_genes(fixed_genes)
 

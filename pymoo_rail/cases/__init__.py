@@ -19,6 +19,7 @@ from pathlib import Path
 
 from pymoo_rail.cases.formats import FORMATS, call_reader, format_of
 from pymoo_rail.cases.generate import KINDS, generate_case
+from pymoo_rail.cases.railjson import railjson_case
 from pymoo_rail.cases.toml_case import read_case, write_case
 from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK, from_ttobench
 from pymoo_rail.cases.ttobench_writer import to_ttobench
@@ -128,4 +129,4 @@ def load_train(path: str | Path, **options) -> Train:
 
 __all__ = ["load_case", "generate_case", "KINDS", "list_cases", "case_path", "with_load", "LOADS_T",
            "TTOBENCH_SECTIONS", "from_ttobench", "to_ttobench", "read_case", "write_case", "FORMATS", "format_of",
-           "load_train"]
+           "load_train", "railjson_case"]

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from pymoo_rail.cases import toml_case, ttobench
+from pymoo_rail.cases import railjson, toml_case, ttobench
 from pymoo_rail.cases.files import file_bytes
 from pymoo_rail.model import Case, CaseError, Train
 
@@ -32,7 +32,8 @@ class CaseFormat:
     read_train: Callable[..., Train]
 
 
-FORMATS: tuple[CaseFormat, ...] = (
+FORMATS: tuple[CaseFormat, ...] = (  # content is tried in this order: the narrowest format first
+    CaseFormat("railjson", (".toml", ".json"), railjson.looks_like, railjson.read_case, railjson.read_train),
     CaseFormat("toml", (".toml",), toml_case.looks_like, toml_case.read_case, toml_case.read_train),
     CaseFormat("ttobench", (".json",), ttobench.looks_like, ttobench.read_case, ttobench.read_train_file),
 )
@@ -62,5 +63,7 @@ def format_of(path: str | Path) -> CaseFormat:
     for fmt in by_suffix or FORMATS:
         if fmt.looks_like(head):
             return fmt
+    if by_suffix:  # the suffix's general reader (the last) names what is wrong with the file
+        return by_suffix[-1]
     known = ", ".join(f"{f.name} ({' '.join(f.suffixes)})" for f in FORMATS)
     raise CaseError("path", str(path), f"is in no known case format (known: {known})", str(path))

@@ -134,6 +134,83 @@ def _value_at(rows, x: float) -> float:
     return rows[-1][2]
 
 
+def _overlay(rows, a, b, pieces):
+    """Replace ``rows`` over [a, b] by ``pieces`` (start, end, value)."""
+    out = []
+    for r0, r1, v in rows:
+        if r1 <= a or r0 >= b:
+            out.append((r0, r1, v))
+            continue
+        if r0 < a:
+            out.append((r0, a, v))
+        if r1 > b:
+            out.append((b, r1, v))
+    out.extend(pieces)
+    out.sort()
+    return out
+
+
+def _split(rng, a, b, values, gap):
+    """``values`` over [a, b], on stretches cut at random (each at least ``gap``, or a share of [a, b])."""
+    cuts = [a, *_cuts(rng, a, b, len(values) - 1, min(gap, (b - a) / (2 * len(values)))), b]
+    return [(c0, c1, values[k]) for k, (c0, c1) in enumerate(zip(cuts[:-1], cuts[1:]))]
+
+
+def _add_descent(rng, spec, length, gap, margin, grad_rows, limit_rows, features):
+    """A long descent under low limits (regenerative holding): the new gradient and limit rows."""
+    size = min(_round(rng.uniform(*spec.descent_m)), 0.5 * length)
+    a = _round(rng.uniform(margin, max(margin, length - margin - size)))
+    b = min(a + size, length - margin)
+    if b - a >= 2 * gap:
+        n = int(rng.integers(2, 5))
+        steep = [-_round(float(rng.uniform(*spec.descent_permille)), 0.5) for _ in range(n)]
+        grad_rows = _overlay(grad_rows, a, b, _split(rng, a, b, steep, gap))
+        lows = sorted((float(rng.choice(spec.low_limits_kmh)) for _ in range(2)), reverse=True)
+        limit_rows = _overlay(limit_rows, a, b, _split(rng, a, b, lows, gap))
+        features.append(f"descent {steep} permille over {a:.0f}-{b:.0f} m under {lows} km/h")
+    return grad_rows, limit_rows
+
+
+def _add_climb(rng, spec, length, gap, margin, mild, grad_rows, features):
+    """A long climb taken at full power, not over the descent: the new gradient rows."""
+    size = min(_round(rng.uniform(*spec.climb_m)), 0.4 * length)
+    a = _round(rng.uniform(margin, max(margin, length - margin - size)))
+    b = min(a + size, length - margin)
+    clear = all(v > -mild or r1 <= a or r0 >= b for r0, r1, v in grad_rows)  # not over the descent
+    if b - a >= 2 * gap and clear:
+        n = int(rng.integers(1, 4))
+        steep = [_round(float(rng.uniform(*spec.climb_permille)), 0.5) for _ in range(n)]
+        grad_rows = _overlay(grad_rows, a, b, _split(rng, a, b, steep, gap))
+        features.append(f"climb {steep} permille over {a:.0f}-{b:.0f} m")
+    return grad_rows
+
+
+def _neutral_sections(rng, spec, length, train_length_m, grad_rows):
+    """Neutral sections drawn at random, kept on level or falling track over the whole train."""
+    neutral = []
+    for a, b in _intervals(rng, length, int(rng.integers(0, spec.neutral_sections + 1)), spec.neutral_m,
+                           max(2000.0, 0.2 * length)):
+        # on level or falling track over the whole train: no stall on a climb without power
+        under = [v for r0, r1, v in grad_rows if r1 > a - train_length_m and r0 < b]
+        if max(under) <= 0.0:
+            neutral.append((a, b))
+    return neutral
+
+
+def _boundary_speeds_kmh(rng, spec, limit_rows, features) -> tuple[float, float]:
+    """Initial and final speed: from and to rest, or moving, below the limits there with room to brake."""
+    initial_kmh = final_kmh = 0.0
+    if rng.random() < spec.p_moving_ends:
+        speed = float(rng.choice(spec.boundary_speeds_kmh))
+        first_room = limit_rows[0][1] - limit_rows[0][0]
+        last_room = limit_rows[-1][1] - limit_rows[-1][0]
+        if first_room >= 1000.0 and last_room >= 1000.0:
+            initial_kmh = min(speed, limit_rows[0][2])
+            final_kmh = min(speed, limit_rows[-1][2])
+            features.append(f"moving ends {initial_kmh:g} / {final_kmh:g} km/h")
+    return initial_kmh, final_kmh
+
+
 def generate_case(seed: int, kind: str = "intercity") -> Case:
     """A random but plausible case: a line drawn from ``seed`` for one kind of service.
 
@@ -178,47 +255,11 @@ def generate_case(seed: int, kind: str = "intercity") -> Case:
     grad_rows = list(_tile(grad_points, grads))
     limit_rows = list(_tile(limit_points, limits))
 
-    def overlay(rows, a, b, pieces):
-        """Replace ``rows`` over [a, b] by ``pieces`` (start, end, value)."""
-        out = []
-        for r0, r1, v in rows:
-            if r1 <= a or r0 >= b:
-                out.append((r0, r1, v))
-                continue
-            if r0 < a:
-                out.append((r0, a, v))
-            if r1 > b:
-                out.append((b, r1, v))
-        out.extend(pieces)
-        out.sort()
-        return out
-
-    def split(a, b, values):
-        cuts = [a, *_cuts(rng, a, b, len(values) - 1, min(gap, (b - a) / (2 * len(values)))), b]
-        return [(c0, c1, values[k]) for k, (c0, c1) in enumerate(zip(cuts[:-1], cuts[1:]))]
-
     margin = max(gap, 0.1 * length)
     if rng.random() < spec.p_descent:  # a long descent under low limits: regenerative holding
-        size = min(_round(rng.uniform(*spec.descent_m)), 0.5 * length)
-        a = _round(rng.uniform(margin, max(margin, length - margin - size)))
-        b = min(a + size, length - margin)
-        if b - a >= 2 * gap:
-            n = int(rng.integers(2, 5))
-            steep = [-_round(float(rng.uniform(*spec.descent_permille)), 0.5) for _ in range(n)]
-            grad_rows = overlay(grad_rows, a, b, split(a, b, steep))
-            lows = sorted((float(rng.choice(spec.low_limits_kmh)) for _ in range(2)), reverse=True)
-            limit_rows = overlay(limit_rows, a, b, split(a, b, lows))
-            features.append(f"descent {steep} permille over {a:.0f}-{b:.0f} m under {lows} km/h")
+        grad_rows, limit_rows = _add_descent(rng, spec, length, gap, margin, grad_rows, limit_rows, features)
     if rng.random() < spec.p_climb:  # a long climb, taken at full power
-        size = min(_round(rng.uniform(*spec.climb_m)), 0.4 * length)
-        a = _round(rng.uniform(margin, max(margin, length - margin - size)))
-        b = min(a + size, length - margin)
-        clear = all(v > -mild or r1 <= a or r0 >= b for r0, r1, v in grad_rows)  # not over the descent
-        if b - a >= 2 * gap and clear:
-            n = int(rng.integers(1, 4))
-            steep = [_round(float(rng.uniform(*spec.climb_permille)), 0.5) for _ in range(n)]
-            grad_rows = overlay(grad_rows, a, b, split(a, b, steep))
-            features.append(f"climb {steep} permille over {a:.0f}-{b:.0f} m")
+        grad_rows = _add_climb(rng, spec, length, gap, margin, mild, grad_rows, features)
     grad_rows, limit_rows = _absorb_short(grad_rows, gap), _absorb_short(limit_rows, gap)
     grad_points = [r[0] for r in grad_rows] + [length]
     grad_rows = list(_tile(grad_points, [r[2] for r in grad_rows]))
@@ -228,24 +269,10 @@ def generate_case(seed: int, kind: str = "intercity") -> Case:
     curves = tuple((a, b, _round(float(rng.uniform(*spec.curve_radius_m)), 50.0))
                    for a, b in _intervals(rng, length, n_curves, (0.05 * length, 0.15 * length), gap))
     tunnels = tuple(_intervals(rng, length, int(rng.integers(0, 3)), (0.03 * length, 0.12 * length), gap))
-    neutral = []
-    for a, b in _intervals(rng, length, int(rng.integers(0, spec.neutral_sections + 1)), spec.neutral_m,
-                           max(2000.0, 0.2 * length)):
-        # on level or falling track over the whole train: no stall on a climb without power
-        under = [v for r0, r1, v in grad_rows if r1 > a - train.length_m and r0 < b]
-        if max(under) <= 0.0:
-            neutral.append((a, b))
+    neutral = _neutral_sections(rng, spec, length, train.length_m, grad_rows)
 
     # boundary speeds: from and to rest, or moving, below the limits there with room to brake
-    initial_kmh = final_kmh = 0.0
-    if rng.random() < spec.p_moving_ends:
-        speed = float(rng.choice(spec.boundary_speeds_kmh))
-        first_room = limit_rows[0][1] - limit_rows[0][0]
-        last_room = limit_rows[-1][1] - limit_rows[-1][0]
-        if first_room >= 1000.0 and last_room >= 1000.0:
-            initial_kmh = min(speed, limit_rows[0][2])
-            final_kmh = min(speed, limit_rows[-1][2])
-            features.append(f"moving ends {initial_kmh:g} / {final_kmh:g} km/h")
+    initial_kmh, final_kmh = _boundary_speeds_kmh(rng, spec, limit_rows, features)
 
     line = replace(base.line, length_m=length, gradients=tuple(grad_rows), speed_limits=tuple(limit_rows),
                    curves=curves, tunnels=tunnels, neutral_sections=tuple(neutral))

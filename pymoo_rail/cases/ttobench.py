@@ -59,6 +59,7 @@ from typing import Any, Union
 
 import numpy as np
 
+from pymoo_rail.cases.json_files import load_json_object
 from pymoo_rail.model import Case, CaseError, DavisResistance, ForceCurve, Line, Train
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.line import CURVE_MODELS
@@ -127,21 +128,7 @@ def _warn(field: str, reason: str, source: str) -> None:
 
 def _load(source: Source, what: str) -> tuple[dict, str]:
     """The parsed JSON object and a label for error messages."""
-    if isinstance(source, Mapping):
-        return dict(source), f"<{what} dict>"
-    path = Path(source)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise CaseError("<file>", str(path), f"cannot read the TTOBench {what} file: {err.strerror}",
-                        str(path)) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise CaseError("<file>", str(path), f"is not valid JSON: {err}", str(path)) from None
-    if not isinstance(data, dict):
-        raise CaseError("<file>", str(path), "a TTOBench file must hold a JSON object", str(path))
-    return data, str(path)
+    return load_json_object(source, f"TTOBench {what}")
 
 
 def _number(field: str, value: Any, source: str) -> float:

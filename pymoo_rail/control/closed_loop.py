@@ -244,6 +244,37 @@ def reference_command(model: KernelModel, reference: Trajectory) -> float:
     return float(np.clip(force / top, -1.0, 1.0)) if top > 0.0 else math.copysign(1.0, force)
 
 
+def _decision_period_s(controller) -> float:
+    """The controller's ``decide_every_s``, checked (> 0; inf: it never decides again)."""
+    every_s = float(controller.decide_every_s)
+    if not every_s > 0.0:
+        raise FieldError("controller.decide_every_s", controller.decide_every_s, "must be > 0 (inf: never)")
+    return every_s
+
+
+def _reference_on_grid(ref, ahead: KernelModel) -> tuple[float, float, np.ndarray]:
+    """End of the reference's first traction phase, start of its final braking, its speed on the grid ahead."""
+    x_ref = np.ascontiguousarray(ref.position_m, dtype=float)
+    regime = np.ascontiguousarray(ref.regime, dtype=np.int8)
+    x_start, x_stop = ck.reference_phases(x_ref, regime, x_ref.shape[0])
+    v_ref = np.interp(ahead.position_m, x_ref, np.asarray(ref.speed_ms, dtype=float), right=0.0)
+    return x_start, x_stop, v_ref
+
+
+def _program_leg(ahead: KernelModel, program, every_s: float, x_end: float):
+    """A controller's own program run on the real train up to the next decision.
+
+    Returns the trace arrays (position, speed, time, acceleration, force, regime) up to the first
+    node at ``every_s`` seconds or at ``x_end``, their length, and whether the run ended there.
+    """
+    run = run_trace(ahead, program)
+    x, vs, ts, a, f, r = (run.position_m, run.speed_ms, run.time_s, run.accel_ms2, run.force_n, run.regime)
+    cut = np.flatnonzero((ts[1:] >= every_s - 1e-9) | (x[1:] >= x_end))
+    count = x.shape[0] if cut.size == 0 else int(cut[0]) + 2
+    finished = count >= x.shape[0]
+    return tuple(y[:count] for y in (x, vs, ts, a, f, r)), count, finished
+
+
 def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance | None = None,
                 planned_time_s: float | None = None, control_period_s: float = DEFAULT_CONTROL_PERIOD_S,
                 dx_m: float | None = None) -> Trajectory:
@@ -276,9 +307,7 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
     direct = callable(getattr(controller, "program", None))
     tracker = check_controller(PID() if direct else controller.tracker)
     planned = float(case.planned_time_s if planned_time_s is None else planned_time_s)
-    every_s = float(controller.decide_every_s)
-    if not every_s > 0.0:
-        raise FieldError("controller.decide_every_s", controller.decide_every_s, "must be > 0 (inf: never)")
+    every_s = _decision_period_s(controller)
     model = real_model(case, d, dx_m)
     n = model.position_m.shape[0]
     noise = np.ascontiguousarray(d.noise_ms())
@@ -299,18 +328,10 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
         ahead = model_from(model, node, v)
         x_end = float(d.announce_m) if pending and d.announce_m > state.position_m else math.inf
         if direct:  # the controller's program drives the real train itself
-            run = run_trace(ahead, controller.program(state))
-            x, vs, ts, a, f, r = (run.position_m, run.speed_ms, run.time_s, run.accel_ms2, run.force_n, run.regime)
-            cut = np.flatnonzero((ts[1:] >= every_s - 1e-9) | (x[1:] >= x_end))
-            count = x.shape[0] if cut.size == 0 else int(cut[0]) + 2
-            finished = count >= x.shape[0]
-            x, vs, ts, a, f, r = (y[:count] for y in (x, vs, ts, a, f, r))
+            (x, vs, ts, a, f, r), count, finished = _program_leg(ahead, controller.program(state), every_s, x_end)
         else:
             ref = controller.reference(state)
-            x_ref = np.ascontiguousarray(ref.position_m, dtype=float)
-            regime = np.ascontiguousarray(ref.regime, dtype=np.int8)
-            x_start, x_stop = ck.reference_phases(x_ref, regime, x_ref.shape[0])
-            v_ref = np.interp(ahead.position_m, x_ref, np.asarray(ref.speed_ms, dtype=float), right=0.0)
+            x_start, x_stop, v_ref = _reference_on_grid(ref, ahead)
             if carry[ck.C_RESUME] > 0.0 and ref is not previous:
                 # a new reference: the controller starts from the reference's own command
                 ck.align_controller(code, params, carry, reference_command(ahead, ref))

@@ -13,6 +13,7 @@ See ``docs/experiments.md``.
 from pymoo_rail.experiments.registry import (
     ALGORITHMS,
     PROBLEMS,
+    UntrustedCodeError,
     algorithm_names,
     build_algorithm,
     build_problem,
@@ -46,4 +47,5 @@ __all__ = ["Study", "ProblemSpec", "AlgorithmSpec", "Budget", "RunSpec", "StudyE
            "run_study", "execute_run", "StudyReport", "load_results", "load_records", "records_frame",
            "indicator_columns", "read_study", "write_study", "study_to_toml", "ResultStore", "PROBLEMS",
            "ALGORITHMS", "problem_names", "algorithm_names", "build_problem", "build_algorithm", "distinct_front",
-           "distinct_index", "choose_member", "punctual_member", "tang2020_nsga2", "best_of_seeds", "best_run"]
+           "distinct_index", "choose_member", "punctual_member", "tang2020_nsga2", "best_of_seeds", "best_run",
+           "UntrustedCodeError"]

@@ -144,3 +144,13 @@ def convergence_point(F: np.ndarray, pf: np.ndarray | None) -> dict[str, float]:
     elif pf is not None:
         out["error"] = float(F.min() - pf.min())
     return out
+
+
+def hv_ratio(F, pf) -> float:
+    """Hypervolume of ``F`` over that of the front ``pf`` (both normalised by ``pf``'s ideal and nadir)."""
+    F = np.atleast_2d(np.asarray(F, dtype=float))
+    pf = np.atleast_2d(np.asarray(pf, dtype=float))
+    if F.size == 0:
+        return 0.0
+    ideal, nadir = pf.min(axis=0), pf.max(axis=0)
+    return normalised_hv(F, ideal, nadir) / normalised_hv(pf, ideal, nadir)

@@ -160,7 +160,7 @@ def _kinematic_phases(case: Any = "metro-a", **params):
     return KinematicPhasesProblem(_case(case), **_tuples(params))
 
 
-@_forwards("pymoo_rail.control.tuning", "ControllerTuningProblem")
+@_forwards("pymoo_rail.problems.controller_tuning", "ControllerTuningProblem")
 def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params):
     """``pymoo_rail.problems.controller_tuning.ControllerTuningProblem`` (PID or fuzzy PID gains on disturbed trains)."""
     from pymoo_rail.problems.controller_tuning import ControllerTuningProblem
@@ -530,6 +530,9 @@ def _defaults(target: Callable[..., Any]) -> dict[str, Any]:
     return out
 
 
+POSITIVE_COUNTS = ("pop_size", "n_var", "n_obj", "n_offsprings", "n_neighbors", "n_sections", "limit", "k")
+
+
 def _is_count(name: str) -> bool:
     return name.startswith("n_") or name.endswith("_size") or name in ("limit", "k")
 
@@ -544,7 +547,10 @@ def _type_mismatch(name: str, default: Any, value: Any) -> str:
     if isinstance(default, bool):
         return "" if is_bool else "must be true or false"
     if isinstance(default, int) and _is_count(name):
-        least = 1 if default > 0 else 0
+        # sizes of a population, a problem or a neighbourhood are at least 1; other counts may be 0
+        # (GoldenRatioNSGA2's local_size = 0 turns the local search off); the constructors check
+        # their own upper bounds
+        least = 1 if default > 0 and name in POSITIVE_COUNTS else 0
         ok = isinstance(value, int) and not is_bool and value >= least
         return "" if ok else f"must be an integer >= {least}"
     if isinstance(default, (int, float)):

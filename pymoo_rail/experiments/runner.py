@@ -7,8 +7,13 @@ returns (:func:`execute_and_store`), so a run a worker finished is kept even if 
 with Dask, whose workers may not see the study directory, the driver stores each record the
 moment it arrives. The driver claims each run (a file lock, see :mod:`.store`) before starting
 it, checks the stored record and its input fingerprint (:mod:`.inputs`), and redoes a run whose
-record is corrupt or whose inputs changed, saying why. Pool workers watch their parent and exit
-within a second when it dies.
+record is corrupt, of an older format or whose inputs changed, saying why. Pool workers watch
+their parent and exit within a second when it dies.
+
+Before anything else, :func:`run_study` refuses a study that names code to import unless it is
+trusted (:func:`.registry.check_trust`), reads each case once (:func:`.inputs.resolve_run`: the
+runs get the loaded case with its fingerprint), and checks every parameter and builds every
+problem and algorithm once (:func:`check_study`).
 """
 
 from __future__ import annotations

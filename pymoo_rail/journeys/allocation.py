@@ -52,6 +52,35 @@ _ABOVE_MIN = 0.005  # the flat-out run itself is added from the simulator (it is
 _GRID = "quadratic"  # recorded in front caches: a cache made with another spacing is not reused
 
 
+def _named_source(fronts: str, n_times: int, max_time_factor: float, dx_m: float | None,
+                  running_times) -> tuple[Callable[[int, Case], pd.DataFrame], str, str]:
+    """``(compute(k, case), label, version)`` of a front source given by name (see :func:`section_fronts`)."""
+    if fronts == "simulated":
+        def compute(k: int, case: Case) -> pd.DataFrame:
+            return strategy_front(case, dx_m=dx_m, max_time_factor=max_time_factor)
+    elif fronts in ("optimal", "combined"):
+        from pymoo_rail.optimal import optimal_front  # the exact solver
+
+        exact = _sampled(lambda case, times: optimal_front(case, times, dx_m=dx_m), n_times,
+                         max_time_factor, dx_m, running_times)
+        if fronts == "optimal":
+            compute = exact
+        else:
+            def compute(k: int, case: Case) -> pd.DataFrame:
+                searched = strategy_front(case, dx_m=dx_m, max_time_factor=max_time_factor)
+                return pd.concat([exact(k, case)[list(FRONT_COLUMNS)], searched[list(FRONT_COLUMNS)]],
+                                 ignore_index=True)
+    else:
+        raise CaseError("fronts", fronts, f"unknown front source (known: {', '.join(FRONT_SOURCES)}, "
+                                          "a callable, or one DataFrame per section)")
+    from pymoo_rail.journeys.fronts import STRATEGY_VERSION  # read at the call (tests change them)
+    from pymoo_rail.optimal.solver import SOLVER_VERSION
+
+    version = {"simulated": f"strategy {STRATEGY_VERSION}", "optimal": f"solver {SOLVER_VERSION}",
+               "combined": f"solver {SOLVER_VERSION} + strategy {STRATEGY_VERSION}"}[fronts]
+    return compute, fronts, version
+
+
 def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_SOURCE, *, n_times: int = 16,
                    max_time_factor: float = 1.5, dx_m: float | None = None,
                    running_times: Callable[[Case], np.ndarray] | None = None,
@@ -98,30 +127,7 @@ def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_
     """
     journey = as_journey(journey)
     if isinstance(fronts, str):
-        if fronts == "simulated":
-            def compute(k: int, case: Case) -> pd.DataFrame:
-                return strategy_front(case, dx_m=dx_m, max_time_factor=max_time_factor)
-        elif fronts in ("optimal", "combined"):
-            from pymoo_rail.optimal import optimal_front  # the exact solver
-
-            exact = _sampled(lambda case, times: optimal_front(case, times, dx_m=dx_m), n_times,
-                             max_time_factor, dx_m, running_times)
-            if fronts == "optimal":
-                compute = exact
-            else:
-                def compute(k: int, case: Case) -> pd.DataFrame:
-                    searched = strategy_front(case, dx_m=dx_m, max_time_factor=max_time_factor)
-                    return pd.concat([exact(k, case)[list(FRONT_COLUMNS)], searched[list(FRONT_COLUMNS)]],
-                                     ignore_index=True)
-        else:
-            raise CaseError("fronts", fronts, f"unknown front source (known: {', '.join(FRONT_SOURCES)}, "
-                                              "a callable, or one DataFrame per section)")
-        from pymoo_rail.journeys.fronts import STRATEGY_VERSION  # read at the call (tests change them)
-        from pymoo_rail.optimal.solver import SOLVER_VERSION
-
-        label = fronts
-        version = {"simulated": f"strategy {STRATEGY_VERSION}", "optimal": f"solver {SOLVER_VERSION}",
-                   "combined": f"solver {SOLVER_VERSION} + strategy {STRATEGY_VERSION}"}[fronts]
+        compute, label, version = _named_source(fronts, n_times, max_time_factor, dx_m, running_times)
     elif callable(fronts):
         compute = _sampled(fronts, n_times, max_time_factor, dx_m, running_times)
         # a function's qualified name, or a callable object's class (its repr would hold its address)

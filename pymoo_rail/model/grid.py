@@ -25,6 +25,7 @@ from pymoo_rail.model.errors import CaseError
 from pymoo_rail.model.train import GRAVITY_MS2
 
 CURVE_RESISTANCE_A = 600.0  # Liu (2019) eq. 2-11, the usual value in [450, 800]
+OSRD_CURVE_RESISTANCE_A = 800.0  # OSRD's equivalent gradient of a curve, 800 / |R| m/km
 TUNNEL_RESISTANCE_PER_M = 0.00013  # Liu (2019) eq. 2-12, N/kN per metre of tunnel
 
 
@@ -136,12 +137,15 @@ def curve_resistance_n_per_kn(radius_m: float, model: str = "tang2020") -> float
 
     ``"tang2020"``: ``600 / R`` (Tang et al. (2020) eq. 2, Liu (2019) eq. 2-11). ``"roeckl"``:
     Roeckl's formula for standard gauge, ``650 / (R - 55)`` for R >= 300 m, ``500 / (R - 30)`` below.
+    ``"osrd"``: ``800 / R``, the equivalent gradient OSRD adds for a curve.
     """
     if model == "tang2020":
         return CURVE_RESISTANCE_A / radius_m
     if model == "roeckl":
         return 650.0 / (radius_m - 55.0) if radius_m >= 300.0 else 500.0 / (radius_m - 30.0)
-    raise CaseError("line.curve_model", model, "unknown curve model (known: tang2020, roeckl)")
+    if model == "osrd":
+        return OSRD_CURVE_RESISTANCE_A / radius_m
+    raise CaseError("line.curve_model", model, "unknown curve model (known: tang2020, roeckl, osrd)")
 
 
 FINE_DX_M, COARSE_DX_M = 1.0, 5.0

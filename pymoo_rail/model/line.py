@@ -16,8 +16,9 @@ Valued = tuple[float, float, float]
 GRADIENT_MODELS = ("train_length", "point_mass")
 # Curve resistance per unit weight (N/kN) from the radius R (m), see ``model/grid.py`` and docs/ttobench.md:
 # "tang2020": 600 / R (Tang et al. (2020) eq. 2; with the train-length average it is their 10.5 alpha / L_c
-# branch for curves shorter than the train); "roeckl": Roeckl's standard-gauge formula.
-CURVE_MODELS = ("tang2020", "roeckl")
+# branch for curves shorter than the train); "roeckl": Roeckl's standard-gauge formula; "osrd": 800 / R,
+# OSRD's equivalent gradient of a curve (railjson lines, ``cases/railjson_infra.py``).
+CURVE_MODELS = ("tang2020", "roeckl", "osrd")
 
 
 def _intervals_hold(rows: np.ndarray, length_m: float, *, tile: bool) -> bool:
@@ -91,7 +92,7 @@ class Line:
     ``gradient_model`` is ``"train_length"`` (line resistance averaged over the train, Liu (2019)
     eq. 4-14) or ``"point_mass"``. ``curve_model`` picks the curve resistance: ``"tang2020"``
     (``600 / R`` N/kN) or ``"roeckl"`` (``650 / (R - 55)`` for R >= 300 m, ``500 / (R - 30)`` below;
-    needs R > 30 m).
+    needs R > 30 m) or ``"osrd"`` (``800 / R``, as OSRD).
     """
 
     length_m: float

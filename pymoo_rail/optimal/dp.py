@@ -516,8 +516,20 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
 
 
 @njit(cache=True)
-def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
-                   floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias):
+def _singular_rows(m, i, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val):
+    """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them."""
+    for s in range(sing_v.shape[1]):
+        sing_val[i, s] = PENALTY_J
+        if sing_p[i, s] < 0.0 or sing_p[i, s] < floor_k:
+            continue
+        best = best_control(m, i, sing_v[i, s], price_w, v_next, max_targets, bias, sing_v[i + 1], sing_p[i + 1],
+                            sing_val[i + 1])[0]
+        sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
+
+
+@njit(cache=True)
+def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
+                   floor_k, terminal_j, m=None, sing_v=None, sing_p=None, sing_val=None, max_targets=0, bias=0.0):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
@@ -534,7 +546,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     from them with the simulator's steps (:func:`best_control`, as in the forward run, prices
     ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
     through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
-    them exactly.
+    them exactly. Without ``m`` (the kernel model) and the singular arrays, the speed grid alone.
     """
     n, n_speeds = value.shape
     # at the end of the line the top node is the final speed (the envelope ends there; 0 at a
@@ -542,20 +554,24 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     # (:func:`terminal_cost`)
     for j in range(n_speeds):
         value[n - 1, j] = terminal_j[j] if j >= floor_k[n - 1] else PENALTY_J
-    for s in range(sing_val.shape[1]):
-        sing_val[n - 1, s] = PENALTY_J
+    if sing_p is None:  # no singular speeds: zero of them at every node
+        sp_all = np.full((n, 0), -1.0)
+        sv_all = np.zeros((n, 0))
+    else:
+        sp_all = sing_p
+        sv_all = sing_val
+    for s in range(sv_all.shape[1]):
+        sv_all[n - 1, s] = PENALTY_J
     for i in range(n - 2, -1, -1):
         v_next = value[i + 1]
-        sp_next = sing_p[i + 1]
-        sv_next = sing_val[i + 1]
+        sp_next = sp_all[i + 1]
+        sv_next = sv_all[i + 1]
         t = cell_type[i]
-        for s in range(sing_v.shape[1]):
-            sing_val[i, s] = PENALTY_J
-            if sing_p[i, s] < 0.0 or sing_p[i, s] < floor_k[i]:
-                continue
-            best = best_control(m, i, sing_v[i, s], time_price_w[i] + m.aux_power_w, v_next, max_targets, bias,
-                                sing_v[i + 1], sp_next, sv_next)[0]
-            sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
+        if m is None:
+            pass
+        else:
+            _singular_rows(m, i, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v,
+                           sing_p, sing_val)
         for j in range(n_speeds):
             best = INF
             for c in range(N_FIXED):
@@ -576,8 +592,8 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
 
 
 @njit(cache=True)
-def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds, sing_v, sing_p,
-                    sing_val):
+def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds, sing_v=None,
+                    sing_p=None, sing_val=None):
     """Drive from the case's initial speed choosing each cell's control from the cost-to-go (continuous state).
 
     Between controls whose costs differ by at most ``tie_j`` (J) the run keeps its previous mode,
@@ -590,6 +606,14 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     the best control, summed over the cells where it was kept (by the cost-to-go's estimate).
     """
     n = m.position_m.shape[0]
+    if sing_p is None:  # no singular speeds (:func:`singular_speeds`)
+        sv_all = np.zeros((n, 0))
+        sp_all = np.full((n, 0), -1.0)
+        sval_all = np.zeros((n, 0))
+    else:
+        sv_all = sing_v
+        sp_all = sing_p
+        sval_all = sing_val
     v = m.initial_speed_ms
     speeds[0] = v
     energy = 0.0
@@ -597,8 +621,8 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     tie_cost = 0.0
     previous = MODE_TRACTION
     for i in range(n - 1):
-        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias, sing_v[i + 1],
-                                          sing_p[i + 1], sing_val[i + 1])
+        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias, sv_all[i + 1],
+                                          sp_all[i + 1], sval_all[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
         tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
@@ -608,8 +632,8 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
                 c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias, sing_p[i + 1],
-                                      sing_val[i + 1])
+                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias, sp_all[i + 1],
+                                      sval_all[i + 1])
                 if c_keep < INF and c_keep <= cost + tie_j:
                     tie_cost += c_keep - cost
                     mode, target = keep, 0.0
@@ -676,7 +700,7 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     else:
         sing_v[:] = 0.0
         sing_p[:] = -1.0
-    backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v, sing_p, sing_val, int(max_targets),
+    backward_sweep(prices, *tables, value, floor_k, terminal_j, model, sing_v, sing_p, sing_val, int(max_targets),
                    float(bias))
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)

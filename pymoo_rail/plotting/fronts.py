@@ -44,6 +44,29 @@ def is_disconnected(front: np.ndarray, jump: float = 5.0, flat: float = 1e-3) ->
     return bool(np.any(long & flat_step))
 
 
+def _as_reference(reference, n_obj: int) -> np.ndarray:
+    """The reference front as an (k, n_obj) array, checked."""
+    ref = np.asarray(reference.to_numpy() if isinstance(reference, pd.DataFrame) else reference, dtype=float)
+    ref = _as_front(ref, "reference")
+    if ref.shape[1] != n_obj:
+        raise ValueError(f"reference has {ref.shape[1]} objectives, the fronts {n_obj}")
+    return ref
+
+
+def _draw_reference(ax, ref: np.ndarray, reference_label: str) -> None:
+    """The reference front: a line (2 objectives, sparse and connected), else dots."""
+    n_obj = ref.shape[1]
+    if n_obj == 2 and len(ref) < 200 and not is_disconnected(ref):
+        order = np.argsort(ref[:, 0])
+        ax.plot(ref[order, 0], ref[order, 1], "-", marker=".", ms=4, color="0.35", lw=1.2,
+                label=reference_label, zorder=1)
+    elif n_obj == 2:  # dense or disconnected true front: dots, so gaps (ZDT3) are not bridged
+        ax.scatter(ref[:, 0], ref[:, 1], s=1.5 if len(ref) >= 200 else 6, color="0.35",
+                   label=reference_label, zorder=1)
+    else:
+        ax.scatter(*ref.T, s=2, color="0.6", label=reference_label)
+
+
 def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | None = None,
                 reference=None, reference_label: str = "optimal front", highlight=None,
                 highlight_label: str = "chosen", title: str | None = None, ax=None):
@@ -83,10 +106,7 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
     labels = objective_labels(objectives, n_obj)
     ref = None
     if reference is not None:
-        ref = np.asarray(reference.to_numpy() if isinstance(reference, pd.DataFrame) else reference, dtype=float)
-        ref = _as_front(ref, "reference")
-        if ref.shape[1] != n_obj:
-            raise ValueError(f"reference has {ref.shape[1]} objectives, the fronts {n_obj}")
+        ref = _as_reference(reference, n_obj)
     if n_obj > 3:
         if ax is not None:
             raise ValueError(f"{n_obj} objectives are drawn as a scatter matrix, which needs its own figure: "
@@ -104,15 +124,7 @@ def plot_fronts(fronts: Mapping[str, np.ndarray], objectives: Sequence[str] | No
     fig = ax.figure
 
     if ref is not None:
-        if n_obj == 2 and len(ref) < 200 and not is_disconnected(ref):
-            order = np.argsort(ref[:, 0])
-            ax.plot(ref[order, 0], ref[order, 1], "-", marker=".", ms=4, color="0.35", lw=1.2,
-                    label=reference_label, zorder=1)
-        elif n_obj == 2:  # dense or disconnected true front: dots, so gaps (ZDT3) are not bridged
-            ax.scatter(ref[:, 0], ref[:, 1], s=1.5 if len(ref) >= 200 else 6, color="0.35",
-                       label=reference_label, zorder=1)
-        else:
-            ax.scatter(*ref.T, s=2, color="0.6", label=reference_label)
+        _draw_reference(ax, ref, reference_label)
     markers = "os^Dvp<>h*"
     for i, (label, F) in enumerate(fronts.items()):
         order = np.argsort(F[:, 0])

@@ -26,6 +26,9 @@ This module turns the solver's runs into a front with a certificate and keeps it
   fronts shipped with the package (``pymoo_rail/suite/fronts``), then in the user cache
   directory (``platformdirs.user_cache_dir("pymoo-rail")/fronts``, or ``$PYMOO_RAIL_CACHE_DIR``),
   and computed and written there (atomically) otherwise.
+- **Gaps.** :func:`certified_gap` measures an optimiser's members against the front and counts
+  those below it by more than the certificate (a defect of the reference). The gap to an optimum
+  solved at a member's own running time is :func:`pymoo_rail.optimal.solved_energy_gap`.
 """
 
 from __future__ import annotations
@@ -252,6 +255,41 @@ class CertifiedFront:
                 raise ValueError(f"{path}: column '{column}' row {row}: {table[column].iloc[row]!r} is not a number")
         return cls(table, meta["case_hash"], meta["case_name"], float(meta["planned_time_s"]), float(meta["dx_m"]),
                    meta["certificate"], meta["version"])
+
+
+def certified_gap(front: CertifiedFront, running_time_s, energy_kwh) -> dict[str, float]:
+    """Energy gaps of an optimiser's runs to the optimum at their own running times.
+
+    Parameters
+    ----------
+    front : CertifiedFront
+        The certified front of the case the members ran on.
+    running_time_s, energy_kwh : array-like
+        Running time and net energy of each feasible member.
+
+    Returns
+    -------
+    dict
+        ``gap_median_kwh`` and ``gap_min_kwh`` (``E - E*(T)`` over the members whose running time
+        the front covers; in kWh, since on lines with strong regeneration ``E*`` can be near zero or
+        negative and a relative gap means nothing), ``gap_median_pct`` (the median gap in % of the
+        front's largest energy, its fastest run), ``n_in_range``, and ``n_below_certificate``:
+        members below the optimum by more than its certificate (``E < E*(T) - bound(T)``), which a
+        correct certificate never allows. Gaps are NaN when no member lies in the front's range.
+    """
+    t = np.asarray(running_time_s, dtype=float).reshape(-1)
+    e = np.asarray(energy_kwh, dtype=float).reshape(-1)
+    inside, below = front.below_certificate(t, e)
+    out = {"n_in_range": float(inside.sum()), "n_below_certificate": float(below.sum()),
+           "gap_median_kwh": float("nan"), "gap_min_kwh": float("nan"), "gap_median_pct": float("nan")}
+    if not inside.any():
+        return out
+    optimum, _ = front.energy_at(t[inside])
+    gap = e[inside] - optimum
+    scale = float(front.table["energy_kwh"].abs().max())
+    out.update(gap_median_kwh=float(np.median(gap)), gap_min_kwh=float(np.min(gap)),
+               gap_median_pct=100.0 * float(np.median(gap)) / scale)
+    return out
 
 
 def default_window(min_time_s: float, planned_time_s: float) -> tuple[float, float]:

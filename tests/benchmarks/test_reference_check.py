@@ -16,7 +16,9 @@ def _script():
 
 
 def test_every_committed_member_is_read():
-    table = _script().members()
+    from pymoo_rail.experiments.report import committed_members
+
+    table = committed_members(SCRIPT.parent / "reports")
     counts = table.groupby("source").size().to_dict()
     # 180 yizhuang runs, 3 members of each of 58 wuguang runs, the 13 sections' strategy fronts
     assert counts["yizhuang_seed000"] == 180 and counts["emu_wuguang"] == 3 * 58

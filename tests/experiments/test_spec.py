@@ -214,3 +214,18 @@ def test_seed_functions_use_the_seed_domains_and_optima(name, low, high):
     assert p.evaluate(x_opt).item() == pytest.approx(0.0, abs=1e-12)
     if name == "sphere":
         assert p.evaluate(np.full((1, 5), 3.0)).item() == pytest.approx(45.0)  # 5 * 3^2
+
+
+def test_every_forwarded_class_of_the_registry_exists():
+    """A factory's parameters are checked against the class it forwards to: that class must import
+    (a module moved without updating its registry entry would leave its parameters unchecked)."""
+    import importlib
+
+    from pymoo_rail.experiments.registry import ALGORITHMS, PROBLEMS
+
+    factories = list(PROBLEMS.values()) + [entry.factory for entry in ALGORITHMS.values()]
+    targets = [target for factory in factories for target in getattr(factory, "forwards_to", ())]
+    assert targets, "no factory forwards its parameters: the check would be vacuous"
+    missing = [f"{module}.{name}" for module, name in targets
+               if not hasattr(importlib.import_module(module), name)]
+    assert missing == []

@@ -350,3 +350,19 @@ def test_execute_run_uses_the_case_it_was_given(tmp_path):
     assert record["inputs"] == dict(resolved.fingerprint)
     fresh = execute_run(run)  # read now: the edited file
     assert fresh["inputs"] != record["inputs"] and fresh["front"]["F"] != record["front"]["F"]
+
+
+def test_trust_on_the_command_line_runs_and_replots_an_import_path_study(tmp_path, capsys):
+    study_file = tmp_path / "plugin.toml"
+    study_file.write_text('name = "plugin"\nseeds = 2\n[budget]\nn_gen = 2\n[[problems]]\n'
+                          'problem = "pymoo.problems.multi.zdt:ZDT1"\nn_var = 4\n'
+                          '[[algorithms]]\nalgorithm = "nsga2"\npop_size = 6\n')
+    out = tmp_path / "out"
+    assert main(["study", str(study_file), "--workers", "1", "--out", str(out), "-q", "--no-plots"]) == 2
+    assert "--trust" in capsys.readouterr().err and not (out / "runs").exists()
+    assert main(["study", str(study_file), "--workers", "1", "--out", str(out), "-q", "--no-plots", "--trust"]) == 0
+    capsys.readouterr()
+    assert main(["plot", "study", str(out), "--out", str(tmp_path / "figures")]) == 2
+    assert "--trust" in capsys.readouterr().err
+    assert main(["plot", "study", str(out), "--out", str(tmp_path / "figures"), "--trust"]) == 0
+    assert list((tmp_path / "figures").rglob("front_*.png"))  # with the true front, rebuilt because trusted

@@ -183,3 +183,30 @@ def test_a_grid_too_large_for_memory_is_refused_before_allocating():
     with pytest.raises(CaseError) as raised:
         build_grid(load_case("yizhuang"), dx_m=1e-6)
     assert raised.value.field == "dx_m"
+
+
+def test_the_documented_bounds_are_the_loaders():
+    from pymoo_rail.model import plausibility as bounds
+
+    doc = (ROOT / "docs" / "case-format.md").read_text(encoding="utf-8")
+    rows = {}
+    for line in doc.split("## Plausibility bounds")[1].split("\n## ")[0].splitlines():
+        cells = [c.strip() for c in line.split("|")]
+        if len(cells) > 3 and cells[1] in IMPLAUSIBLE_KINDS:
+            rows.setdefault(cells[1], []).append(cells[2])
+    assert set(rows) == set(IMPLAUSIBLE_KINDS)
+
+    def shown(value: float) -> str:
+        return f"{value:,.0f}".replace(",", " ") if value >= 10_000 else f"{value:g}"
+
+    expected = {
+        "length": [bounds.LINE_LENGTH_M[0], bounds.LINE_LENGTH_M[1] / 1000, *bounds.TRAIN_LENGTH_M],
+        "speed": list(bounds.SPEED_KMH), "gradient": [bounds.MAX_GRADIENT_PERMILLE],
+        "mass": [*bounds.MASS_T, *bounds.MASS_PER_METRE_T], "force": [*bounds.FORCE_PER_WEIGHT,
+                                                                       bounds.RESISTANCE_PER_WEIGHT],
+        "power": [*bounds.POWER_KW_PER_T, bounds.AUX_POWER_KW_PER_T], "time": [bounds.MAX_TIME_S],
+    }
+    for kind, values in expected.items():
+        text = " ".join(rows[kind])
+        for value in values:
+            assert shown(value) in text, f"{kind}: {shown(value)} is not in the documented bound {text!r}"

@@ -86,6 +86,8 @@ mutations = st.one_of(
               st.one_of(st.sampled_from(ODD_NUMBERS), st.floats(-1e4, 1e4, allow_nan=False))),
     st.tuples(st.just("odd list"), st.sampled_from(LIST_PATHS),
               st.sampled_from([[], 5.0, "abc", True, [[]], [["a", "b"]], {"x": 1}])),
+    st.tuples(st.just("not text"), st.sampled_from([("name",), ("source",), ("description",), ("train", "name")]),
+              st.sampled_from([5, 1.5, True, [], {"a": 1}])),
 )
 
 
@@ -118,12 +120,14 @@ def test_a_malformed_case_gets_a_named_error_or_loads_exactly_what_was_written(m
         message = str(err)
         assert err.field and "<" not in err.field and "mutated.toml" in message, message
         assert _field_exists(err.field), f"{err.field!r} is no field of a case: {message}"
+        if kind == "not text":  # description = 5: refused under its own name
+            assert err.field == _dotted(path) and err.value is value, message
         if kind == "not a number" and not isinstance(_at(BASE, path), list):
             # a value that is never a number must be refused under its own name, not coerced
             assert err.field == _dotted(path) or _dotted(path).startswith(err.field), message
             assert err.value is value or (isinstance(value, float) and math.isnan(value) and math.isnan(err.value))
         return
-    assert kind != "not a number", f"{_dotted(path)} = {value!r} was accepted"
+    assert kind not in ("not a number", "not text"), f"{_dotted(path)} = {value!r} was accepted"
     # it loaded: the case holds exactly the value written (nothing clipped or converted)
     reread = case_to_dict(case)
     if kind == "odd number":

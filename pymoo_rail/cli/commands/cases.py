@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import textwrap
 
-from pymoo_rail.cli.arguments import add_command, say
+from pymoo_rail.cli.arguments import UsageError, add_command, say
 from pymoo_rail.cli.case_options import load_case
 
 ORDER = 10
@@ -16,8 +16,11 @@ def add_parser(sub) -> None:
                     description="List the built-in cases (length, planned time, train, source), or describe "
                                 "one case (built-in name or path of a .toml case file) in full.",
                     epilog="examples:\n  pymoo-rail cases\n  pymoo-rail cases wuguang-crh3\n"
-                           "  pymoo-rail cases my_line.toml")
+                           "  pymoo-rail cases my_line.toml\n"
+                           "  pymoo-rail cases osrd_run.toml --write full_case.toml")
     p.add_argument("case", nargs="?", metavar="CASE", help="a case to describe (name or .toml path)")
+    p.add_argument("--write", metavar="OUT.toml", help="also write CASE as a complete case file (e.g. an OSRD "
+                                                        "railjson case, docs/railjson.md)")
 
 
 def _list() -> None:
@@ -63,7 +66,14 @@ def _describe(case) -> None:
 def run(args) -> int:
     """List the built-in cases, or describe ``args.case``; returns the exit code."""
     if args.case is None:
+        if args.write:
+            raise UsageError("--write", "needs a CASE to write")
         _list()
     else:
-        _describe(load_case("CASE", args.case))
+        case = load_case("CASE", args.case)
+        _describe(case)
+        if args.write:
+            from pymoo_rail.cases import write_case
+
+            say(f"written: {write_case(case, args.write)}")
     return 0

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from pymoo_rail.cli.arguments import EXACT_SOLVER_NOTICE, UsageError, add_command, out_dir, say
+from pymoo_rail.cli.progress import ticking
 
 ORDER = 30
 
@@ -52,7 +53,8 @@ def run(args) -> int:
 
     out = out_dir(args.out)
     timed = _timed_journey(args)
-    run_ = solve_timed_journey(timed)
+    with ticking(f"exact solver: {timed.journey.name}, every section and timing point"):
+        run_ = solve_timed_journey(timed)
     pd.DataFrame(list(run_.checks)).to_csv(out / "timing.csv", index=False)
     for k, traj in enumerate(run_.trajectories):
         traj.to_frame().to_csv(out / f"trajectory_{k}.csv", index=False)

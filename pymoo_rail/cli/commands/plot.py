@@ -71,10 +71,21 @@ def _study(args) -> list[Path]:
     return study_outputs(directory, out, args.baseline, plots=True, trusted=args.trust)
 
 
+def _save(fig, args, default: Path) -> Path:
+    """Save to ``--out`` or ``default``; a path that cannot be written is a usage error naming it."""
+    from pymoo_rail.plotting import save_figure
+
+    path = Path(args.out) if args.out else default
+    try:
+        return save_figure(fig, path)
+    except OSError as err:
+        raise UsageError("--out" if args.out else "CSV", f"cannot write {str(path)!r}: {err.strerror or err}") from None
+
+
 def _front(args, table, csv: Path) -> Path:
     import pandas as pd
 
-    from pymoo_rail.plotting import plot_fronts, save_figure
+    from pymoo_rail.plotting import plot_fronts
 
     objectives = [c for c in table.columns if c.startswith("f_")]
     x = args.x or (objectives[0] if objectives else None)
@@ -95,18 +106,18 @@ def _front(args, table, csv: Path) -> Path:
     fig = plot_fronts({csv.stem: table[[x, y]].to_numpy(float)}, [_objective_of_column(x), _objective_of_column(y)],
                       reference=reference, highlight=highlight, reference_label="reference front")
     # not front.png: that is the figure 'optimize' wrote next to front.csv
-    return save_figure(fig, Path(args.out) if args.out else csv.with_name(f"{csv.stem}_plot.png"))
+    return _save(fig, args, csv.with_name(f"{csv.stem}_plot.png"))
 
 
 def _trajectory(args, table, csv: Path) -> Path:
-    from pymoo_rail.plotting import plot_speed_profile, save_figure
+    from pymoo_rail.plotting import plot_speed_profile
 
     case = load_case("--case", args.case) if args.case else None
     try:
         fig = plot_speed_profile(table, case)
     except ValueError as err:
         raise UsageError("CSV", str(err)) from None
-    return save_figure(fig, Path(args.out) if args.out else csv.with_suffix(".png"))
+    return _save(fig, args, csv.with_suffix(".png"))
 
 
 def run(args) -> int:

@@ -6,6 +6,7 @@ from pymoo_rail.cli.arguments import (EXACT_SOLVER_NOTICE, UsageError, add_comma
                                       positive_int, say)
 from pymoo_rail.cli.case_options import add_case_arguments, case_from_args
 from pymoo_rail.cli.problem_options import add_grid_argument
+from pymoo_rail.cli.progress import ticking
 
 ORDER = 40
 
@@ -66,13 +67,15 @@ def run(args) -> int:
     out = out_dir(args.out)
     say(f"{case.name}: exact minimum-energy runs for {len(times)} running times "
         f"({times.min():.1f}-{times.max():.1f} s)")
-    front = optimal_front(case, times, dx_m=args.dx)
+    with ticking(f"exact solver: {len(times)} running times"):
+        front = optimal_front(case, times, dx_m=args.dx)
     front.to_csv(out / "optimal_front.csv", index=False)
     points = front[["running_time_s", "energy_kwh"]].to_numpy(float)
     figure = plot_fronts({"optimal": points}, ["running_time", "energy"], reference=points,
                          reference_label="optimal front", title=f"{case.name}: minimum energy against running time")
     written = [out / "optimal_front.csv", save_figure(figure, out / "optimal_front.png")]
-    trajectory = optimal_profile(case, case.planned_time_s, dx_m=args.dx)
+    with ticking("exact solver: the optimal run at the planned time"):
+        trajectory = optimal_profile(case, case.planned_time_s, dx_m=args.dx)
     trajectory.to_frame().to_csv(out / "optimal_trajectory.csv", index=False)
     written.append(out / "optimal_trajectory.csv")
     written.append(save_figure(plot_speed_profile(trajectory, case, label="optimal"), out / "optimal_profile.png"))

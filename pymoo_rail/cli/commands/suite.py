@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pymoo_rail.cli.arguments import UsageError, add_command, say
+from pymoo_rail.cli.progress import ticking
 
 ORDER = 80
 
@@ -43,7 +44,8 @@ def _verify(cases: list[str]) -> int:
     for name in cases:
         if name not in known:
             raise UsageError("CASE", f"unknown suite case {name!r} (known: {', '.join(known)})")
-    report = verify(cases or None)
+    with ticking("exact solver: solving the shipped fronts again (minutes per long line)"):
+        report = verify(cases or None)
     for case_name, rows in report.groupby("case", sort=False):
         if "drift_kwh" in rows and rows["drift_kwh"].notna().any():
             say(f"{case_name:32s} {'ok' if rows['ok'].all() else 'DRIFT'}: largest drift "
