@@ -13,8 +13,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "pymoo_rail"
 MAX_LINES = 80
 KERNEL_DECORATORS = ("njit", "jit", "vectorize", "guvectorize")
-# waiting on the exact-solver work in progress on pymoo_rail/optimal (solver.py / dp.py): split it there
-ALLOWED = {"optimal/flat.py:flat_track_optimum"}
+ALLOWED: set[str] = set()
 
 
 def _is_kernel(node: ast.FunctionDef) -> bool:

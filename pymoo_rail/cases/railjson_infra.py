@@ -324,16 +324,7 @@ def is_infra(data: Mapping) -> bool:
     return isinstance(data, Mapping) and "track_sections" in data and "switches" in data
 
 
-def read_infra(source: Source) -> RailjsonInfra:
-    """Read and check a railjson infrastructure file (or its parsed JSON object).
-
-    Signalling objects (routes, signals, detectors, buffer stops) are not read: a run between two
-    stops does not need them.
-    """
-    data, label = load_json(source, "infrastructure")
-    if not is_infra(data):
-        raise CaseError("track_sections", None, "is required: not a railjson infrastructure "
-                                                "(needs track_sections and switches)", label)
+def _read_tracks(data: Mapping, label: str) -> dict[str, TrackSection]:
     raw_tracks = data["track_sections"]
     if not isinstance(raw_tracks, list) or not raw_tracks:
         raise CaseError("track_sections", raw_tracks, "must be a non-empty array", label)
@@ -343,6 +334,11 @@ def read_infra(source: Source) -> RailjsonInfra:
         if section.id in tracks:
             raise CaseError(f"track_sections[{k}].id", section.id, "duplicate track section id", label)
         tracks[section.id] = section
+    return tracks
+
+
+def _read_links(data: Mapping, label: str, tracks: Mapping[str, TrackSection]) -> dict[Endpoint, tuple[Endpoint, ...]]:
+    """Which track ends the switches join (both ways), from the built-in and extended switch types."""
     switch_types = dict(BUILTIN_SWITCH_TYPES)
     for k, entry in enumerate(data.get("extended_switch_types", [])):
         groups = entry.get("groups", {}) if isinstance(entry, Mapping) else None
@@ -367,6 +363,10 @@ def read_infra(source: Source) -> RailjsonInfra:
                 ends.append((end["track"], end["endpoint"]))
             links.setdefault(ends[0], []).append(ends[1])
             links.setdefault(ends[1], []).append(ends[0])
+    return {k: tuple(v) for k, v in links.items()}
+
+
+def _read_speed_sections(data: Mapping, label: str, tracks: Mapping[str, TrackSection]) -> tuple[SpeedSection, ...]:
     speed_sections = []
     for k, entry in enumerate(data.get("speed_sections", [])):
         where = f"speed_sections[{k}]"
@@ -383,6 +383,11 @@ def read_infra(source: Source) -> RailjsonInfra:
             id=str(entry.get("id", k)), speed_limit_ms=default, by_tag_ms=by_tag, on_routes=tuple(routes),
             ranges=tuple(_ranges(entry.get("track_ranges"), f"{where}.track_ranges", label, None, tracks,
                                  "applicable_directions"))))
+    return tuple(speed_sections)
+
+
+def _read_electric_ranges(data: Mapping, label: str, tracks: Mapping[str, TrackSection]) -> tuple[list, list]:
+    """The electrified ranges (value: the voltage) and the neutral sections (value: lower pantograph)."""
     electrifications = []
     for k, entry in enumerate(data.get("electrifications", [])):
         voltage = entry.get("voltage")
@@ -397,6 +402,10 @@ def read_infra(source: Source) -> RailjsonInfra:
             raise CaseError(f"neutral_sections[{k}].lower_pantograph", lower, "must be true or false", label)
         neutral += _ranges(entry.get("track_ranges"), f"neutral_sections[{k}].track_ranges", label, lower,
                            tracks, "direction")
+    return electrifications, neutral
+
+
+def _read_points(data: Mapping, label: str, tracks: Mapping[str, TrackSection]) -> dict[str, tuple[tuple[str, float], ...]]:
     points: dict[str, tuple[tuple[str, float], ...]] = {}
     for k, entry in enumerate(data.get("operational_points", [])):
         parts = []
@@ -410,11 +419,27 @@ def read_infra(source: Source) -> RailjsonInfra:
                                 f"is beyond the end of track '{part['track']}'", label)
             parts.append((part["track"], position))
         points[str(entry.get("id"))] = tuple(parts)
+    return points
+
+
+def read_infra(source: Source) -> RailjsonInfra:
+    """Read and check a railjson infrastructure file (or its parsed JSON object).
+
+    Signalling objects (routes, signals, detectors, buffer stops) are not read: a run between two
+    stops does not need them.
+    """
+    data, label = load_json(source, "infrastructure")
+    if not is_infra(data):
+        raise CaseError("track_sections", None, "is required: not a railjson infrastructure "
+                                                "(needs track_sections and switches)", label)
+    tracks = _read_tracks(data, label)
+    electrifications, neutral = _read_electric_ranges(data, label, tracks)
     if data.get("version") is None:
         warn_field("version", "is missing: read as railjson infrastructure 3.4", label)
-    return RailjsonInfra(source=label, tracks=tracks, links={k: tuple(v) for k, v in links.items()},
-                         speed_sections=tuple(speed_sections), electrifications=tuple(electrifications),
-                         neutral_sections=tuple(neutral), operational_points=points)
+    return RailjsonInfra(source=label, tracks=tracks, links=_read_links(data, label, tracks),
+                         speed_sections=_read_speed_sections(data, label, tracks),
+                         electrifications=tuple(electrifications), neutral_sections=tuple(neutral),
+                         operational_points=_read_points(data, label, tracks))
 
 
 # ------------------------------------------------------------------------------------- along the path

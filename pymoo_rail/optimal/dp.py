@@ -528,8 +528,8 @@ def _singular_rows(m, i, price_w, v_next, max_targets, bias, floor_k, sing_v, si
 
 
 @njit(cache=True)
-def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
-                   floor_k, terminal_j, m=None, sing_v=None, sing_p=None, sing_val=None, max_targets=0, bias=0.0):
+def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
+                   floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
@@ -546,7 +546,7 @@ def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, t
     from them with the simulator's steps (:func:`best_control`, as in the forward run, prices
     ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
     through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
-    them exactly. Without ``m`` (the kernel model) and the singular arrays, the speed grid alone.
+    them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone.
     """
     n, n_speeds = value.shape
     # at the end of the line the top node is the final speed (the envelope ends there; 0 at a
@@ -554,24 +554,15 @@ def backward_sweep(time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, t
     # (:func:`terminal_cost`)
     for j in range(n_speeds):
         value[n - 1, j] = terminal_j[j] if j >= floor_k[n - 1] else PENALTY_J
-    if sing_p is None:  # no singular speeds: zero of them at every node
-        sp_all = np.full((n, 0), -1.0)
-        sv_all = np.zeros((n, 0))
-    else:
-        sp_all = sing_p
-        sv_all = sing_val
-    for s in range(sv_all.shape[1]):
-        sv_all[n - 1, s] = PENALTY_J
+    for s in range(sing_val.shape[1]):
+        sing_val[n - 1, s] = PENALTY_J
     for i in range(n - 2, -1, -1):
         v_next = value[i + 1]
-        sp_next = sp_all[i + 1]
-        sv_next = sv_all[i + 1]
+        sp_next = sing_p[i + 1]
+        sv_next = sing_val[i + 1]
         t = cell_type[i]
-        if m is None:
-            pass
-        else:
-            _singular_rows(m, i, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v,
-                           sing_p, sing_val)
+        _singular_rows(m, i, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
+                       sing_val)
         for j in range(n_speeds):
             best = INF
             for c in range(N_FIXED):
@@ -700,7 +691,7 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     else:
         sing_v[:] = 0.0
         sing_p[:] = -1.0
-    backward_sweep(prices, *tables, value, floor_k, terminal_j, model, sing_v, sing_p, sing_val, int(max_targets),
+    backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v, sing_p, sing_val, int(max_targets),
                    float(bias))
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)

@@ -58,6 +58,75 @@ def _check_flat(case: Case, level: bool = True) -> float:
     return grades.pop()
 
 
+@dataclass(frozen=True)
+class _FlatModel:
+    """The case's train on its one gradient, as the closed form needs it (SI units)."""
+
+    case: Case
+    m: float  # effective mass (kg)
+    a: float  # Davis a plus the gradient force (N)
+    b: float
+    c: float
+    limit: float  # lowest limit (m/s)
+
+    @classmethod
+    def of(cls, case: Case) -> _FlatModel:
+        permille = _check_flat(case, level=False)
+        train = case.train
+        a, b, c = train.resistance.coefficients_si(train.mass_kg)
+        a += train.mass_kg * GRAVITY_MS2 * permille / 1000.0  # the gradient force, independent of the speed
+        if a <= 0.0:
+            raise ValueError(f"case '{case.name}': on {permille:g} per mille coasting accelerates at low speed; the "
+                             "closed form needs R(v) + G > 0")
+        limit = min(min(row[2] for row in case.line.speed_limits), train.max_speed_kmh) / KMH_PER_MS
+        return cls(case, train.effective_mass_kg, a, b, c, limit)
+
+    def resist(self, v):
+        return self.a + self.b * v + self.c * v * v
+
+    def traction(self, v):
+        train = self.case.train
+        f = float(train.traction.force_kn(v * KMH_PER_MS)[0]) * 1000.0
+        a_max = train.max_accel_ms2 if train.max_accel_ms2 is not None else math.inf
+        return min(f, self.m * a_max + self.resist(v))
+
+    def braking(self, v):
+        train = self.case.train
+        f = float(train.braking.force_kn(v * KMH_PER_MS)[0]) * 1000.0
+        d_max = train.max_decel_ms2 if train.max_decel_ms2 is not None else math.inf
+        return min(f, self.m * d_max - self.resist(v))
+
+    def brake_speed(self, hold, price):
+        """``W`` from the constancy of the Hamiltonian: ``price / W + eta_b R(W) = R(V) / eta + price / V``."""
+        eta, eta_b = self.case.train.traction_efficiency, self.case.train.regen_efficiency
+        # (price / W + eta_b R(W)) falls from +inf to below its value at V on (0, V]
+        rhs = self.resist(hold) / eta + price / hold
+        return brentq(lambda w: price / w + eta_b * self.resist(w) - rhs, 1e-9 * hold, hold, xtol=1e-14, rtol=1e-15)
+
+    def phases(self, lam):
+        """(hold speed, brake speed, traction length, hold length, coast length, time s, energy J) at ``lam``."""
+        train, m, resist, traction, braking = self.case.train, self.m, self.resist, self.traction, self.braking
+        eta, eta_b, aux = train.traction_efficiency, train.regen_efficiency, train.aux_power_kw * 1000.0
+        v_start, v_end = self.case.initial_speed_ms, self.case.final_speed_ms
+        price = lam + aux
+        # hold speed from lambda + P_aux = V^2 R'(V) / eta (increasing in V)
+        hold = brentq(lambda v: v * v * (self.b + 2 * self.c * v) / eta - price, 1e-9, 10 * self.limit)
+        brake = self.brake_speed(hold, price)
+        opts = {"limit": 200, "epsabs": 0.0, "epsrel": 1e-11}
+        s_a = quad(lambda v: m * v / (traction(v) - resist(v)), v_start, hold, **opts)[0]
+        t_a = quad(lambda v: m / (traction(v) - resist(v)), v_start, hold, **opts)[0]
+        e_a = quad(lambda v: traction(v) * m * v / (traction(v) - resist(v)), v_start, hold, **opts)[0] / eta
+        s_c = quad(lambda v: m * v / resist(v), brake, hold, **opts)[0]
+        t_c = quad(lambda v: m / resist(v), brake, hold, **opts)[0]
+        s_b = quad(lambda v: m * v / (braking(v) + resist(v)), v_end, brake, **opts)[0]
+        t_b = quad(lambda v: m / (braking(v) + resist(v)), v_end, brake, **opts)[0]
+        e_b = quad(lambda v: braking(v) * m * v / (braking(v) + resist(v)), v_end, brake, **opts)[0] * eta_b
+        s_h = self.case.line.length_m - s_a - s_c - s_b
+        t = t_a + s_h / hold + t_c + t_b
+        e = e_a + resist(hold) * s_h / eta - e_b + aux * t
+        return hold, brake, s_a, s_h, s_c, t, e
+
+
 def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
     """The optimal traction-hold-coast-brake run of a level (or constant-gradient) case taking ``running_time_s``.
 
@@ -71,71 +140,23 @@ def flat_track_optimum(case: Case, running_time_s: float) -> FlatTrackOptimum:
     auxiliary power and the boundary speeds are honoured. Raises ``ValueError`` when the case is not
     level, or when no hold speed fits the time.
     """
-    permille = _check_flat(case, level=False)
-    train = case.train
-    m = train.effective_mass_kg
-    a, b, c = train.resistance.coefficients_si(train.mass_kg)
-    a += train.mass_kg * GRAVITY_MS2 * permille / 1000.0  # the gradient force, independent of the speed
-    if a <= 0.0:
-        raise ValueError(f"case '{case.name}': on {permille:g} per mille coasting accelerates at low speed; the "
-                         "closed form needs R(v) + G > 0")
-    eta = train.traction_efficiency
-    eta_b = train.regen_efficiency
-    aux = train.aux_power_kw * 1000.0
-    v_start, v_end = case.initial_speed_ms, case.final_speed_ms
-    a_max = train.max_accel_ms2 if train.max_accel_ms2 is not None else math.inf
-    d_max = train.max_decel_ms2 if train.max_decel_ms2 is not None else math.inf
-    length = case.line.length_m
-    limit = min(min(row[2] for row in case.line.speed_limits), train.max_speed_kmh) / KMH_PER_MS
-
-    def resist(v):
-        return a + b * v + c * v * v
-
-    def traction(v):
-        f = float(train.traction.force_kn(v * KMH_PER_MS)[0]) * 1000.0
-        return min(f, m * a_max + resist(v))
-
-    def braking(v):
-        f = float(train.braking.force_kn(v * KMH_PER_MS)[0]) * 1000.0
-        return min(f, m * d_max - resist(v))
-
-    def brake_speed(hold, price):
-        # (price / W + eta_b R(W)) falls from +inf to below its value at V on (0, V]
-        rhs = resist(hold) / eta + price / hold
-        return brentq(lambda w: price / w + eta_b * resist(w) - rhs, 1e-9 * hold, hold, xtol=1e-14, rtol=1e-15)
-
-    def phases(lam):
-        price = lam + aux
-        # hold speed from lambda + P_aux = V^2 R'(V) / eta (increasing in V)
-        hold = brentq(lambda v: v * v * (b + 2 * c * v) / eta - price, 1e-9, 10 * limit)
-        brake = brake_speed(hold, price)
-        opts = {"limit": 200, "epsabs": 0.0, "epsrel": 1e-11}
-        s_a = quad(lambda v: m * v / (traction(v) - resist(v)), v_start, hold, **opts)[0]
-        t_a = quad(lambda v: m / (traction(v) - resist(v)), v_start, hold, **opts)[0]
-        e_a = quad(lambda v: traction(v) * m * v / (traction(v) - resist(v)), v_start, hold, **opts)[0] / eta
-        s_c = quad(lambda v: m * v / resist(v), brake, hold, **opts)[0]
-        t_c = quad(lambda v: m / resist(v), brake, hold, **opts)[0]
-        s_b = quad(lambda v: m * v / (braking(v) + resist(v)), v_end, brake, **opts)[0]
-        t_b = quad(lambda v: m / (braking(v) + resist(v)), v_end, brake, **opts)[0]
-        e_b = quad(lambda v: braking(v) * m * v / (braking(v) + resist(v)), v_end, brake, **opts)[0] * eta_b
-        s_h = length - s_a - s_c - s_b
-        t = t_a + s_h / hold + t_c + t_b
-        e = e_a + resist(hold) * s_h / eta - e_b + aux * t
-        return hold, brake, s_a, s_h, s_c, t, e
+    model = _FlatModel.of(case)
+    eta, aux = case.train.traction_efficiency, case.train.aux_power_kw * 1000.0
+    limit = model.limit
 
     def time_gap(log_lam):
-        return phases(math.exp(log_lam))[5] - running_time_s
+        return model.phases(math.exp(log_lam))[5] - running_time_s
 
     # lambda from a crawl (1 W) up to the hold speed at the lowest limit, and a hold length >= 0
     lo = math.log(1.0)
-    hi = math.log(max(limit * limit * (b + 2 * c * limit) / eta - aux, 2.0))
-    if phases(math.exp(hi))[3] < 0.0:
-        hi = brentq(lambda x: phases(math.exp(x))[3], lo, hi, xtol=1e-12)
+    hi = math.log(max(limit * limit * (model.b + 2 * model.c * limit) / eta - aux, 2.0))
+    if model.phases(math.exp(hi))[3] < 0.0:
+        hi = brentq(lambda x: model.phases(math.exp(x))[3], lo, hi, xtol=1e-12)
     if not time_gap(lo) > 0.0 > time_gap(hi):
         raise ValueError(f"running_time_s = {running_time_s}: outside the times a hold phase can give "
-                         f"({phases(math.exp(hi))[5]:.2f} .. {phases(math.exp(lo))[5]:.2f} s)")
+                         f"({model.phases(math.exp(hi))[5]:.2f} .. {model.phases(math.exp(lo))[5]:.2f} s)")
     lam = math.exp(brentq(time_gap, lo, hi, xtol=1e-13, rtol=1e-13))
-    hold, brake, s_a, s_h, s_c, t, e = phases(lam)
+    hold, brake, s_a, s_h, s_c, t, e = model.phases(lam)
     return FlatTrackOptimum(lambda_w=lam, hold_speed_ms=hold, brake_speed_ms=brake, traction_end_m=s_a,
                             coast_start_m=s_a + s_h, brake_start_m=s_a + s_h + s_c, running_time_s=t,
                             energy_kwh=e / J_PER_KWH)
