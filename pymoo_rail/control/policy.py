@@ -327,7 +327,7 @@ class OptimalPolicy:
         ahead = model_from(m, node, 0.0)
         tables = line.tables[:-1] + (np.ascontiguousarray(line.tables[-1][node:]),)
         dp.singular_speeds(ahead, prices + m.aux_power_w, self.n_speeds, self.bias, sing_v[node:], sing_p[node:])
-        dp.backward_sweep(prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), line.terminal_j, ahead,
+        dp.backward_sweep(ahead, prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), line.terminal_j,
                           sing_v[node:], sing_p[node:], sing_val[node:], self.max_targets, self.bias)
         self.n_sweeps += 1
         line.values[k] = (node, arrays)
