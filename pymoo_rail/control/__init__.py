@@ -1,4 +1,9 @@
-"""ATO tracking layer: controllers that follow a recommended speed-distance curve.
+"""ATO tracking layer: controllers that follow a recommended speed-distance curve, and driving in the loop.
+
+The tracking controllers (``Hysteresis``, ``PID``, ``FuzzyPID``, ``track``) follow a fixed curve;
+``OptimalPolicy`` re-plans the optimal rest of the run from any state, ``closed_loop`` drives a
+disturbed train with a tracking, re-planning or advised driver, ``AdvisedDriving`` turns the
+policy into driver advice (``docs/control.md``).
 
 >>> from pymoo_rail.cases import load_case
 >>> from pymoo_rail.sim import Simulator
