@@ -40,8 +40,6 @@ import pandas as pd
 from pymoo_rail.constants import J_PER_KWH
 
 HERE = Path(__file__).resolve().parent
-if str(HERE.parent) not in sys.path:  # this checkout's package, not an installed one
-    sys.path.insert(0, str(HERE.parent))
 REPORT = HERE / "reports" / "peers.md"
 CASES = [  # (case, running time s, ms-eetc track id or None)
     (str(HERE / "cases" / "intercity-var-limit-100.toml"), 1541.0, "00_var_speed_limit_100"),
@@ -317,7 +315,7 @@ def main_generated(args) -> None:
     seeds = args.seeds if args.seeds else range(args.first_seed, args.first_seed + args.generated)
     intervals = tuple(args.intervals)
     table = generated_rows(seeds, args.mseetc, args.mseetc_python, intervals, args.repeats)
-    from optimal import markdown  # benchmarks/optimal.py (this script's directory is on sys.path)
+    from pymoo_rail.experiments.report import markdown
 
     text = ["# pymoo-rail's exact solver beside ms-eetc on generated lines", "",
             "Written by `python benchmarks/peers.py "
@@ -384,7 +382,7 @@ def main() -> None:
             energy, cpu = GPOPS_II[row["case"]]
             peers.append({"case": row["case"], "solver": "GPOPS-II", "energy_kwh": energy, "cpu_s": cpu,
                           "source": "published"})
-    from optimal import markdown  # benchmarks/optimal.py (this script's directory is on sys.path)
+    from pymoo_rail.experiments.report import markdown
 
     ours = pd.DataFrame(rows)
     theirs = pd.DataFrame(peers)
