@@ -341,15 +341,21 @@ def front_progress_bar(case_name: str):
     Returns ``(bar, progress)``: close ``bar`` when done; pass ``progress`` to :func:`compute_front`.
     """
     import sys
+    import time
 
     from tqdm import tqdm
 
+    delay_s = PROGRESS_DELAY_S
     bar = tqdm(total=1, desc=f"certified front of {case_name} (exact solver)", unit="solve",
-               delay=PROGRESS_DELAY_S, file=sys.stderr, dynamic_ncols=True, leave=False)
+               delay=delay_s, file=sys.stderr, dynamic_ncols=True, leave=False)
+    started_s = time.monotonic()
 
     def progress(done: int, total: int) -> None:
         bar.total = total
         bar.update(done - bar.n)
+        # tqdm throttles its refreshes: show the last count before the bar closes (once it is shown)
+        if done == total and time.monotonic() - started_s >= delay_s:
+            bar.refresh()
 
     return bar, progress
 
