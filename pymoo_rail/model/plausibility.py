@@ -32,6 +32,7 @@ MASS_T = (1.0, 100_000.0)             # a track trolley / the heaviest ore train
 MASS_PER_METRE_T = (0.3, 25.0)        # light railcars ~1 t/m, 40 t axle-load ore wagons ~13 t/m
 FORCE_PER_WEIGHT = (0.001, 3.0)       # adhesion gives <= 0.35 of the weight, heavy freight >= 0.004
 RESISTANCE_PER_WEIGHT = 0.3           # real W0 at top speed <= 0.05 of the weight
+ACCEL_MS2 = (0.01, 5.0)               # freight ~0.05 m/s^2; emergency braking ~1.5-2.5; beyond adhesion
 POWER_KW_PER_T = (0.1, 200.0)         # freight ~1 kW/t, EMUs 5-25 kW/t, a lone locomotive ~80 kW/t
 AUX_POWER_KW_PER_T = 20.0             # hotel load ~0.5-3 kW/t
 MAX_TIME_S = 86_400.0                 # one stop-to-stop run or dwell longer than a day
@@ -136,6 +137,10 @@ def _check_force(case) -> None:
         _outside("train.braking.regen_max_force_kn", train.regen_max_force_kn, "force",
                  "an electric-brake force per weight of", (0.0, FORCE_PER_WEIGHT[1]), "kN/kN",
                  train.regen_max_force_kn / weight_kn, high_hint="N where kN is meant?")
+    for name in ("max_accel_ms2", "max_decel_ms2"):
+        cap_ms2 = getattr(train, name)
+        if cap_ms2 is not None:
+            _outside(f"train.{name}", cap_ms2, "force", "an acceleration cap of", ACCEL_MS2, "m/s^2", cap_ms2)
     top_kn = float(train.resistance.force_kn(train.max_speed_kmh, train.mass_t))
     _outside("train.resistance", train.resistance, "force", "a running resistance per weight at top speed of",
              (0.0, RESISTANCE_PER_WEIGHT), "kN/kN", top_kn / weight_kn,

@@ -87,6 +87,10 @@ AUDIT = [
      "train.braking.max_force_kn", "N where kN"),
     ("resistance in N", lambda d: d["train"]["resistance"].update(a=2000.0, unit="kN"), "force",
      "train.resistance", "N where kN"),
+    ("an acceleration cap of 1e30 m/s^2", lambda d: _set(d, ("train", "max_accel_ms2"), 10 ** 30), "force",
+     "train.max_accel_ms2", "above"),
+    ("a deceleration cap of 0.001 m/s^2", lambda d: _set(d, ("train", "max_decel_ms2"), 0.001), "force",
+     "train.max_decel_ms2", "below"),
     ("aux power 1e30 kW", lambda d: _set(d, ("train", "aux_power_kw"), 1e30), "power", "train.aux_power_kw",
      "above"),
     ("aux power in W", lambda d: _set(d, ("train", "aux_power_kw"), 150_000.0), "power", "train.aux_power_kw",
@@ -203,7 +207,8 @@ def test_the_documented_bounds_are_the_loaders():
         "length": [bounds.LINE_LENGTH_M[0], bounds.LINE_LENGTH_M[1] / 1000, *bounds.TRAIN_LENGTH_M],
         "speed": list(bounds.SPEED_KMH), "gradient": [bounds.MAX_GRADIENT_PERMILLE],
         "mass": [*bounds.MASS_T, *bounds.MASS_PER_METRE_T], "force": [*bounds.FORCE_PER_WEIGHT,
-                                                                       bounds.RESISTANCE_PER_WEIGHT],
+                                                                       bounds.RESISTANCE_PER_WEIGHT,
+                                                                       *bounds.ACCEL_MS2],
         "power": [*bounds.POWER_KW_PER_T, bounds.AUX_POWER_KW_PER_T], "time": [bounds.MAX_TIME_S],
     }
     for kind, values in expected.items():
