@@ -12,8 +12,14 @@ train, flat out from its late departure with the restriction known, could still 
 
 from __future__ import annotations
 
+import json
 import math
 import time as _time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -29,16 +35,21 @@ from pymoo_rail.control.closed_loop import (
     closed_loop,
     real_model,
 )
-from pymoo_rail.control.controllers import PID, FuzzyPID, Hysteresis
+from pymoo_rail.control.controllers import PID, Controller, FuzzyPID, Hysteresis
 from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction, run_trace
 from pymoo_rail.model import Case
+from pymoo_rail.experiments.store import ResultStore, record_checksum
 from pymoo_rail.model.errors import FieldError
 from pymoo_rail.optimal import OptimalSolver
 from pymoo_rail.sim.drivers import flat_out_program
 
 STUDY_CONTROLLERS = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis", "recovery", "replanning",
                      "replanning_hysteresis", "optimal_controls", "advice")
+# Curve tracking by the gains tuned on the case's plan (given to the study, tuned by the problems layer)
+TUNED_CONTROLLERS = ("tracking_tuned_pid", "tracking_tuned_fuzzy_pid")
 DECIDE_EVERY_S = 10.0
+# One record of the result store holds the rows of one world of one case
+LOOP_RECORD_FORMAT = "pymoo-rail/loop-world/1"
 # Ranges of a world (uniform), shares of the line length or of the planned time where so named
 WORLD_RANGES = {"mass_factor": (0.9, 1.15), "adhesion_factor": (0.85, 1.0), "speed_noise_kmh": (0.0, 0.5),
                 "traction_lag_s": (0.0, 0.5), "resistance_factor": (0.9, 1.2), "regen_factor": (0.85, 1.0),
@@ -76,11 +87,20 @@ def draw_loop_disturbances(case: Case, n: int, seed: int, planned_time_s: float 
     return worlds
 
 
-def make_loop_controller(name: str, case: Case, policy: OptimalPolicy):
-    """A fresh controller of the study by name (:data:`STUDY_CONTROLLERS`), around ``policy`` and its plan."""
-    if name not in STUDY_CONTROLLERS:
-        raise FieldError("controller", name, f"is unknown (known: {', '.join(STUDY_CONTROLLERS)})")
+def make_loop_controller(name: str, case: Case, policy: OptimalPolicy, tuned: Mapping[str, Controller] | None = None):
+    """A fresh controller of the study by name, around ``policy`` and its plan.
+
+    Names: :data:`STUDY_CONTROLLERS`, and :data:`TUNED_CONTROLLERS` when ``tuned`` maps ``"pid"``
+    and ``"fuzzy_pid"`` to tuned controllers (e.g. by
+    :func:`pymoo_rail.problems.controller_tuning.tune_controller`), which then track the plan.
+    """
+    tuned = dict(tuned or {})
+    known = STUDY_CONTROLLERS + tuple(n for n in TUNED_CONTROLLERS if n.removeprefix("tracking_tuned_") in tuned)
+    if name not in known:
+        raise FieldError("controller", name, f"is unknown (known: {', '.join(known)})")
     plan = policy.plan
+    if name in TUNED_CONTROLLERS:
+        return CurveTracking(plan, tuned[name.removeprefix("tracking_tuned_")], name=name)
     makers = {
         "tracking_pid": lambda: CurveTracking(plan, PID(), name=name),
         "tracking_fuzzy_pid": lambda: CurveTracking(plan, FuzzyPID(), name=name),
@@ -125,8 +145,41 @@ def exact_energies_kwh(case: Case, disturbance: LoopDisturbance, running_times_s
     return out
 
 
+def world_rows(case: Case, run: int, world: LoopDisturbance, policy: OptimalPolicy, planned_time_s: float,
+               controllers: Sequence[str] = STUDY_CONTROLLERS, exact: bool = True,
+               tuned: Mapping[str, Controller] | None = None) -> list[dict]:
+    """The rows of one world (index ``run``) driven by every controller: see :func:`loop_runs`."""
+    price_kwh_s = policy.lambda_w / J_PER_KWH
+    feasible = can_be_on_time(case, world, planned_time_s)
+    rows = []
+    for name in controllers:
+        controller = make_loop_controller(name, case, policy, tuned)
+        started = _time.process_time()
+        trace = closed_loop(case, controller, world, planned_time_s=planned_time_s)
+        s = trace.summary
+        cpu = getattr(controller, "cpu_s", [])
+        advised = name == "advice"
+        rows.append({"case": case.name, "run": run, "controller": name, "net_kwh": s["net_kwh"],
+                     "cost_kwh": s["net_kwh"] + price_kwh_s * s["lateness_s"], "lateness_s": s["lateness_s"],
+                     "stop_error_m": s["stop_error_m"], "jerk_ms2": s["jerk_ms2"],
+                     "advice_changes": float(controller.changes(trace)) if advised else math.nan,
+                     "seconds_per_change": (trace.running_time_s / max(controller.changes(trace), 1)
+                                            if advised else math.nan),
+                     "n_decisions": s["n_decisions"], "reached": s["reached"], "can_be_on_time": feasible,
+                     "delay_s": world.departure_delay_s, "restricted": world.restriction is not None,
+                     "max_speed_kmh": float(np.max(trace.speed_ms) * KMH_PER_MS),
+                     "decision_cpu_ms": float(np.median(cpu) * 1000.0) if cpu else math.nan,
+                     "running_time_s": trace.running_time_s, "cpu_s": _time.process_time() - started})
+    if exact:
+        for row, best in zip(rows, exact_energies_kwh(case, world, [r["running_time_s"] for r in rows])):
+            row["exact_kwh"] = best
+            row["gap_pct"] = 100.0 * (row["net_kwh"] / best - 1.0) if best > 0 else math.nan
+    return rows
+
+
 def loop_runs(case: Case, n_runs: int, seed: int, controllers=STUDY_CONTROLLERS, policy: OptimalPolicy | None = None,
-              planned_time_s: float | None = None, first_run: int = 0, exact: bool = True) -> pd.DataFrame:
+              planned_time_s: float | None = None, first_run: int = 0, exact: bool = True,
+              tuned: Mapping[str, Controller] | None = None) -> pd.DataFrame:
     """One row per (world, controller): the closed-loop study of one case.
 
     Columns: ``case``, ``run`` (world index), ``controller``, ``net_kwh``, ``cost_kwh`` (energy
@@ -135,38 +188,120 @@ def loop_runs(case: Case, n_runs: int, seed: int, controllers=STUDY_CONTROLLERS,
     ``delay_s``, ``restricted``, ``decision_cpu_ms`` (median per decision, re-planning only) and
     ``cpu_s``; with ``exact``, ``exact_kwh`` (the real train's exact optimum at the run's own
     running time, :func:`exact_energies_kwh`) and ``gap_pct`` (energy above it, %). Worlds
-    ``first_run .. first_run + n_runs - 1`` of the seeded draw.
+    ``first_run .. first_run + n_runs - 1`` of the seeded draw; ``tuned`` adds the tuned trackers
+    (:func:`make_loop_controller`).
     """
     planned = float(case.planned_time_s if planned_time_s is None else planned_time_s)
     policy = OptimalPolicy(case, planned) if policy is None else policy
-    price_kwh_s = policy.lambda_w / J_PER_KWH
     worlds = draw_loop_disturbances(case, first_run + n_runs, seed, planned)[first_run:]
     rows = []
     for k, world in enumerate(worlds):
-        feasible = can_be_on_time(case, world, planned)
-        for name in controllers:
-            controller = make_loop_controller(name, case, policy)
-            started = _time.process_time()
-            run = closed_loop(case, controller, world, planned_time_s=planned)
-            s = run.summary
-            cpu = getattr(controller, "cpu_s", [])
-            rows.append({"case": case.name, "run": first_run + k, "controller": name, "net_kwh": s["net_kwh"],
-                         "cost_kwh": s["net_kwh"] + price_kwh_s * s["lateness_s"], "lateness_s": s["lateness_s"],
-                         "stop_error_m": s["stop_error_m"], "jerk_ms2": s["jerk_ms2"],
-                         "advice_changes": float(controller.changes(run)) if name == "advice" else math.nan,
-                         "seconds_per_change": (run.running_time_s / max(controller.changes(run), 1)
-                                                if name == "advice" else math.nan),
-                         "n_decisions": s["n_decisions"], "reached": s["reached"], "can_be_on_time": feasible,
-                         "delay_s": world.departure_delay_s, "restricted": world.restriction is not None,
-                         "max_speed_kmh": float(np.max(run.speed_ms) * KMH_PER_MS),
-                         "decision_cpu_ms": float(np.median(cpu) * 1000.0) if cpu else math.nan,
-                         "running_time_s": run.running_time_s, "cpu_s": _time.process_time() - started})
-        if exact:
-            mine = rows[-len(controllers):]
-            for row, best in zip(mine, exact_energies_kwh(case, world, [r["running_time_s"] for r in mine])):
-                row["exact_kwh"] = best
-                row["gap_pct"] = 100.0 * (row["net_kwh"] / best - 1.0) if best > 0 else math.nan
+        rows += world_rows(case, first_run + k, world, policy, planned, controllers, exact, tuned)
     return pd.DataFrame(rows)
+
+
+@dataclass(frozen=True)
+class LoopStudyCase:
+    """One case of a closed-loop study: its planned time, worlds and the tuned trackers (if any)."""
+
+    case: Case
+    planned_time_s: float
+    n_runs: int
+    tuned: Mapping[str, Controller] = field(default_factory=dict)
+
+
+def world_run_id(case_name: str, seed: int, run: int) -> str:
+    """The result store's id of one world of a case."""
+    return f"{case_name}-seed{seed}-world{run:04d}"
+
+
+def _loop_chunk(item: LoopStudyCase, runs: list[int], seed: int, directory: str,
+                controllers: tuple[str, ...]) -> int:
+    """Compute and store the worlds ``runs`` of one case (skipping those stored or claimed); returns how many."""
+    store = ResultStore(directory)
+    planned = item.planned_time_s
+    policy = None
+    worlds = draw_loop_disturbances(item.case, max(runs) + 1, seed, planned)
+    done = 0
+    for run in runs:
+        run_id = world_run_id(item.case.name, seed, run)
+        lock = store.claim(run_id)
+        if lock is None:
+            continue
+        try:
+            if store.path(run_id).is_file():
+                continue
+            policy = OptimalPolicy(item.case, planned) if policy is None else policy
+            started = _time.process_time()
+            rows = world_rows(item.case, run, worlds[run], policy, planned, controllers, True, item.tuned)
+            store.write({"format": LOOP_RECORD_FORMAT, "run_id": run_id, "case": item.case.name, "seed": seed,
+                         "planned_time_s": planned, "controllers": list(controllers), "rows": rows,
+                         "cpu_s": _time.process_time() - started})
+            done += 1
+        finally:
+            lock.release()
+    return done
+
+
+def load_loop_rows(directory: str | Path) -> pd.DataFrame:
+    """Every world stored by :func:`run_loop_study` in ``directory``, one row per world and controller.
+
+    A record whose checksum does not match its content is a :class:`FieldError` naming the file.
+    """
+    store = ResultStore(directory)
+    rows = []
+    for path in sorted(store.runs_dir.glob("*.json")) if store.runs_dir.is_dir() else []:
+        record = json.loads(path.read_text(encoding="utf-8"))
+        checksum = record.pop("checksum", None)
+        if record.get("format") != LOOP_RECORD_FORMAT or checksum != record_checksum(record):
+            raise FieldError("record", str(path), "is not a checked closed-loop record (altered or damaged): "
+                                                  "delete it and run the study again")
+        rows += record["rows"]
+    return pd.DataFrame(rows)
+
+
+def run_loop_study(items: Sequence[LoopStudyCase], seed: int, directory: str | Path, workers: int = 1,
+                   chunk: int = 5, controllers: Sequence[str] | None = None,
+                   say: Callable[[str], None] = print) -> pd.DataFrame:
+    """The closed-loop study of several cases, resumable: one record per world in a result store.
+
+    Worlds already stored in ``directory`` are not computed again, so a study stopped at any time
+    goes on where it was by running it again. Work is handed out in chunks of ``chunk`` worlds of
+    one case (a chunk builds its case's policy once), chunk by chunk across the cases, so that a
+    study stopped early has about as many worlds of every case; ``workers`` processes of a pool.
+    Returns :func:`load_loop_rows` of the directory.
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise FieldError("workers", workers, "must be a positive integer")
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
+        raise FieldError("chunk", chunk, "must be a positive integer")
+    store = ResultStore(directory)
+    store.prepare()
+    done = store.done_ids()
+    tasks = []
+    for first in range(0, max(item.n_runs for item in items), chunk):
+        for item in items:
+            names = tuple(controllers or STUDY_CONTROLLERS + tuple(
+                n for n in TUNED_CONTROLLERS if n.removeprefix("tracking_tuned_") in item.tuned))
+            runs = [r for r in range(first, min(first + chunk, item.n_runs))
+                    if world_run_id(item.case.name, seed, r) not in done]
+            if runs:
+                tasks.append((item, runs, seed, str(directory), names))
+    say(f"{len(done)} worlds stored, {sum(len(t[1]) for t in tasks)} to compute in {len(tasks)} chunks")
+    if workers == 1:
+        for task in tasks:
+            _report_chunk(task, _loop_chunk(*task), say)
+    else:
+        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+            futures = [(task, pool.submit(_loop_chunk, *task)) for task in tasks]
+            for task, future in futures:
+                _report_chunk(task, future.result(), say)
+    return load_loop_rows(directory)
+
+
+def _report_chunk(task: tuple, n_done: int, say: Callable[[str], None]) -> None:
+    item, runs = task[0], task[1]
+    say(f"{item.case.name}: worlds {runs[0]}-{runs[-1]} stored ({n_done} computed here)")
 
 
 def loop_summary(runs: pd.DataFrame, on_time_s: float = 2.0) -> pd.DataFrame:
