@@ -9,14 +9,20 @@ through the exact plan's price of time (``cost_kwh = net energy + lambda x laten
 the lateness, stop error, comfort (acceleration variation) and advice changes are reported beside
 it, with Wilcoxon rank-sum tests of every controller against the best curve-tracking one.
 
+The worlds are computed by :func:`pymoo_rail.control.study.run_loop_study`: one record per world
+in a result store (``out/closed_loop_study/store``), in chunks handed to a process pool
+(``--workers``), so a stopped study resumes where it was when run again. With the tuned trackers
+(default), each case's PID and fuzzy PID are first tuned on its plan by pymoo's DE
+(:func:`pymoo_rail.problems.controller_tuning.tune_controller`).
+
 Writes ``benchmarks/reports/closed_loop_study.md``, ``closed_loop_study_summary.csv`` and the
-figure ``closed_loop_study.png``; the per-run rows go to ``out/closed_loop_study/runs.csv``
-(``--report-only`` rebuilds the report from them).
+figure ``closed_loop_study.png`` (not tracked); the per-run rows also go to
+``out/closed_loop_study/runs.csv`` (``--report-only`` rebuilds the report from the store).
 
 Usage: ``python benchmarks/closed_loop_study.py [--runs 200] [--runs-long 200] [--seed 1]
-[--cases yizhuang metro-a wuguang-crh3 ttobench-ref] [--report-only]``. The defaults are the full
-study (200 worlds per case); ``--runs-long`` sets the worlds of the lines over 10 km (about 15 s
-of CPU per world with all eight controllers and the exact optima, against 1.5 s on yizhuang).
+[--workers 2] [--cases yizhuang metro-a wuguang-crh3 ttobench-ref] [--report-only]``. The
+defaults are the full study (200 worlds per case); ``--runs-long`` sets the worlds of the lines
+over 10 km.
 """
 
 from __future__ import annotations
@@ -32,11 +38,18 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
-from pymoo_rail.control.study import STUDY_CONTROLLERS, loop_runs, loop_summary  # noqa: E402
+from pymoo_rail.control.study import (  # noqa: E402
+    STUDY_CONTROLLERS,
+    TUNED_CONTROLLERS,
+    LoopStudyCase,
+    load_loop_rows,
+    loop_summary,
+    run_loop_study,
+)
 from pymoo_rail.experiments.stats import rank_sum  # noqa: E402
 from pymoo_rail.plotting import save_figure  # noqa: E402
 from pymoo_rail.sim import Simulator  # noqa: E402
-from pymoo_rail.experiments.report import fixed
+from pymoo_rail.experiments.report import fixed, lower_priority  # noqa: E402
 
 REPORTS = Path(__file__).parent / "reports"
 OUT = Path(__file__).parents[1] / "out" / "closed_loop_study"
@@ -44,7 +57,7 @@ CASES = ("yizhuang", "metro-a", "wuguang-crh3", "ttobench-ref")
 # metro-a's own 70 s is 0.4 % above its flat-out run: no disturbed train could be on time, so the
 # study plans it 8 % above the minimum running time, like the other cases' margins
 MARGIN = 1.08
-TRACKING = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis")
+TRACKING = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis") + TUNED_CONTROLLERS
 
 
 def planned_time(case) -> float:
@@ -60,7 +73,7 @@ def tests_table(runs: pd.DataFrame) -> pd.DataFrame:
         medians = g.groupby("controller")["gap_pct"].median()
         best = min(TRACKING, key=lambda n: medians.get(n, np.inf))
         base = g[g["controller"] == best]
-        for name in STUDY_CONTROLLERS:
+        for name in dict.fromkeys(g["controller"]):
             if name == best:
                 continue
             mine = g[g["controller"] == name]
@@ -80,7 +93,8 @@ def figure(runs: pd.DataFrame, path: Path) -> None:
 
     cases = list(dict.fromkeys(runs["case"]))
     fig, axes = plt.subplots(1, len(cases), figsize=(4.2 * len(cases), 4.0), squeeze=False)
-    colors = dict(zip(STUDY_CONTROLLERS, plt.get_cmap("tab10").colors))
+    palette = plt.get_cmap("tab20").colors
+    colors = dict(zip(STUDY_CONTROLLERS + TUNED_CONTROLLERS, palette[::2] + palette[1::2]))
     for ax, case in zip(axes[0], cases):
         g = runs[runs["case"] == case]
         for name, h in g.groupby("controller", sort=False):
@@ -104,7 +118,12 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
     figure(runs, REPORTS / "closed_loop_study.png")
     lines = ["# Closed-loop study: tracking, recovery, re-planning and driver advice on disturbed trains", "",
              f"Produced by `benchmarks/closed_loop_study.py --runs {args.runs} --runs-long {args.runs_long} "
-             f"--seed {args.seed}`" + (f" in {seconds:.0f} s of CPU." if seconds else " (report rebuilt from the runs)."),
+             f"--seed {args.seed}`; {runs.groupby(['case', 'run'])['world_cpu_s'].first().sum():.0f} s of CPU in "
+             "the worlds (every controller and the exact optima)"
+             + (f", {seconds:.0f} s in the tuning." if seconds else "."),
+             "CPU per world (median, s): " + ", ".join(
+                 f"{c} {v:.1f}" for c, v in runs.groupby(["case", "run"])["world_cpu_s"].first()
+                 .groupby(level=0, sort=False).median().items()) + ".",
              "Worlds per case: " + ", ".join(f"{c} {n}" for c, n in runs.groupby('case', sort=False)['run'].nunique().items())
              + ". Energy at equal arrival, two ways: `gap to exact`, the run's energy above the real train's exact "
              "optimum at the run's own running time (the exact solver on the world's own model, restriction known "
@@ -145,29 +164,50 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
     return text
 
 
+def study_items(names, runs: int, runs_long: int, tune: bool) -> list:
+    """Each case with its planned time, worlds and (with ``tune``) the PID and fuzzy PID tuned on its plan."""
+    from pymoo_rail.control.policy import OptimalPolicy
+    from pymoo_rail.problems.controller_tuning import tune_controller
+
+    items = []
+    for name in names:
+        case = load_case(name)
+        planned = planned_time(case)
+        n = runs if case.line.length_m <= 10_000 else runs_long
+        tuned = {}
+        if tune:
+            plan = OptimalPolicy(case, planned, certify=False).plan
+            tuned = {family: tune_controller(case, family, plan, seed=1) for family in ("pid", "fuzzy_pid")}
+            print(f"{name}: tuned {tuned}", flush=True)
+        items.append(LoopStudyCase(case, planned, n, tuned))
+    return items
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=200, help="worlds per case (lines up to 10 km)")
     parser.add_argument("--runs-long", type=int, default=None, help="worlds per case over 10 km (default: --runs)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--cases", nargs="+", default=list(CASES))
+    parser.add_argument("--workers", type=int, default=1, help="processes of the pool")
+    parser.add_argument("--chunk", type=int, default=5, help="worlds of one case per task")
+    parser.add_argument("--no-tuning", action="store_true", help="leave out the tuned PID and fuzzy PID")
+    parser.add_argument("--work", type=Path, default=OUT / "store", help="the result store (resumable)")
     parser.add_argument("--report-only", action="store_true")
     args = parser.parse_args()
     args.runs_long = args.runs if args.runs_long is None else args.runs_long
+    lower_priority()
     OUT.mkdir(parents=True, exist_ok=True)
-    path = OUT / "runs.csv"
     if args.report_only:
-        print(report(pd.read_csv(path), None, args))
+        runs = load_loop_rows(args.work)
+        print(report(runs, None, args))
         return
     started = time.process_time()
-    frames = []
-    for name in args.cases:
-        case = load_case(name)
-        n = args.runs if case.line.length_m <= 10_000 else args.runs_long
-        frames.append(loop_runs(case, n, args.seed, planned_time_s=planned_time(case)))
-        pd.concat(frames).to_csv(path, index=False)
-        print(f"{name}: {n} worlds, {time.process_time() - started:.0f} s CPU so far", flush=True)
-    print(report(pd.concat(frames), time.process_time() - started, args))
+    items = study_items(args.cases, args.runs, args.runs_long, not args.no_tuning)
+    runs = run_loop_study(items, args.seed, args.work, args.workers, args.chunk,
+                          say=lambda text: print(text, flush=True))
+    runs.to_csv(OUT / "runs.csv", index=False)
+    print(report(runs, time.process_time() - started, args))  # the main process's CPU: the tuning
 
 
 if __name__ == "__main__":
