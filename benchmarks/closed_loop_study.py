@@ -9,11 +9,11 @@ through the exact plan's price of time (``cost_kwh = net energy + lambda x laten
 the lateness, stop error, comfort (acceleration variation) and advice changes are reported beside
 it, with Wilcoxon rank-sum tests of every controller against the best curve-tracking one.
 
-The worlds are computed by :func:`pymoo_rail.control.study.run_loop_study`: one record per world
+The worlds are computed by :func:`pymoo_rail.experiments.loop_study.run_loop_study`: one record per world
 in a result store (``out/closed_loop_study/store``), in chunks handed to a process pool
 (``--workers``), so a stopped study resumes where it was when run again. With the tuned trackers
 (default), each case's PID and fuzzy PID are first tuned on its plan by pymoo's DE
-(:func:`pymoo_rail.problems.controller_tuning.tune_controller`).
+(:func:`pymoo_rail.experiments.loop_study.tuned_trackers`).
 
 Writes ``benchmarks/reports/closed_loop_study.md``, ``closed_loop_study_summary.csv`` and the
 figure ``closed_loop_study.png`` (not tracked); the per-run rows also go to
@@ -38,14 +38,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
-from pymoo_rail.control.study import (  # noqa: E402
-    STUDY_CONTROLLERS,
-    TUNED_CONTROLLERS,
-    LoopStudyCase,
-    load_loop_rows,
-    loop_summary,
-    run_loop_study,
-)
+from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, loop_summary  # noqa: E402
+from pymoo_rail.experiments.loop_study import LoopStudyCase, load_loop_rows, run_loop_study, tuned_trackers  # noqa: E402
 from pymoo_rail.experiments.stats import rank_sum  # noqa: E402
 from pymoo_rail.plotting import save_figure  # noqa: E402
 from pymoo_rail.sim import Simulator  # noqa: E402
@@ -167,7 +161,6 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
 def study_items(names, runs: int, runs_long: int, tune: bool) -> list:
     """Each case with its planned time, worlds and (with ``tune``) the PID and fuzzy PID tuned on its plan."""
     from pymoo_rail.control.policy import OptimalPolicy
-    from pymoo_rail.problems.controller_tuning import tune_controller
 
     items = []
     for name in names:
@@ -177,7 +170,7 @@ def study_items(names, runs: int, runs_long: int, tune: bool) -> list:
         tuned = {}
         if tune:
             plan = OptimalPolicy(case, planned, certify=False).plan
-            tuned = {family: tune_controller(case, family, plan, seed=1) for family in ("pid", "fuzzy_pid")}
+            tuned = tuned_trackers(case, plan)
             print(f"{name}: tuned {tuned}", flush=True)
         items.append(LoopStudyCase(case, planned, n, tuned))
     return items

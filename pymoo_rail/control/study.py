@@ -12,14 +12,10 @@ train, flat out from its late departure with the restriction known, could still 
 
 from __future__ import annotations
 
-import json
 import math
 import time as _time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from multiprocessing import get_context
-from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -29,18 +25,20 @@ from pymoo_rail.control.advice import AdvisedDriving
 from pymoo_rail.control.closed_loop import (
     CurveTracking,
     LoopDisturbance,
+    LoopState,
     OptimalControls,
     Recovery,
     Replanning,
     closed_loop,
+    plan_for,
     real_model,
 )
 from pymoo_rail.control.controllers import PID, Controller, FuzzyPID, Hysteresis
 from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction, run_trace
 from pymoo_rail.model import Case
-from pymoo_rail.experiments.store import ResultStore, record_checksum
 from pymoo_rail.model.errors import FieldError
 from pymoo_rail.optimal import OptimalSolver
+from pymoo_rail.sim import Trajectory
 from pymoo_rail.sim.drivers import flat_out_program
 
 STUDY_CONTROLLERS = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis", "recovery", "replanning",
@@ -48,8 +46,6 @@ STUDY_CONTROLLERS = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis"
 # Curve tracking by the gains tuned on the case's plan (given to the study, tuned by the problems layer)
 TUNED_CONTROLLERS = ("tracking_tuned_pid", "tracking_tuned_fuzzy_pid")
 DECIDE_EVERY_S = 10.0
-# One record of the result store holds the rows of one world of one case
-LOOP_RECORD_FORMAT = "pymoo-rail/loop-world/1"
 # Ranges of a world (uniform), shares of the line length or of the planned time where so named
 WORLD_RANGES = {"mass_factor": (0.9, 1.15), "adhesion_factor": (0.85, 1.0), "speed_noise_kmh": (0.0, 0.5),
                 "traction_lag_s": (0.0, 0.5), "resistance_factor": (0.9, 1.2), "regen_factor": (0.85, 1.0),
@@ -200,111 +196,6 @@ def loop_runs(case: Case, n_runs: int, seed: int, controllers=STUDY_CONTROLLERS,
     return pd.DataFrame(rows)
 
 
-@dataclass(frozen=True)
-class LoopStudyCase:
-    """One case of a closed-loop study: its planned time, worlds and the tuned trackers (if any)."""
-
-    case: Case
-    planned_time_s: float
-    n_runs: int
-    tuned: Mapping[str, Controller] = field(default_factory=dict)
-
-
-def world_run_id(case_name: str, seed: int, run: int) -> str:
-    """The result store's id of one world of a case."""
-    return f"{case_name}-seed{seed}-world{run:04d}"
-
-
-def _loop_chunk(item: LoopStudyCase, runs: list[int], seed: int, directory: str,
-                controllers: tuple[str, ...]) -> int:
-    """Compute and store the worlds ``runs`` of one case (skipping those stored or claimed); returns how many."""
-    store = ResultStore(directory)
-    planned = item.planned_time_s
-    policy = None
-    worlds = draw_loop_disturbances(item.case, max(runs) + 1, seed, planned)
-    done = 0
-    for run in runs:
-        run_id = world_run_id(item.case.name, seed, run)
-        lock = store.claim(run_id)
-        if lock is None:
-            continue
-        try:
-            if store.path(run_id).is_file():
-                continue
-            policy = OptimalPolicy(item.case, planned) if policy is None else policy
-            started = _time.process_time()
-            rows = world_rows(item.case, run, worlds[run], policy, planned, controllers, True, item.tuned)
-            world_cpu_s = _time.process_time() - started  # every controller and the exact optima
-            rows = [dict(row, world_cpu_s=world_cpu_s) for row in rows]
-            store.write({"format": LOOP_RECORD_FORMAT, "run_id": run_id, "case": item.case.name, "seed": seed,
-                         "planned_time_s": planned, "controllers": list(controllers), "rows": rows})
-            done += 1
-        finally:
-            lock.release()
-    return done
-
-
-def load_loop_rows(directory: str | Path) -> pd.DataFrame:
-    """Every world stored by :func:`run_loop_study` in ``directory``, one row per world and controller.
-
-    A record whose checksum does not match its content is a :class:`FieldError` naming the file.
-    """
-    store = ResultStore(directory)
-    rows = []
-    for path in sorted(store.runs_dir.glob("*.json")) if store.runs_dir.is_dir() else []:
-        record = json.loads(path.read_text(encoding="utf-8"))
-        checksum = record.pop("checksum", None)
-        if record.get("format") != LOOP_RECORD_FORMAT or checksum != record_checksum(record):
-            raise FieldError("record", str(path), "is not a checked closed-loop record (altered or damaged): "
-                                                  "delete it and run the study again")
-        rows += record["rows"]
-    return pd.DataFrame(rows)
-
-
-def run_loop_study(items: Sequence[LoopStudyCase], seed: int, directory: str | Path, workers: int = 1,
-                   chunk: int = 5, controllers: Sequence[str] | None = None,
-                   say: Callable[[str], None] = print) -> pd.DataFrame:
-    """The closed-loop study of several cases, resumable: one record per world in a result store.
-
-    Worlds already stored in ``directory`` are not computed again, so a study stopped at any time
-    goes on where it was by running it again. Work is handed out in chunks of ``chunk`` worlds of
-    one case (a chunk builds its case's policy once), chunk by chunk across the cases, so that a
-    study stopped early has about as many worlds of every case; ``workers`` processes of a pool.
-    Returns :func:`load_loop_rows` of the directory.
-    """
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise FieldError("workers", workers, "must be a positive integer")
-    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
-        raise FieldError("chunk", chunk, "must be a positive integer")
-    store = ResultStore(directory)
-    store.prepare()
-    done = store.done_ids()
-    tasks = []
-    for first in range(0, max(item.n_runs for item in items), chunk):
-        for item in items:
-            names = tuple(controllers or STUDY_CONTROLLERS + tuple(
-                n for n in TUNED_CONTROLLERS if n.removeprefix("tracking_tuned_") in item.tuned))
-            runs = [r for r in range(first, min(first + chunk, item.n_runs))
-                    if world_run_id(item.case.name, seed, r) not in done]
-            if runs:
-                tasks.append((item, runs, seed, str(directory), names))
-    say(f"{len(done)} worlds stored, {sum(len(t[1]) for t in tasks)} to compute in {len(tasks)} chunks")
-    if workers == 1:
-        for task in tasks:
-            _report_chunk(task, _loop_chunk(*task), say)
-    else:
-        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-            futures = [(task, pool.submit(_loop_chunk, *task)) for task in tasks]
-            for task, future in futures:
-                _report_chunk(task, future.result(), say)
-    return load_loop_rows(directory)
-
-
-def _report_chunk(task: tuple, n_done: int, say: Callable[[str], None]) -> None:
-    item, runs = task[0], task[1]
-    say(f"{item.case.name}: worlds {runs[0]}-{runs[-1]} stored ({n_done} computed here)")
-
-
 def loop_summary(runs: pd.DataFrame, on_time_s: float = 2.0) -> pd.DataFrame:
     """Per case and controller: medians, the share on time (within ``on_time_s``) among runs that can be."""
     rows = []
@@ -321,3 +212,53 @@ def loop_summary(runs: pd.DataFrame, on_time_s: float = 2.0) -> pd.DataFrame:
                      "median_seconds_per_change": g["seconds_per_change"].median(),
                      "median_decision_cpu_ms": g["decision_cpu_ms"].median()})
     return pd.DataFrame(rows)
+
+
+@dataclass
+class _RecordingReplanning(Replanning):
+    """The re-planning controller, keeping the states it planned from."""
+
+    states: list = field(default_factory=list)
+
+    def reference(self, state: LoopState) -> Trajectory:
+        self.states.append(state)
+        return super().reference(state)
+
+
+def replan_latency(case: Case, planned_time_s: float, n_worlds: int, seed: int) -> dict:
+    """CPU time per re-plan of :class:`OptimalPolicy` against a fresh exact solve, in one process.
+
+    The policy is built once. In each seeded world (:func:`draw_loop_disturbances`) the
+    re-planning controller drives a closed-loop run; its re-plans are timed as the loop made them
+    (``loop_*``: with the sweeps of prices and the tables of the world's train not yet computed),
+    then again from the same states right after (``warm_*``: the train's own policy, its lattice
+    and tables computed; also over the states in the first half of the line). Beside them, two
+    fresh exact solves of the whole run at the planned time (new solver: tables, price search,
+    certificate). Times in ms (re-plans) and s (solves and the policy's build).
+    """
+    started = _time.process_time()
+    policy = OptimalPolicy(case, planned_time_s)
+    build_s = _time.process_time() - started
+    in_loop, warm, first_half, fastest = [], [], [], 0
+    for world in draw_loop_disturbances(case, n_worlds, seed, planned_time_s):
+        controller = _RecordingReplanning(policy, PID(), DECIDE_EVERY_S)
+        closed_loop(case, controller, world, planned_time_s=planned_time_s)
+        in_loop += controller.cpu_s
+        for state in controller.states:
+            started = _time.process_time()
+            rest = plan_for(policy, state)
+            warm.append(_time.process_time() - started)
+            fastest += not math.isfinite(rest.summary["lambda_w"])  # late beyond recovery: the flat-out run
+            if state.position_m < 0.5 * float(case.line.length_m):
+                first_half.append(warm[-1])
+    fresh = []
+    for _ in range(2):
+        started = _time.process_time()
+        OptimalSolver(case).profile(planned_time_s)
+        fresh.append(_time.process_time() - started)
+    ms = 1000.0
+    return {"case": case.name, "length_km": float(case.line.length_m) / 1000.0, "replans": len(warm),
+            "fastest": fastest, "build_s": build_s, "loop_median_ms": ms * float(np.median(in_loop)),
+            "loop_p90_ms": ms * float(np.percentile(in_loop, 90)), "warm_median_ms": ms * float(np.median(warm)),
+            "warm_p90_ms": ms * float(np.percentile(warm, 90)), "first_half_ms": ms * float(np.median(first_half)),
+            "fresh_s": float(np.median(fresh))}

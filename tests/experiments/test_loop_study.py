@@ -1,0 +1,37 @@
+"""The closed-loop study at full size: one checked record per world, resumable (``pymoo_rail.experiments.loop_study``)."""
+
+import numpy as np
+import pytest
+
+from pymoo_rail.cases import load_case
+from pymoo_rail.control.study import loop_runs
+from pymoo_rail.model.errors import FieldError
+
+
+@pytest.fixture(scope="module")
+def metro():
+    return load_case("metro-a")
+
+
+def test_the_study_is_stored_world_by_world_and_resumes(metro, tmp_path):
+    from pymoo_rail.control import PID
+    from pymoo_rail.experiments.loop_study import LoopStudyCase, load_loop_rows, run_loop_study
+
+    item = LoopStudyCase(metro, 80.0, 2, tuned={"pid": PID(kp=0.3, ki=0.02, kd=0.0)})
+    names = ("tracking_pid", "tracking_tuned_pid", "optimal_controls")
+    said = []
+    rows = run_loop_study([item], 5, tmp_path, chunk=1, controllers=names, say=said.append)
+    assert said[0] == "0 worlds stored, 2 to compute in 2 chunks"
+    assert sorted(set(rows["run"])) == [0, 1] and len(rows) == 6
+    tuned = rows[rows["controller"] == "tracking_tuned_pid"]
+    assert (tuned["net_kwh"].to_numpy() != rows[rows["controller"] == "tracking_pid"]["net_kwh"].to_numpy()).all()
+    # the same worlds as the study's own runs, so a resumed study matches one run in one go
+    direct = loop_runs(metro, 2, seed=5, controllers=names, planned_time_s=80.0, tuned=item.tuned)
+    np.testing.assert_allclose(rows["net_kwh"].to_numpy(), direct["net_kwh"].to_numpy())
+    again = run_loop_study([item], 5, tmp_path, chunk=1, controllers=names, say=said.append)
+    assert said[-1] == "2 worlds stored, 0 to compute in 0 chunks"
+    assert again.equals(rows)
+    record = tmp_path / "runs" / "metro-a-seed5-world0000.json"
+    record.write_text(record.read_text().replace('"run": 0', '"run": 7'))
+    with pytest.raises(FieldError, match="'record' = .*altered or damaged"):
+        load_loop_rows(tmp_path)
