@@ -34,13 +34,17 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
 from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, loop_summary  # noqa: E402
-from pymoo_rail.experiments.loop_study import LoopStudyCase, load_loop_rows, run_loop_study, tuned_trackers  # noqa: E402
-from pymoo_rail.experiments.stats import rank_sum  # noqa: E402
+from pymoo_rail.experiments.loop_study import (  # noqa: E402
+    LoopStudyCase,
+    load_loop_rows,
+    loop_tests,
+    run_loop_study,
+    tuned_trackers,
+)
 from pymoo_rail.plotting import save_figure  # noqa: E402
 from pymoo_rail.sim import Simulator  # noqa: E402
 from pymoo_rail.experiments.report import fixed, lower_priority  # noqa: E402
@@ -58,27 +62,6 @@ def planned_time(case) -> float:
     """The case's planned time, or 8 % above its minimum where the case leaves less."""
     fastest = Simulator(case).min_running_time_s()
     return float(max(case.planned_time_s, round(MARGIN * fastest)))
-
-
-def tests_table(runs: pd.DataFrame) -> pd.DataFrame:
-    """Each controller against the best curve-tracking one of its case (lowest median gap to the exact optimum)."""
-    rows = []
-    for case, g in runs.groupby("case", sort=False):
-        medians = g.groupby("controller")["gap_pct"].median()
-        best = min(TRACKING, key=lambda n: medians.get(n, np.inf))
-        base = g[g["controller"] == best]
-        for name in dict.fromkeys(g["controller"]):
-            if name == best:
-                continue
-            mine = g[g["controller"] == name]
-            for measure in ("gap_pct", "cost_kwh", "lateness_abs_s"):
-                a = mine["lateness_s"].abs() if measure == "lateness_abs_s" else mine[measure]
-                b = base["lateness_s"].abs() if measure == "lateness_abs_s" else base[measure]
-                u, p, verdict = rank_sum(a.to_numpy(), b.to_numpy())
-                rows.append({"case": case, "controller": name, "against": best, "measure": measure,
-                             "median": float(np.median(a)), "median_against": float(np.median(b)), "p_value": p,
-                             "verdict": verdict})
-    return pd.DataFrame(rows)
 
 
 def figure(runs: pd.DataFrame, path: Path) -> None:
@@ -105,25 +88,23 @@ def figure(runs: pd.DataFrame, path: Path) -> None:
     save_figure(fig, path, dpi=80)
 
 
-def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
-    summary = loop_summary(runs)
-    summary.to_csv(REPORTS / "closed_loop_study_summary.csv", index=False, float_format="%.6g")
-    tests = tests_table(runs)
-    figure(runs, REPORTS / "closed_loop_study.png")
-    lines = ["# Closed-loop study: tracking, recovery, re-planning and driver advice on disturbed trains", "",
-             f"Produced by `benchmarks/closed_loop_study.py --runs {args.runs} --runs-long {args.runs_long} "
-             f"--seed {args.seed}`; {runs.groupby(['case', 'run'])['world_cpu_s'].first().sum():.0f} s of CPU in "
-             "the worlds (every controller and the exact optima)"
-             + (f", {seconds:.0f} s in the tuning." if seconds else "."),
-             "CPU per world (median, s): " + ", ".join(
-                 f"{c} {v:.1f}" for c, v in runs.groupby(["case", "run"])["world_cpu_s"].first()
-                 .groupby(level=0, sort=False).median().items()) + ".",
-             "Worlds per case: " + ", ".join(f"{c} {n}" for c, n in runs.groupby('case', sort=False)['run'].nunique().items())
-             + ". Energy at equal arrival, two ways: `gap to exact`, the run's energy above the real train's exact "
-             "optimum at the run's own running time (the exact solver on the world's own model, restriction known "
-             "from the start); `cost_kwh = net energy + lambda x lateness` with the exact plan's price of time. On "
-             "time: within 2 s of the plan, among the worlds where the real train flat out could be.", "",
-             "| case | controller | median gap to exact % | median cost kWh | median energy kWh | median lateness s "
+def header(runs: pd.DataFrame, seconds: float | None, args) -> list[str]:
+    worlds = runs.groupby(["case", "run"], sort=False)["world_cpu_s"].first()
+    return ["# Closed-loop study: tracking, recovery, re-planning and driver advice on disturbed trains", "",
+            f"Produced by `benchmarks/closed_loop_study.py --runs {args.runs} --runs-long {args.runs_long} "
+            f"--seed {args.seed}`; {worlds.sum():.0f} s of CPU in the worlds (every controller and the exact optima)"
+            + (f", {seconds:.0f} s in the main process (the tuning)." if seconds else "."),
+            "Worlds per case: " + ", ".join(f"{c} {n}" for c, n in worlds.groupby(level=0, sort=False).size().items())
+            + "; CPU per world (median): " + ", ".join(
+                f"{c} {v:.1f} s" for c, v in worlds.groupby(level=0, sort=False).median().items())
+            + ". Energy at equal arrival, two ways: `gap to exact`, the run's energy above the real train's exact "
+            "optimum at the run's own running time (the exact solver on the world's own model, restriction known "
+            "from the start); `cost_kwh = net energy + lambda x lateness` with the exact plan's price of time. On "
+            "time: within 2 s of the plan, among the worlds where the real train flat out could be.", ""]
+
+
+def summary_lines(summary: pd.DataFrame) -> list[str]:
+    lines = ["| case | controller | median gap to exact % | median cost kWh | median energy kWh | median lateness s "
              "| on time (of possible) | late | median stop error m | median accel. variation m/s^2 "
              "| s per advice change | ms per re-plan |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -134,25 +115,42 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
                      f"{int(r['n_can_be_on_time'])} | {fixed(100 * r['late_share'], 0, missing='n/a')} % "
                      f"| {fixed(r['median_stop_error_m'], 3, missing='n/a')} | {fixed(r['median_jerk_ms2'], missing='n/a')} "
                      f"| {fixed(r['median_seconds_per_change'], 1, missing='n/a')} | {fixed(r['median_decision_cpu_ms'], 1, missing='n/a')} |")
-    lines += ["", "## Driver advice (1.5 s reaction) against the policy's own controls, world by world", "",
-              "Paired by world: `cost_kwh` of the advised run over that of `optimal_controls` (both re-plan every "
-              "10 s from the same states of the same worlds).", "",
-              "| case | worlds | median extra cost | 90th percentile | worlds over 1 % |", "|---|---|---|---|---|"]
+    return lines
+
+
+def advice_lines(runs: pd.DataFrame) -> list[str]:
+    lines = ["", "## Driver advice (1.5 s reaction) against the policy's own controls, world by world", "",
+             "Paired by world: `cost_kwh` of the advised run over that of `optimal_controls` (both re-plan every "
+             "10 s from the same states of the same worlds).", "",
+             "| case | worlds | median extra cost | 90th percentile | worlds over 1 % |", "|---|---|---|---|---|"]
     for case, g in runs.groupby("case", sort=False):
         adv = g[g["controller"] == "advice"].set_index("run")["cost_kwh"]
         opt = g[g["controller"] == "optimal_controls"].set_index("run")["cost_kwh"]
         extra = 100.0 * (adv / opt.reindex(adv.index) - 1.0)
         lines.append(f"| {case} | {len(extra)} | {extra.median():+.2f} % | {extra.quantile(0.9):+.2f} % "
                      f"| {int((extra > 1.0).sum())} |")
-    lines += ["", "## Wilcoxon rank-sum tests against the best curve tracking of each case", "",
-              "`+`: significantly lower (better) than the tracking controller at p < 0.05, `-`: higher, `=`: no "
-              "significant difference.", "",
-              "| case | controller | against | measure | median | median of tracking | p | verdict |",
-              "|---|---|---|---|---|---|---|---|"]
+    return lines
+
+
+def tests_lines(tests: pd.DataFrame) -> list[str]:
+    lines = ["", "## Wilcoxon signed-rank tests (paired by world) against the best curve tracking of each case", "",
+             "`+`: significantly lower (better) than the tracking controller at p < 0.05, `-`: higher, `=`: no "
+             "significant difference.", "",
+             "| case | controller | against | measure | median | median of tracking | p | verdict |",
+             "|---|---|---|---|---|---|---|---|"]
     for _, r in tests.iterrows():
         lines.append(f"| {r['case']} | {r['controller']} | {r['against']} | {r['measure']} | {fixed(r['median'], 3, missing='n/a')} "
                      f"| {fixed(r['median_against'], 3, missing='n/a')} | {fixed(r['p_value'], 4, missing='n/a')} | {r['verdict']} |")
-    lines += ["", "![energy against lateness](closed_loop_study.png)", ""]
+    return lines
+
+
+def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
+    runs = pd.concat([runs[runs["case"] == name] for name in args.cases])  # the cases in the order asked
+    summary = loop_summary(runs)
+    summary.to_csv(REPORTS / "closed_loop_study_summary.csv", index=False, float_format="%.6g")
+    figure(runs, REPORTS / "closed_loop_study.png")
+    lines = (header(runs, seconds, args) + summary_lines(summary) + advice_lines(runs)
+             + tests_lines(loop_tests(runs, TRACKING)) + ["", "![energy against lateness](closed_loop_study.png)", ""])
     text = "\n".join(lines)
     (REPORTS / "closed_loop_study.md").write_text(text, encoding="utf-8")
     return text

@@ -23,6 +23,7 @@ import pandas as pd
 from pymoo_rail.control.controllers import Controller
 from pymoo_rail.control.policy import OptimalPolicy
 from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, draw_loop_disturbances, world_rows
+from pymoo_rail.experiments.stats import signed_rank_vs
 from pymoo_rail.experiments.store import ResultStore, record_checksum
 from pymoo_rail.model import Case
 from pymoo_rail.model.errors import FieldError
@@ -141,3 +142,30 @@ def run_loop_study(items: Sequence[LoopStudyCase], seed: int, directory: str | P
 def _report_chunk(task: tuple, n_done: int, say: Callable[[str], None]) -> None:
     item, runs = task[0], task[1]
     say(f"{item.case.name}: worlds {runs[0]}-{runs[-1]} stored ({n_done} computed here)")
+
+
+def loop_tests(runs: pd.DataFrame, tracking: Sequence[str]) -> pd.DataFrame:
+    """Each controller against the best curve tracking of its case (lowest median ``gap_pct``), world by world.
+
+    Paired Wilcoxon signed-rank tests (every controller drove the same worlds) of ``gap_pct``,
+    ``cost_kwh`` and the absolute lateness; verdict ``+`` significantly lower (better) at p < 0.05,
+    ``-`` higher, ``=`` no significant difference.
+    """
+    rows = []
+    for case, g in runs.groupby("case", sort=False):
+        medians = g.groupby("controller")["gap_pct"].median()
+        best = min((n for n in tracking if n in medians.index), key=lambda n: medians[n])
+        base = g[g["controller"] == best].set_index("run")
+        for name in dict.fromkeys(g["controller"]):
+            if name == best:
+                continue
+            mine = g[g["controller"] == name].set_index("run")
+            for measure in ("gap_pct", "cost_kwh", "lateness_abs_s"):
+                a, b = (frame["lateness_s"].abs() if measure == "lateness_abs_s" else frame[measure]
+                        for frame in (mine, base))
+                b = b.reindex(a.index)
+                p, verdict = signed_rank_vs((a - b).to_numpy(), 0.0)
+                rows.append({"case": case, "controller": name, "against": best, "measure": measure,
+                             "median": float(a.median()), "median_against": float(b.median()), "p_value": p,
+                             "verdict": verdict})
+    return pd.DataFrame(rows)

@@ -35,3 +35,24 @@ def test_the_study_is_stored_world_by_world_and_resumes(metro, tmp_path):
     record.write_text(record.read_text().replace('"run": 0', '"run": 7'))
     with pytest.raises(FieldError, match="'record' = .*altered or damaged"):
         load_loop_rows(tmp_path)
+
+
+def test_loop_tests_pair_the_worlds():
+    import pandas as pd
+
+    from pymoo_rail.experiments.loop_study import loop_tests
+
+    rng = np.random.default_rng(0)
+    base = rng.uniform(1.0, 20.0, 12)  # worlds differ far more than the controllers do
+    rows = []
+    for name, shift in (("tracking_a", 0.0), ("tracking_b", 0.5), ("better", -0.1), ("worse", 0.1)):
+        for run, b in enumerate(base):
+            rows.append({"case": "c", "run": run, "controller": name, "gap_pct": b + shift, "cost_kwh": b + shift,
+                         "lateness_s": 0.0})
+    tests = loop_tests(pd.DataFrame(rows), ("tracking_a", "tracking_b"))
+    gap = tests[tests["measure"] == "gap_pct"].set_index("controller")
+    assert set(gap["against"]) == {"tracking_a"}
+    # unpaired, +-0.1 would be lost in the spread of the worlds; paired, it is significant
+    assert gap.loc["better", "verdict"] == "+" and gap.loc["worse", "verdict"] == "-"
+    assert gap.loc["tracking_b", "verdict"] == "-"
+    assert (tests[tests["measure"] == "lateness_abs_s"]["verdict"] == "=").all()
