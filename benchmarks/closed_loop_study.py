@@ -37,7 +37,7 @@ matplotlib.use("Agg")
 import pandas as pd  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
-from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, loop_summary  # noqa: E402
+from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, loop_summary, study_planned_time  # noqa: E402
 from pymoo_rail.experiments.loop_study import (  # noqa: E402
     LoopStudyCase,
     load_loop_rows,
@@ -46,22 +46,12 @@ from pymoo_rail.experiments.loop_study import (  # noqa: E402
     tuned_trackers,
 )
 from pymoo_rail.plotting import save_figure  # noqa: E402
-from pymoo_rail.sim import Simulator  # noqa: E402
 from pymoo_rail.experiments.report import fixed, lower_priority  # noqa: E402
 
 REPORTS = Path(__file__).parent / "reports"
 OUT = Path(__file__).parents[1] / "out" / "closed_loop_study"
 CASES = ("yizhuang", "metro-a", "wuguang-crh3", "ttobench-ref")
-# metro-a's own 70 s is 0.4 % above its flat-out run: no disturbed train could be on time, so the
-# study plans it 8 % above the minimum running time, like the other cases' margins
-MARGIN = 1.08
 TRACKING = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis") + TUNED_CONTROLLERS
-
-
-def planned_time(case) -> float:
-    """The case's planned time, or 8 % above its minimum where the case leaves less."""
-    fastest = Simulator(case).min_running_time_s()
-    return float(max(case.planned_time_s, round(MARGIN * fastest)))
 
 
 def figure(runs: pd.DataFrame, path: Path) -> None:
@@ -163,7 +153,7 @@ def study_items(names, runs: int, runs_long: int, tune: bool) -> list:
     items = []
     for name in names:
         case = load_case(name)
-        planned = planned_time(case)
+        planned = study_planned_time(case)
         n = runs if case.line.length_m <= 10_000 else runs_long
         tuned = {}
         if tune:

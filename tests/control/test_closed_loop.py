@@ -124,10 +124,10 @@ def test_the_optimal_controls_applied_directly_arrive_on_time(metro, policy):
 def test_a_long_line_with_weak_adhesion_arrives_on_time():
     """48 km, a 10 % heavier train on 0.895 adhesion: planned on the nominal brakes, it arrived 4.2 s late."""
     from pymoo_rail.control.closed_loop import OptimalControls
-    from pymoo_rail.control.study import draw_loop_disturbances
+    from pymoo_rail.control.study import draw_loop_disturbances, study_planned_time
 
     case = load_case("wuguang-crh3")
-    planned = 1062.0  # 8 % above the minimum running time, as in the closed-loop study
+    planned = study_planned_time(case)  # 8 % above the minimum running time
     world = draw_loop_disturbances(case, 2, 1, planned)[1]
     assert world.adhesion_factor < 0.9 and world.mass_factor > 1.09 and world.departure_delay_s == 0.0
     run = closed_loop(case, OptimalControls(OptimalPolicy(case, planned), 10.0), world, planned_time_s=planned)
