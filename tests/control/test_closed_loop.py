@@ -108,6 +108,17 @@ def test_bad_decision_period(metro, policy):
         closed_loop(metro, CurveTracking(policy.plan, PID(), decide_every_s=0.0))
 
 
+def test_a_train_just_behind_a_tight_plan_is_not_driven_flat_out(metro):
+    """metro-a at 75 s: the plan's last coast ends 0.05 s behind 75 s, and flat out saves little time."""
+    from pymoo_rail.control.closed_loop import OptimalControls
+
+    tight = OptimalPolicy(metro, 75.0)
+    run = closed_loop(metro, OptimalControls(tight, 10.0), planned_time_s=75.0)
+    # re-planning on the plan changes nothing; flat out from 879 m cost 0.40 kWh (2.3 %) more
+    assert run.energy.net_kwh == pytest.approx(tight.plan.energy.net_kwh, rel=1e-3)
+    assert abs(run.summary["lateness_s"]) <= 0.5
+
+
 def test_the_optimal_controls_applied_directly_arrive_on_time(metro, policy):
     from pymoo_rail.control.closed_loop import OptimalControls
 
