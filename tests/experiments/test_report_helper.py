@@ -35,3 +35,17 @@ def test_markdown_formats_float_cells_only(tmp_path):
     path = write_report(tmp_path / "r.md", ["# title", "", "text"])
     assert path.read_text() == "# title\n\ntext\n"
     assert write_report(tmp_path / "s.md", ["a", "b"], newline=False).read_text() == "a\nb"
+
+
+def test_fill_template_fills_every_placeholder_and_names_what_is_missing_or_unused(tmp_path):
+    import pytest
+
+    from pymoo_rail.experiments.report import fill_template
+
+    template = tmp_path / "r.md"
+    template.write_text("# ${title}\n\n${table} costs $$5, ${n} runs\n")
+    assert fill_template(template, {"title": "T", "table": "| a |", "n": 3}) == "# T\n\n| a | costs $5, 3 runs\n"
+    with pytest.raises(KeyError, match=r"no value for \$\{n\}"):
+        fill_template(template, {"title": "T", "table": ""})
+    with pytest.raises(ValueError, match="no placeholder for the value.s. runs"):
+        fill_template(template, {"title": "T", "table": "", "n": 1, "runs": 2})
