@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from pymoo_rail.experiments.report import fixed, markdown, markdown_rows, mean_std, significant, write_report
 
@@ -35,3 +36,17 @@ def test_markdown_formats_float_cells_only(tmp_path):
     path = write_report(tmp_path / "r.md", ["# title", "", "text"])
     assert path.read_text() == "# title\n\ntext\n"
     assert write_report(tmp_path / "s.md", ["a", "b"], newline=False).read_text() == "a\nb"
+
+
+def test_require_runs_names_the_missing_record(tmp_path):
+    from pymoo_rail.experiments import Study, algorithm, problem
+    from pymoo_rail.experiments.report import require_runs
+
+    study = Study("s", problems=[problem("zdt1")], algorithms=[algorithm("nsga2", pop_size=10)], seeds=2,
+                  budget={"n_gen": 2})
+    first, second = study.runs()
+    require_runs(pd.DataFrame({"run_id": [first.run_id, second.run_id]}), study, tmp_path)  # all there
+    with pytest.raises(FileNotFoundError, match=r"1 of the 2 runs of study 's' \(e.g. zdt1 / nsga2 / seed 2\)"):
+        require_runs(pd.DataFrame({"run_id": [first.run_id]}), study, tmp_path)
+    with pytest.raises(FileNotFoundError, match="2 of the 2 runs"):
+        require_runs(pd.DataFrame(), study, tmp_path)
