@@ -55,6 +55,23 @@ TTOBENCH = Path(__file__).resolve().parents[1] / "tests" / "data" / "ttobench"
 PARTS_VARIANTS = ({"n_speeds": 100}, {"n_speeds": 400}, {"n_speeds": 800}, {"tie_j": 0.0})
 
 
+def progress(items):
+    """A progress bar over the cases."""
+    return tqdm(items, desc="cases", unit="case")
+
+
+def chosen_members(limit: int | None):
+    """The committed members, or the first ``limit`` of each case (a quick run)."""
+    table = committed_members(REPORTS)
+    return table if limit is None else table.groupby("case", sort=False).head(limit)
+
+
+def show(path: Path, lines: list[str]) -> None:
+    """Write a report (no newline after its last line, as committed) and print it."""
+    write_report(path, lines, newline=False)
+    print("\n".join(lines))
+
+
 def members(args) -> int:
     """Check every committed member (or report from the stored CSV); the number below the reference."""
     csv_path = args.out / "reference_check.csv"
@@ -63,10 +80,7 @@ def members(args) -> int:
             raise SystemExit(f"--report-only: no {csv_path}; run without --report-only first")
         table = with_derived_columns(pd.read_csv(csv_path))
     else:
-        table = committed_members(REPORTS)
-        if args.limit is not None:
-            table = table.groupby("case", sort=False).head(args.limit)
-        table = check_members(table, member_cases(), progress=lambda items: tqdm(items, desc="cases", unit="case"))
+        table = check_members(chosen_members(args.limit), member_cases(), progress=progress)
         # 9 digits (1 mWh on 1000 kWh), far below any gap quoted; the derived columns are rebuilt on reading
         table.drop(columns=list(DERIVED)).to_csv(csv_path, index=False, float_format="%.9g")
     s = members_summary(table)
@@ -79,18 +93,14 @@ def members(args) -> int:
              "more than the certificate, a defect of the reference.", "",
              f"Members in range: {int(table['in_range'].sum())} of {len(table)}; below the reference beyond the "
              f"certificate: **{n_below}**.", "", markdown(s), ""]
-    write_report(args.out / "reference_check.md", lines, newline=False)
-    print("\n".join(lines))
+    show(args.out / "reference_check.md", lines)
     return n_below
 
 
 def coverage(args) -> int:
     """The certificate against other grids at every member time; the number of misses."""
-    table = committed_members(REPORTS)
-    if args.limit is not None:
-        table = table.groupby("case", sort=False).head(args.limit)
     start = time.process_time()
-    result = coverage_table(table, member_cases(), progress=lambda items: tqdm(items, desc="cases", unit="case"))
+    result = coverage_table(chosen_members(args.limit), member_cases(), progress=progress)
     cpu = time.process_time() - start
     s, sentences = coverage_summary(result)
     misses = int(s["misses"].sum())
@@ -104,8 +114,7 @@ def coverage(args) -> int:
              "certificate - difference.", "",
              f"Times compared: {int(np.isfinite(result['default_kwh']).sum())}; misses: **{misses}**; "
              f"CPU {cpu:.0f} s.", "", *sentences, "", markdown(s), ""]
-    write_report(args.out / "certificate_coverage.md", lines, newline=False)
-    print("\n".join(lines))
+    show(args.out / "certificate_coverage.md", lines)
     return misses
 
 
@@ -122,8 +131,7 @@ def parts(args) -> int:
              "default run (200 speed nodes, `tie_j` = 100 J) and its certificate with its parts, beside finer grids "
              "and the run without the tie rule, all moved to the default run's time along the front's slope. The "
              "certificate is the grid part plus the floor plus the largest of the other three.", "", markdown(table), ""]
-    write_report(args.out / "certificate.md", lines, newline=False)
-    print("\n".join(lines))
+    show(args.out / "certificate.md", lines)
     return 0
 
 
