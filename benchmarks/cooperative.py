@@ -35,9 +35,9 @@ import pandas as pd
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments import load_results, run_study
 from pymoo_rail.experiments.cooperative import (
+    best_clocked_runs,
     exact_baselines,
     offsets_study,
-    problem_label,
     savings_table,
     sharing_potential,
 )
@@ -70,27 +70,17 @@ def savings_lines(table: pd.DataFrame) -> list[str]:
     return lines
 
 
-def best_runs(results: pd.DataFrame, x: float, label: str, make_problem) -> list:
-    """The clocked runs of the best stored result at offset x (none if the study has no such run)."""
-    sel = results[results["problem"] == problem_label(1.0, x)] if results is not None else []
-    if len(sel) == 0:
-        return []
-    best = sel.iloc[int(np.argmin([float(np.min(F[:, 0])) for F in sel["F"]]))]
-    x_best = np.asarray(best["X"])[int(np.argmin(best["F"][:, 0]))]
-    return [(label, make_problem(x).simulate(x_best[None, :])["clocked"][0])]
-
-
 def potential_lines(results: pd.DataFrame, paper_results, base) -> list[str]:
     """Regenerated energy per train and offset, from the traces of the exact runs and of the best GA runs."""
     case = load_case("cooperative-pair")
     lines = ["| x (s) | runs | A regenerates (kWh, when on the clock) | of it while B moves | B regenerates | "
              "of it while A moves | shared |", "|---|---|---|---|---|---|---|"]
     for x in SEED_001_OFFSETS_S:
-        candidates = [("exact, alone", base.clocked_pair(x))]
-        candidates += best_runs(results, x, "best GA, speed codes", lambda o: CooperativeTrainsProblem(case, o))
-        candidates += best_runs(paper_results, x, "best GA, paper's encoding",
-                                lambda o: CooperativeSeedProblem(case, o))
-        for label, runs in candidates:
+        candidates = [("exact, alone", base.clocked_pair(x)),
+                      ("best GA, speed codes", best_clocked_runs(results, x, lambda o: CooperativeTrainsProblem(case, o))),
+                      ("best GA, paper's encoding",
+                       best_clocked_runs(paper_results, x, lambda o: CooperativeSeedProblem(case, o)))]
+        for label, runs in [(label, runs) for label, runs in candidates if runs is not None]:
             pot = sharing_potential(runs)
             a, b = pot.iloc[0], pot.iloc[1]
             lines.append(f"| {x:+g} | {label} | {a.regen_kwh:.2f} ({a.braking_from_s:.0f}-{a.braking_to_s:.0f} s) | "
