@@ -68,7 +68,14 @@ def write_report(rows: list[dict]) -> None:
              "thread, so on an idle 2-core machine the cold wall time is about its CPU time.", "",
              "| date | commit | note | CPUs | load at start / end | run | wall s | CPU s | compile message |",
              "|---|---|---|---|---|---|---|---|---|"]
-    for row in reversed(rows):
+    stamp = ("date", "commit", "note", "cpus", "load_start", "load_end")
+    blocks: list[list[dict]] = []  # one block per measurement (rows with the same stamp), in run order
+    for row in rows:
+        if blocks and all(blocks[-1][0][k] == row[k] for k in stamp):
+            blocks[-1].append(row)
+        else:
+            blocks.append([row])
+    for row in [r for block in reversed(blocks) for r in block]:
         lines.append(f"| {row['date']} | {row['commit']} | {row['note']} | {row['cpus']} | "
                      f"{row['load_start']} / {row['load_end']} | {row['run']} | {row['wall_s']} | "
                      f"{row['cpu_s']} | {row['compile_message']} |")
