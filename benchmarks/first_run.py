@@ -96,6 +96,7 @@ def main() -> None:
     parser.add_argument("--no-report", action="store_true", help="print only; leave the report files alone")
     args = parser.parse_args()
     load = os.getloadavg()[0]
+    measured_commit = commit()  # before the runs: the code they ran
     print(f"load average at start: {load:.1f} on {os.cpu_count()} CPUs")
     print("run   wall s   CPU s   compile message")
     measured = []
@@ -110,7 +111,7 @@ def main() -> None:
     print(f"load average at end: {load_end:.1f}")
     if args.no_report:
         return
-    stamp = dict(date=dt.date.today().isoformat(), commit=commit(), note=args.note, cpus=os.cpu_count(),
+    stamp = dict(date=dt.date.today().isoformat(), commit=measured_commit, note=args.note, cpus=os.cpu_count(),
                  load_start=f"{load:.1f}", load_end=f"{load_end:.1f}")
     rows = read_rows() + [dict(stamp, run=label, wall_s=f"{wall:.1f}", cpu_s=f"{cpu:.1f}",
                                compile_message="yes" if said else "no") for label, wall, cpu, said in measured]
