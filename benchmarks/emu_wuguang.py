@@ -16,7 +16,7 @@ run, resumable):
   and on switching points (the best fronts of the encoding study, as a check).
 
 The exact front of ``pymoo_rail.optimal`` at 13 running times from 990 to 1110 s is computed once
-and cached in ``reports/emu_wuguang_optimal.csv`` by ``pymoo_rail.problems.reference.exact_points``
+and cached in ``reports/emu_wuguang_optimal.csv`` by ``pymoo_rail.optimal.reference.exact_points``
 (``--no-exact`` leaves it out). Its rows are read back only for the same case content, speed nodes
 and solver version (``pymoo_rail.optimal.solver.SOLVER_VERSION``); rows without that key (written
 before rows carried it) or of another key are solved again (13 solves at 800 nodes; the CSV's
@@ -134,7 +134,7 @@ def exact_front(path: Path, times_s=EXACT_TIMES_S, profile_path: Path | None = N
     ``profile_path``, the optimal run at the planned time is kept there as a trajectory table (fig. 12)."""
     from pymoo_rail.atomic import atomic_write_text
     from pymoo_rail.cases import load_case
-    from pymoo_rail.problems.reference import exact_points
+    from pymoo_rail.optimal.reference import exact_points
 
     case = load_case(CASE)
 

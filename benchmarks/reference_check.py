@@ -98,7 +98,7 @@ DERIVED = ("gap_rel", "below_reference")
 
 def with_derived_columns(table: pd.DataFrame) -> pd.DataFrame:
     """The stored table with ``gap_rel`` and ``below_reference`` as ``solved_energy_gap`` defines them."""
-    from pymoo_rail.optimal.gap import gap_columns
+    from pymoo_rail.optimal.reference import gap_columns
 
     gaps = gap_columns(table["gap_kwh"], table["optimal_kwh"], table["energy_bound_kwh"], table["in_range"])
     return table.assign(gap_rel=gaps["gap_rel"], below_reference=gaps["below_reference"])

@@ -64,7 +64,7 @@ def scores(results: pd.DataFrame) -> pd.DataFrame:
     against the front shipped now, even if a record was written against an earlier front version.
     """
     from pymoo_rail.experiments.metrics import hv_ratio
-    from pymoo_rail.problems.reference import certified_gap
+    from pymoo_rail.optimal.reference import certified_gap
     from pymoo_rail.experiments.metrics import front_indicators
     from pymoo_rail.suite import get_problem
 
@@ -193,7 +193,7 @@ def mean_ranks(results: pd.DataFrame, indicator: str, lower_better: bool) -> pd.
 
 def write_report(results: pd.DataFrame, study, out: Path, note: str) -> Path:
     from pymoo_rail.experiments.stats import rank_sum_tests, to_markdown
-    from pymoo_rail.problems.reference import FRONT_VERSION
+    from pymoo_rail.optimal.reference import FRONT_VERSION
 
     baseline = study.baseline
     lines = ["# Rail benchmark suite: five algorithms against certified optimal fronts", "",
@@ -256,7 +256,7 @@ def front_table() -> pd.DataFrame:
     """
     import time
 
-    from pymoo_rail.problems import reference
+    from pymoo_rail.optimal import reference
     from pymoo_rail.suite import get_problem, list_problems
 
     rows = []

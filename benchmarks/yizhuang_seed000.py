@@ -261,9 +261,9 @@ def reference_available() -> bool:
 
 def reference_front(case, tolerance_s: float, path: Path) -> dict:
     """Exact optimum (pymoo_rail.optimal) at running times around T_plan and over the MOABC range,
-    cached in ``path`` by ``pymoo_rail.problems.reference.exact_points`` (rows of another case content
+    cached in ``path`` by ``pymoo_rail.optimal.reference.exact_points`` (rows of another case content
     or solver version are solved again)."""
-    from pymoo_rail.problems.reference import exact_points
+    from pymoo_rail.optimal.reference import exact_points
 
     planned = case.planned_time_s
     near = np.round(np.arange(planned - tolerance_s - 0.5, planned + tolerance_s + 0.51, 0.25), 6)
