@@ -179,10 +179,14 @@ def map_node(nodes, x):
         return 0, 0.0
     if x >= nodes[n - 1]:
         return n - 2, 1.0
-    k = 0
-    while k < n - 2 and x >= nodes[k + 1]:
-        k += 1
-    return k, (x - nodes[k]) / (nodes[k + 1] - nodes[k])
+    lo, hi = 0, n - 1  # bisection: nodes[lo] <= x < nodes[hi] (maps from loss tables have ~100 nodes)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if x >= nodes[mid]:
+            lo = mid
+        else:
+            hi = mid
+    return lo, (x - nodes[lo]) / (nodes[lo + 1] - nodes[lo])
 
 
 @inlined

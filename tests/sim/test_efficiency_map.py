@@ -120,3 +120,15 @@ def test_problems_and_tracking_account_with_the_map():
     d, vm_kmh = np.diff(tr_x), 0.5 * (tr_v[1:] + tr_v[:-1]) * KMH_PER_MS
     tracked = np.where(tr_f > 0, tr_f * d / tmap.efficiency(vm_kmh, tr_f / 1000.0), 0.0).sum()
     assert with_map.summary["traction_kwh"] * J_PER_KWH == pytest.approx(tracked, rel=1e-9)
+
+
+def test_kernel_interpolation_is_the_models_inside_and_beyond_the_table():
+    from pymoo_rail.sim.physics import map_efficiency
+
+    tmap = EfficiencyMap(SPEEDS_KMH, FORCES_KN, VALUES)
+    speeds, forces, values = tmap.table_si()
+    rng = np.random.default_rng(11)
+    v_kmh, f_kn = rng.uniform(-10.0, 160.0, 200), rng.uniform(-400.0, 400.0, 200)
+    v_kmh[:4] = SPEEDS_KMH  # on the nodes too
+    kernel = [map_efficiency(speeds, forces, values, v / KMH_PER_MS, f * 1000.0) for v, f in zip(v_kmh, f_kn)]
+    assert np.allclose(kernel, tmap.efficiency(v_kmh, f_kn), rtol=1e-12, atol=0.0)
