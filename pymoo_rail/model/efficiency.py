@@ -127,3 +127,38 @@ def _cell(nodes: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     k = np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, len(nodes) - 2)
     t = np.clip((x - nodes[k]) / (nodes[k + 1] - nodes[k]), 0.0, 1.0)
     return k, t
+
+
+def maps_from_losses(speeds_kmh, forces_kn, traction_loss_w, braking_loss_w, aux_power_kw: float = 0.0,
+                     min_efficiency: float = 0.01) -> tuple[EfficiencyMap, EfficiencyMap, int]:
+    """Traction and regeneration maps of a source that gives power losses (W) at the operating point.
+
+    ``traction_loss_w[i][j]`` is the power lost (beyond the wheel power) when the train pulls with
+    ``forces_kn[j]`` at ``speeds_kmh[i]``, ``braking_loss_w[i][j]`` when it brakes electrically with
+    it; both include ``aux_power_kw`` (ms-eetc's convention), which the train model draws separately
+    (``Train.aux_power_kw``). Then ``eta_traction = F v / (F v + loss - aux)`` and ``eta_regen =
+    (F v - loss + aux) / (F v)``. Where braking loses more than the brake delivers (a regen
+    efficiency below ``min_efficiency``), the map holds ``min_efficiency``, and 1 where a loss is
+    below the auxiliary power: the number of such nodes is returned so that a caller can report it. Forces and speeds must be > 0 (no efficiency at rest).
+
+    Returns
+    -------
+    (traction map, regen map, nodes held at ``min_efficiency`` or 1)
+    """
+    v = np.asarray(speeds_kmh, dtype=float)[:, None] / KMH_PER_MS
+    f = np.asarray(forces_kn, dtype=float)[None, :] * 1000.0
+    if np.any(v <= 0.0) or np.any(f <= 0.0):
+        raise CaseError("speeds_kmh|forces_kn", (list(speeds_kmh), list(forces_kn)),
+                        "must all be > 0: an efficiency needs wheel power")
+    aux_w = aux_power_kw * 1000.0
+    wheel_w = f * v
+    traction = wheel_w / (wheel_w + np.asarray(traction_loss_w, dtype=float) - aux_w)
+    regen = (wheel_w - np.asarray(braking_loss_w, dtype=float) + aux_w) / wheel_w
+    raised = int(sum(np.count_nonzero((e < min_efficiency) | (e > 1.0)) for e in (traction, regen)))
+
+    def table(values: np.ndarray, field: str) -> EfficiencyMap:
+        values = np.clip(values, min_efficiency, 1.0)
+        return EfficiencyMap(tuple(float(s) for s in speeds_kmh), tuple(float(x) for x in forces_kn),
+                             tuple(tuple(float(x) for x in row) for row in values), field)
+
+    return table(traction, "train.traction_efficiency_map"), table(regen, "train.regen_efficiency_map"), raised

@@ -132,3 +132,17 @@ def test_kernel_interpolation_is_the_models_inside_and_beyond_the_table():
     v_kmh[:4] = SPEEDS_KMH  # on the nodes too
     kernel = [map_efficiency(speeds, forces, values, v / KMH_PER_MS, f * 1000.0) for v, f in zip(v_kmh, f_kn)]
     assert np.allclose(kernel, tmap.efficiency(v_kmh, f_kn), rtol=1e-12, atol=0.0)
+
+
+def test_energy_of_a_run_under_its_own_train_is_its_summary():
+    tmap = EfficiencyMap(SPEEDS_KMH, FORCES_KN, VALUES)
+    case = _with(make_case(train={"aux_power_kw": 50.0, "regen_efficiency": 0.8}), traction_efficiency=0.93,
+                 traction_efficiency_map=tmap)
+    sim = Simulator(case, dx_m=2.0)
+    run = sim.run(switching_programs([900.0], ("traction", "brake"), 2000.0)[0])
+    replayed = sim.energy_of(run)
+    for name in ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh"):
+        assert getattr(replayed, name) == pytest.approx(getattr(run.energy, name), rel=1e-12)
+    # under a constant-efficiency train the same run costs the work over that efficiency
+    plain = Simulator(_with(case, traction_efficiency=0.5, traction_efficiency_map=None), dx_m=2.0).energy_of(run)
+    assert plain.traction_kwh * J_PER_KWH == pytest.approx(run.summary["traction_work_j"] / 0.5, rel=1e-12)
