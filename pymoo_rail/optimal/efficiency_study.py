@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case, EfficiencyMap
 from pymoo_rail.optimal.solver import OptimalSolver
 from pymoo_rail.sim import Simulator
@@ -83,3 +83,27 @@ def planned_runs(models: dict[str, Case], running_time_s: float, costed_under: s
                      f"{costed_under}_regen_kwh": real.regen_kwh, f"{costed_under}_aux_kwh": real.aux_kwh,
                      "run": run})
     return rows
+
+
+def profile_energy_kwh(case: Case, position_m, speed_ms, time_s) -> float:
+    """Net energy (kWh) of a speed profile given at its own points (another solver's run) under the
+    case's train: the force of each interval from the change of kinetic energy, ``F = M (v1^2 -
+    v0^2) / (2 d) + R(v) + line force`` at its mean speed and its middle, drawn as ``F d / eta`` when
+    pulling and returned as ``eta |F| d`` when braking (all braking electric: the study's train has no
+    regen caps), plus the auxiliary power over the run's time."""
+    x, v, t = (np.asarray(a, dtype=float) for a in (position_m, speed_ms, time_s))
+    train = case.train
+    a, b, c = train.resistance.coefficients_si(train.mass_kg)
+    grid = Simulator(case).grid
+    d, v_mid, x_mid = np.diff(x), 0.5 * (v[1:] + v[:-1]), 0.5 * (x[1:] + x[:-1])
+    cell = np.minimum((x_mid / grid.dx_m).astype(int), grid.line_force_n.shape[0] - 1)
+    force = (train.effective_mass_kg * (v[1:] ** 2 - v[:-1] ** 2) / (2.0 * d) + a + b * v_mid + c * v_mid ** 2
+             + grid.line_force_n[cell])
+    speed_kmh, force_kn = v_mid * KMH_PER_MS, force / 1000.0
+    eta_t = (train.traction_efficiency_map.efficiency(speed_kmh, force_kn) if train.traction_efficiency_map
+             is not None else np.full(force.shape, train.traction_efficiency))
+    eta_r = (train.regen_efficiency_map.efficiency(speed_kmh, force_kn) if train.regen_efficiency_map
+             is not None else np.full(force.shape, train.regen_efficiency))
+    work = force * d
+    electric_j = np.where(force > 0.0, work / eta_t, eta_r * work).sum()
+    return float((electric_j + train.aux_power_kw * 1000.0 * (t[-1] - t[0])) / J_PER_KWH)
