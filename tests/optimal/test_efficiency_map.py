@@ -76,3 +76,19 @@ def test_the_optimum_under_the_map_beats_constant_plans_costed_under_the_map():
         costs[eta] = judge.energy_of(plan).net_kwh + shift
     assert mapped.energy.net_kwh < min(costs.values())
     assert abs(mapped.running_time_s - 330.0) < 1.0
+
+
+def test_a_profile_costed_from_its_points_is_the_simulators_energy():
+    from pymoo_rail.optimal.efficiency_study import profile_energy_kwh
+    from pymoo_rail.sim import switching_programs
+
+    falling = EfficiencyMap((0.0, 50.0, 100.0), (0.0, 50.0, 100.0),
+                            ((0.9, 0.8, 0.55), (0.92, 0.85, 0.6), (0.93, 0.86, 0.62)))
+    case = _mapped(level_case(aux_power_kw=40.0, regen_efficiency=0.8), falling)
+    run = Simulator(case, dx_m=1.0).run(switching_programs([1500.0, 3500.0], ("traction", "coast", "brake"),
+                                                           5000.0)[0])
+    # every 20th node: another solver's coarser points
+    pick = np.r_[np.arange(0, run.position_m.shape[0] - 1, 20), run.position_m.shape[0] - 1]
+    costed = profile_energy_kwh(case, run.position_m[pick], run.speed_ms[pick], run.time_s[pick])
+    assert costed == pytest.approx(run.energy.net_kwh, rel=2e-3)
+    assert costed != pytest.approx(run.energy.net_kwh - run.energy.aux_kwh, rel=2e-3)  # auxiliaries counted
