@@ -92,3 +92,17 @@ def test_a_profile_costed_from_its_points_is_the_simulators_energy():
     costed = profile_energy_kwh(case, run.position_m[pick], run.speed_ms[pick], run.time_s[pick])
     assert costed == pytest.approx(run.energy.net_kwh, rel=2e-3)
     assert costed != pytest.approx(run.energy.net_kwh - run.energy.aux_kwh, rel=2e-3)  # auxiliaries counted
+
+
+def test_regen_holding_condition_with_a_map():
+    # braking on a descent: g = -eta_r(v) |F|, so the condition is V^2 (R' (eta_r + 0) - |F| eta_r'(V))
+    regen = EfficiencyMap((0.0, V1_KMH), (0.0, 300.0), ((0.5, 0.5), (0.8, 0.8)))
+    case = replace(level_case(), train=replace(level_case().train, regen_efficiency=0.8, regen_efficiency_map=regen))
+    m = Simulator(case).model
+    slope = (0.8 - 0.5) / (V1_KMH / KMH_PER_MS)
+    line_n = -60_000.0  # a descent steeper than the resistance at these speeds: braking holds
+    for v in (10.0, 20.0):
+        r = m.davis_a_n + m.davis_b_nsm * v + m.davis_c_ns2m2 * v * v
+        r_prime, eta = m.davis_b_nsm + 2 * m.davis_c_ns2m2 * v, 0.5 + slope * v
+        expected = v * v * (r_prime * eta - abs(r + line_n) * slope)
+        assert hold_stationarity(m, v, line_n, True) == pytest.approx(expected, rel=1e-6)
