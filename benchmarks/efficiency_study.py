@@ -115,6 +115,11 @@ def findings(table: pd.DataFrame) -> list[str]:
             f"- Perfect and static efficiency: pymoo-rail's energy under its own model is within "
             f"{fixed['own_diff_pct'].abs().max():.2f} % of ms-eetc's (largest |own_diff_pct|), the discretisation"
             " differences of `benchmarks/reports/peers.md` (ms-eetc at N = 300 vs N = 1000).",
+            f"- Costed under the dynamic model, those plans differ by {fixed['dynamic_diff_pct'].min():+.2f} to"
+            f" {fixed['dynamic_diff_pct'].max():+.2f} %: plans of (nearly) equal energy under a constant efficiency"
+            " are not equal under losses; with efficiency 1 both ways, where the train accelerates and brakes back"
+            " costs nothing, so the perfect plans are the most apart (ms-eetc's and pymoo-rail's place the last"
+            " acceleration differently).",
             f"- The dynamic model is reproduced: ms-eetc's own optimal run costed by pymoo-rail's maps differs from"
             f" ms-eetc's figure by {faithful.min():+.2f} to {faithful.max():+.2f} % (the motor's no-load losses while"
             " coasting, which an efficiency cannot hold, and bilinear against B-spline interpolation).",
