@@ -1,7 +1,7 @@
 """A CSV file of computed rows, each stamped with the key of what computed it.
 
 The on-disk caches of expensive runs outside the study store (the exact solver's points,
-:func:`pymoo_rail.problems.reference.exact_points`; the section fronts of a journey,
+:func:`pymoo_rail.optimal.reference.exact_points`; the section fronts of a journey,
 :func:`pymoo_rail.journeys.section_fronts`) keep their rows in one CSV file. A row is served
 only to a caller asking with the same key: the fields of the key (the case's content hash, the
 version of the code that computed it, the settings) are written as columns, followed by a last

@@ -20,7 +20,7 @@ import pandas as pd
 
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.optimal import OptimalSolver, ReferenceAtTime, solved_energy_gap
-from pymoo_rail.optimal.gap import gap_columns
+from pymoo_rail.optimal.reference import gap_columns
 
 GAP_COLUMNS = ("optimal_kwh", "gap_kwh", "gap_rel", "energy_bound_kwh", "below_reference", "in_range")
 DERIVED = ("gap_rel", "below_reference")  # rebuilt from the others when a stored table is read

@@ -14,6 +14,7 @@ import argparse
 import math
 import numbers
 import os
+import string
 from pathlib import Path
 from typing import Callable, Iterable, Mapping, Sequence
 
@@ -239,6 +240,42 @@ def markdown(table, digits: int = 4, missing: str | None = None) -> str:
 
     return markdown_rows(list(table.columns), ([cell(v) for v in row]
                                                for row in table.astype(object).itertuples(index=False)))
+
+
+# ------------------------------------------------------------------------------------ templates
+def fill_template(template: str | Path, values: Mapping[str, object]) -> str:
+    """A report's text: its markdown template with every ``${name}`` replaced by ``str(values[name])``.
+
+    A report's prose is written by hand in markdown (``benchmarks/templates/<report>.md``); the
+    script computes only the numbers and tables it names. ``$$`` writes a literal ``$``.
+
+    Parameters
+    ----------
+    template : str or pathlib.Path
+        The template file.
+    values : mapping
+        The value of each placeholder.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    KeyError
+        A placeholder has no value (the message names the template and the placeholder).
+    ValueError
+        A value names no placeholder of the template (a typo on one side or the other).
+    """
+    text = string.Template(Path(template).read_text(encoding="utf-8"))
+    names = {m.group("named") or m.group("braced") for m in text.pattern.finditer(text.template)} - {None}
+    missing = sorted(names - set(values))
+    if missing:
+        raise KeyError(f"template {template}: no value for {', '.join('${' + n + '}' for n in missing)}")
+    unused = sorted(set(values) - names)
+    if unused:
+        raise ValueError(f"template {template}: no placeholder for the value(s) {', '.join(unused)}")
+    return text.substitute({k: str(v) for k, v in values.items()})
 
 
 # ------------------------------------------------------------------------------------ files

@@ -50,3 +50,16 @@ def test_require_runs_names_the_missing_record(tmp_path):
         require_runs(pd.DataFrame({"run_id": [first.run_id]}), study, tmp_path)
     with pytest.raises(FileNotFoundError, match="2 of the 2 runs"):
         require_runs(pd.DataFrame(), study, tmp_path)
+
+def test_fill_template_fills_every_placeholder_and_names_what_is_missing_or_unused(tmp_path):
+    import pytest
+
+    from pymoo_rail.experiments.report import fill_template
+
+    template = tmp_path / "r.md"
+    template.write_text("# ${title}\n\n${table} costs $$5, ${n} runs\n")
+    assert fill_template(template, {"title": "T", "table": "| a |", "n": 3}) == "# T\n\n| a | costs $5, 3 runs\n"
+    with pytest.raises(KeyError, match=r"no value for \$\{n\}"):
+        fill_template(template, {"title": "T", "table": ""})
+    with pytest.raises(ValueError, match="no placeholder for the value.s. runs"):
+        fill_template(template, {"title": "T", "table": "", "n": 1, "runs": 2})

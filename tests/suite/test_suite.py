@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from pymoo.util.nds.non_dominated_sorting import find_non_dominated
 
-from pymoo_rail.problems import reference as ref
+from pymoo_rail.optimal import reference as ref
+from pymoo_rail.optimal.reference import store
 from pymoo_rail.suite import CASES, NoExactFrontError, best_known_front, get_problem, list_problems
 from pymoo_rail.suite.problems import tolerance_s
 from pymoo_rail.suite.sanity import nsga2_against_random
@@ -45,7 +46,7 @@ def test_pareto_front_is_read_not_solved(monkeypatch):
     def no_solver(*args, **kwargs):
         raise AssertionError("the solver ran although the front is shipped")
 
-    monkeypatch.setattr(ref, "compute_front", no_solver)
+    monkeypatch.setattr(store, "compute_front", no_solver)
     ref.forget_fronts()
     problem = get_problem("metro-a-bi")
     pf = problem.pareto_front()
