@@ -69,8 +69,7 @@ FIGURES = (
     Figures("closed_loop_study", ("closed_loop_study.png",), "out/closed_loop_study"),
     Figures("journeys", ("journeys.png",)),
     Figures("optimal", ("optimal_front.png", "optimal_profile.png")),
-    Figures("tracking_metro_a", ("tracking_metro_a.png",)),
-    Figures("tracking_yizhuang", ("tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png")),
+    Figures("tracking", ("tracking_metro_a.png", "tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png")),
 )
 
 
