@@ -5,7 +5,7 @@ Two studies of ``pymoo_rail.experiments.run_study`` (one record per run, resumab
 ``encodings`` (three encodings, a few seeds, a smaller budget: it chooses the encoding) and ``main``
 (population 200, 60,000 evaluations, ``--seeds`` seeds, on speed codes and switching points). The
 exact front at 13 running times is cached in ``reports/emu_wuguang_optimal.csv`` by
-``pymoo_rail.problems.reference.exact_points`` (``--no-exact`` leaves it out). Every member of every
+``pymoo_rail.optimal.reference.exact_points`` (``--no-exact`` leaves it out). Every member of every
 front is re-simulated and checked (``pymoo_rail.experiments.verify``). The report's text is
 ``benchmarks/templates/emu_wuguang.md``; the hand-written discussion is ``reports/emu_wuguang_notes.md``.
 
@@ -35,7 +35,7 @@ from pymoo_rail.experiments.report import fill_template, markdown_rows, mean_std
 from pymoo_rail.experiments.verify import check_members, worst_checks
 from pymoo_rail.indicators.energy import energy_gap
 from pymoo_rail.problems import SpeedProfileProblem
-from pymoo_rail.problems.reference import exact_points
+from pymoo_rail.optimal.reference import exact_points
 
 ROOT = Path(__file__).resolve().parents[1]
 TEMPLATE = ROOT / "benchmarks" / "templates" / "emu_wuguang.md"

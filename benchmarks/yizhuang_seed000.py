@@ -31,11 +31,11 @@ from pymoo_rail.experiments.report import fill_template, fixed, lower_priority, 
 from pymoo_rail.experiments.stats import nondominated, rank_sum
 from pymoo_rail.optimal import optimal_profile
 from pymoo_rail.optimal.baselines import strategy_baselines
-from pymoo_rail.optimal.gap import solved_energy_gap
+from pymoo_rail.optimal.reference.gap import solved_energy_gap
 from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
 from pymoo_rail.plotting.style import new_figure
 from pymoo_rail.problems import SpeedProfileProblem
-from pymoo_rail.problems.reference import exact_points
+from pymoo_rail.optimal.reference import exact_points
 
 HERE = Path(__file__).resolve().parent
 CASE, POP, LIMIT, ARCHIVE = "yizhuang", 40, 50, 100  # colony 20 + 20, limit and cycles: seed 5.2; archive: ours

@@ -60,7 +60,7 @@ def true_front_and_reason(problem) -> tuple[np.ndarray | None, str]:
             pf = problem.pareto_front(n_pareto_points=1000, use_cache=False)
         except TypeError:  # a front without a size argument
             pf = problem.pareto_front()
-    except NotImplementedError as err:  # no known front (pymoo_rail.problems.reference.NoExactFrontError)
+    except NotImplementedError as err:  # no known front (pymoo_rail.optimal.reference.NoExactFrontError)
         return None, f"no true front: {err}" if str(err) else "no true front: the problem knows none"
     if pf is None:
         return None, f"no true front: {type(problem).__name__} knows none"

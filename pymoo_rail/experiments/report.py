@@ -125,6 +125,32 @@ def report_runs(results, run_row: Callable[[Mapping], dict], columns: Sequence[s
     return table[list(columns)], {}, False
 
 
+def require_runs(results, study, work_dir: str | Path) -> None:
+    """Refuse a report whose study has runs without a stored record (instead of writing an empty one).
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        The stored runs (:func:`pymoo_rail.experiments.load_results`), with their ``run_id``.
+    study : pymoo_rail.experiments.Study
+        The study the report is written from.
+    work_dir : str or pathlib.Path
+        Where the records were read from (named in the message).
+
+    Raises
+    ------
+    FileNotFoundError
+        Some run of ``study`` has no record; the message names the first ones (problem / algorithm
+        / seed) and how many are missing.
+    """
+    stored = set(results["run_id"]) if "run_id" in getattr(results, "columns", ()) else set()
+    missing = [run for run in study.runs() if run.run_id not in stored]
+    if missing:
+        named = ", ".join(f"{r.problem.display} / {r.algorithm.display} / seed {r.seed}" for r in missing[:3])
+        raise FileNotFoundError(f"{work_dir}: no stored record of {len(missing)} of the {len(study.runs())} runs of "
+                                f"study {study.name!r} (e.g. {named}): run the study first (without --report-only)")
+
+
 # ------------------------------------------------------------------------------------ numbers
 def _missing(value) -> bool:
     """None, or a number that is not finite (NaN, +-inf)."""

@@ -7,7 +7,7 @@
 See ``docs/suite.md`` for the problems, how their fronts were computed and how exact they are.
 """
 
-from pymoo_rail.problems.reference import CertifiedFront, NoExactFrontError
+from pymoo_rail.optimal.reference import CertifiedFront, NoExactFrontError
 from pymoo_rail.suite.fronts_io import best_known_front, compute_best_known_front, verify
 from pymoo_rail.suite.problems import (
     CASES,

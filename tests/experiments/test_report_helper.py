@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from pymoo_rail.experiments.report import fixed, markdown, markdown_rows, mean_std, significant, write_report
 
@@ -49,3 +50,17 @@ def test_fill_template_fills_every_placeholder_and_names_what_is_missing_or_unus
         fill_template(template, {"title": "T", "table": ""})
     with pytest.raises(ValueError, match="no placeholder for the value.s. runs"):
         fill_template(template, {"title": "T", "table": "", "n": 1, "runs": 2})
+
+
+def test_require_runs_names_the_missing_record(tmp_path):
+    from pymoo_rail.experiments import Study, algorithm, problem
+    from pymoo_rail.experiments.report import require_runs
+
+    study = Study("s", problems=[problem("zdt1")], algorithms=[algorithm("nsga2", pop_size=10)], seeds=2,
+                  budget={"n_gen": 2})
+    first, second = study.runs()
+    require_runs(pd.DataFrame({"run_id": [first.run_id, second.run_id]}), study, tmp_path)  # all there
+    with pytest.raises(FileNotFoundError, match=r"1 of the 2 runs of study 's' \(e.g. zdt1 / nsga2 / seed 2\)"):
+        require_runs(pd.DataFrame({"run_id": [first.run_id]}), study, tmp_path)
+    with pytest.raises(FileNotFoundError, match="2 of the 2 runs"):
+        require_runs(pd.DataFrame(), study, tmp_path)
