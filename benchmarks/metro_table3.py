@@ -159,7 +159,8 @@ def write_report_files(out: Path, table3, weights) -> None:
         "paper_wheel_kwh": f"{replays[(next(iter(lengths)), False)].energy.net_kwh:.2f}",
         "grid_wheel_kwh": f"{replays[('grid optimum', False)].energy.net_kwh:.2f}",
         "comfort_scale": f"{problem.scales[1]:.3f}", "weight_rows": weight_table}
-    write_report(out / "metro_table3.md", [fill_template(ROOT / "benchmarks" / "templates" / "metro_table3.md", values)])
+    write_report(out / "metro_table3.md", [fill_template(ROOT / "benchmarks" / "templates" / "metro_table3.md", values)],
+                 newline=False)
     table3_figure(lengths, problem, replays[("grid optimum", False)], out / "metro_table3.png")
     pd.DataFrame([{"study": study, "problem": r["problem"], "seed": r["seed"], "f": f"{r['f']:.6f}",
                    **dict(zip(("traction_m", "cruise_m", "coast_m"), (f"{v:.3f}" for v in problem.lengths(r["X"])[0])))}
