@@ -1,19 +1,10 @@
-"""Golden-ratio NSGA-II vs NSGA-II on the CRH3 EMU run of Tang et al. (2020), section 4.2 (figs. 10-12,
-tables 4 and 5), at equal evaluation budgets, through the study runner, against the exact front.
+"""GR-NSGA-II vs NSGA-II on the CRH3 EMU run of Tang et al. (2020), 4.2, against the exact front.
 
-Two studies of ``pymoo_rail.experiments.run_study`` (one record per run, resumable, seed by seed):
-``encodings`` (three encodings, a few seeds, a smaller budget: it chooses the encoding) and ``main``
-(population 200, 60,000 evaluations, ``--seeds`` seeds, on speed codes and switching points). The
-exact front at 13 running times is cached in ``reports/emu_wuguang_optimal.csv`` by
-``pymoo_rail.optimal.reference.exact_points`` (``--no-exact`` leaves it out). Every member of every
-front is re-simulated and checked (``pymoo_rail.experiments.verify``). The report's text is
-``benchmarks/templates/emu_wuguang.md``; the hand-written discussion is ``reports/emu_wuguang_notes.md``.
+Two studies (``encodings``: the choice of encoding; ``main``: 60,000 evaluations, ``--seeds`` seeds),
+the cached exact front, and a check of every front member (``pymoo_rail.experiments.verify``). Text:
+``benchmarks/templates/emu_wuguang.md`` and the hand-written ``reports/emu_wuguang_notes.md``.
 
-Usage::
-
-    nice -n 10 python benchmarks/emu_wuguang.py                   # both studies, then the report
-    nice -n 10 python benchmarks/emu_wuguang.py --seeds 5 --budget 30000
-    python benchmarks/emu_wuguang.py --report-only                # re-analyse stored runs
+Usage: ``nice -n 10 python benchmarks/emu_wuguang.py [--seeds 10] [--budget 60000] [--report-only]``
 """
 
 from __future__ import annotations
@@ -28,13 +19,12 @@ import pandas as pd
 
 from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.cases import load_case
-from pymoo_rail.experiments import (Study, algorithm, choose_member, load_results, problem, run_study, stats,
-                                    tang2020_nsga2)
+from pymoo_rail.experiments import (Study, algorithm, build_problem, choose_member, load_results, problem, run_study,
+                                    stats, tang2020_nsga2)
 from pymoo_rail.experiments.metrics import gd_van_veldhuizen
 from pymoo_rail.experiments.report import fill_template, markdown_rows, mean_std, significant, write_report
-from pymoo_rail.experiments.verify import check_members, worst_checks
+from pymoo_rail.experiments.verify import check_members, check_rows, worst_checks
 from pymoo_rail.indicators.energy import energy_gap
-from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.optimal.reference import exact_points
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -75,12 +65,6 @@ def make_study(name: str, encodings, seeds, budget: int, pop_size: int = POP_SIZ
     algorithms = [tang2020_nsga2(label=NSGA2_LABEL, pop_size=pop_size),
                   algorithm("grnsga2", label=GR_LABEL, pop_size=pop_size, local_size=local_size, pc_max=0.9, pm_max=0.1)]
     return Study(name, problems, algorithms, seeds=list(seeds), budget={"n_eval": int(budget)}, baseline=NSGA2_LABEL)
-
-
-def build_problems() -> dict:
-    case = load_case(CASE)
-    return {e: SpeedProfileProblem(case, objectives=OBJECTIVES, time_tolerance_s=case.time_margin_s, **kw)
-            for e, kw in ENCODINGS.items()}
 
 
 def exact_front(path: Path, profile_path: Path):
@@ -250,20 +234,6 @@ def exact_table(ex) -> str:
                            f"{r.solve_s:.0f}"] for r in ex.itertuples()])
 
 
-def verification_table(ver: dict) -> str:
-    """Section 6: the worst value of each check over every member."""
-    checks = [("neutral traction work (J)", "neutral_traction_j_max", "0", "neutral"),
-              ("largest force in a neutral section (N)", "neutral_force_n_max", "<= 0", "force"),
-              ("kernel limit excess (m/s)", "limit_excess_ms_max", "<= 0", "limit"),
-              ("independent limit excess over the train length (m/s)", "independent_excess_ms_max", "<= 0", "independent"),
-              ("stop error (m)", "stop_error_m_max", "<= 0.25", "stop"),
-              ("stored vs re-simulated energy (kWh)", "energy_mismatch_kwh", "0", "energy"),
-              ("stored vs re-simulated running time (s)", "time_mismatch_s", "0", "time")]
-    cells = [[name, significant(ver[key]), required, ver[f"{ok}_ok"]] for name, key, required, ok in checks]
-    cells.append(["neutral-section genes at their fixed value (10 km/h, coast)", "", "all members", ver["fixed_ok"]])
-    return markdown_rows(["check", "worst value over all members", "required", "result"], cells)
-
-
 def verdict_text(rows) -> str:
     """The measured verdict per encoding, from the rank-sum tests."""
     lines = []
@@ -355,10 +325,8 @@ def report_values(rows, enc_rows, chosen, problems, exact, args) -> dict:
         "n_fixed": int(main.encoding.fixed().sum()),
         "other_encodings": ", ".join(f"**{e}** ({problems[e].n_var} variables, {int(problems[e].encoding.fixed().sum())} "
                                      "fixed)" for e in encodings if e != MAIN_ENCODING),
-        "budget": f"{args.budget:,} evaluations per run for both algorithms (`(\"n_eval\", {args.budget})`{budget}); "
-                  f"population {args.pop_size}; seeds {', '.join(map(str, seeds))} ({len(seeds)} runs per algorithm "
-                  "and encoding, the same seeds for both). Evaluations actually used are in table 4 (pymoo stops "
-                  "after the generation that reaches the budget).",
+        "budget": f"{args.budget:,}", "budget_raw": args.budget, "budget_note": budget, "seeds": ", ".join(map(str, seeds)),
+        "n_seeds": len(seeds),
         "pop_size": args.pop_size, "local_size": args.local_size, "workers": args.workers,
         "exact_times": ", ".join(f"{t:g}" for t in exact["requested_time_s"]) + " s, cached in `emu_wuguang_optimal.csv` "
                        "(section 5)." if exact is not None else "(not computed).",
@@ -367,7 +335,8 @@ def report_values(rows, enc_rows, chosen, problems, exact, args) -> dict:
         "tests": "\n\n".join(tests_table(rows, e) for e in encodings), "table5": table5(encodings, chosen, rows, exact),
         "n_speeds": int(exact["n_speeds"].iloc[0]) if exact is not None else EXACT_N_SPEEDS,
         "exact_table": exact_table(exact), "n_members": ver["n_members"], "n_runs": ver["n_runs"],
-        "train_length_m": f"{case.train.length_m:g}", "verification_table": verification_table(ver),
+        "train_length_m": f"{case.train.length_m:g}", "verification_table": markdown_rows(["check", "worst value over all members", "required", "result"],
+                                            check_rows(ver, significant)),
         "all_ok": "yes" if ver["all_ok"] else "NO",
         "verdict": (verdict_text(rows) + "\n\n" + discussion.strip()).strip()}, ver
 
@@ -404,7 +373,7 @@ def main(argv=None) -> int:
     args.work.mkdir(parents=True, exist_ok=True)
     exact = None if args.no_exact else exact_front(args.out / "emu_wuguang_optimal.csv", args.work / "optimal_profile.csv")
     exact_profile = None if args.no_exact else pd.read_csv(args.work / "optimal_profile.csv")
-    problems = build_problems()
+    problems = {p.display: build_problem(p) for p in make_study("all", ENCODINGS, [1], 1).problems}
     main_results, rows = analyse(results["main"], problems, exact)
     enc_rows = analyse(results["encodings"], problems, exact)[1] if len(results.get("encodings", ())) else []
     chosen = punctual_choices(main_results, rows, problems)

@@ -1,17 +1,8 @@
-"""A fair PID vs adaptive fuzzy PID study on metro-a (Meng et al. 2017, sections 3.4-3.5, fig. 9).
+"""PID vs adaptive fuzzy PID on metro-a, tuned fairly (Meng et al. 2017, 3.4-3.5, fig. 9): both families
+tuned by DE with the same budget (study ``metro-controllers``), then compared on held-out disturbed
+trains with a rank-sum test. Text: ``benchmarks/templates/metro_controllers.md``.
 
-1. Tuning (study ``metro-controllers`` of ``pymoo_rail.experiments.run_study``): the gains of each
-   family are tuned by pymoo's DE with the same budget (``--budget`` evaluations) and objective, the
-   mean rms tracking error over 8 disturbed trains (``problems.controller_tuning``).
-2. Held-out comparison: the best-tuned controller of each family and the untuned defaults track the
-   table-3 reference on ``--test`` other disturbed trains (``draw_disturbances(n, seed=1000)``), with a
-   rank-sum test of tuned fuzzy PID against tuned PID. 3. Fig. 9 on the first held-out train.
-
-The report's text is ``benchmarks/templates/metro_controllers.md``.
-
-Usage::
-
-    nice -n 10 python benchmarks/metro_controllers.py [--budget 400] [--tuning-seeds 3] [--test 20]
+Usage: ``nice -n 10 python benchmarks/metro_controllers.py [--budget 400] [--tuning-seeds 3] [--test 20]``
 """
 
 from __future__ import annotations

@@ -1,15 +1,8 @@
-"""Table 3 and the weight sensitivity of Meng et al. (2017), through the study runner.
+"""Table 3 and the weight sensitivity of Meng et al. (2017): the study files ``examples/metro_table3.toml``
+and ``examples/metro_weights.toml`` through ``run_study``, the grid optimum, the phases on the simulator.
 
-Two study files run by ``pymoo_rail.experiments.run_study`` (one record per run, resumable):
-``examples/metro_table3.toml`` (the paper's weighted GA on ``KinematicPhasesProblem`` of metro-a,
-30 seeds) and ``examples/metro_weights.toml`` (the same GA under eight weight vectors). The report
-compares table 3 with the best and median run, the 1 m grid optimum and the paper's lengths in its
-own model, and replays the phases on the simulator. Its text is ``benchmarks/templates/metro_table3.md``.
-
-Usage::
-
-    nice -n 10 python benchmarks/metro_table3.py                 # both studies, then the report
-    python benchmarks/metro_table3.py --report-only
+Text: ``benchmarks/templates/metro_table3.md``.
+Usage: ``nice -n 10 python benchmarks/metro_table3.py [--seeds N] [--report-only]``
 """
 
 from __future__ import annotations

@@ -1,18 +1,9 @@
-"""Tracking controllers following recommended curves: hysteresis on yizhuang (Zhou's thesis, table 5-7)
-and PID against adaptive fuzzy PID on metro-a (Meng et al. 2017, sections 3.4-3.5, figs. 8-10).
+"""Tracking controllers on recommended curves (``pymoo_rail.control.compare_tracking``): ``yizhuang``,
+hysteresis on the hold, DE-ideal and DE-tracked curves (Liu (2019), table 5-7); ``metro-a``, PID
+against fuzzy PID on the paper's phases and a DE curve, nominal and 15 % heavier train (Meng et al.
+(2017), 3.4-3.5). Text: ``benchmarks/templates/tracking_<case>.md``.
 
-``yizhuang``: three curves (``hold``: one speed code running in 150 s; ``DE ideal`` and ``DE tracked``:
-pymoo's DE on min energy with |T - 150 s| <= 0.5 s, scored on the ideal run or on the run tracked
-with A = 2, B = 3 km/h), each tracked by ``Hysteresis(2, B)``, B = 3 ... 6 km/h. ``metro-a``: the
-paper's phases and a DE curve, tracked by ``PID`` and ``FuzzyPID`` with the same base gains, at 0.2 s
-and 1 s, by the nominal train and one 15 % heavier. The DE runs go through
-``pymoo_rail.experiments.run_study``; the comparison is ``pymoo_rail.control.compare_tracking``. The
-reports' text is ``benchmarks/templates/tracking_<case>.md``.
-
-Usage::
-
-    nice -n 10 python benchmarks/tracking.py yizhuang [--gens 200] [--seeds 1 2 3] [--period 0.2]
-    nice -n 10 python benchmarks/tracking.py metro-a [--gens 150]
+Usage: ``nice -n 10 python benchmarks/tracking.py {yizhuang,metro-a} [--gens N] [--seeds 1 2 3]``
 """
 
 from __future__ import annotations
