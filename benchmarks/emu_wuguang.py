@@ -68,7 +68,7 @@ def make_study(name: str, encodings, seeds, budget: int, pop_size: int = POP_SIZ
 
 
 def exact_front(path: Path, profile_path: Path):
-    """The exact front at :data:`EXACT_TIMES_S` cached in ``path``; the optimal run at the planned time in ``profile_path``."""
+    """The exact front at :data:`EXACT_TIMES_S` cached in ``path``; the optimum at the planned time in ``profile_path``."""
     case = load_case(CASE)
 
     def keep_profile(t, traj):
@@ -135,21 +135,14 @@ def pair(rows, enc: str, key: str):
 
 
 def rank_sum(rows, enc: str, key: str, lower_better: bool):
-    """(p, verdict, difference) of GR-NSGA-II against NSGA-II: relative, or in points for ``*_pct``."""
-    sides = pair(rows, enc, key) or ([], [])
-    base, gr = (np.asarray([v for v in side if np.isfinite(v)], dtype=float) for side in sides)
+    """(p, verdict, difference of the means) of GR-NSGA-II against NSGA-II: in %, or in points for ``*_pct``."""
+    base, gr = (np.asarray([v for v in side if np.isfinite(v)], dtype=float) for side in pair(rows, enc, key) or ([], []))
     if len(gr) < 2 or len(base) < 2:
-        return np.nan, "", np.nan
+        return np.nan, "", ""
     _, p, verdict = stats.rank_sum(gr, base, lower_better=lower_better)
     if key.endswith("_pct"):
-        return p, verdict, gr.mean() - base.mean()
-    return p, verdict, (gr.mean() - base.mean()) / abs(base.mean()) if base.mean() != 0 else np.nan
-
-
-def difference(key: str, value: float) -> str:
-    if not np.isfinite(value):
-        return ""
-    return f"{value:+.3f} points" if key.endswith("_pct") else f"{100 * value:+.3f} %"
+        return p, verdict, f"{gr.mean() - base.mean():+.3f} points"
+    return p, verdict, f"{100 * ((gr.mean() - base.mean()) / abs(base.mean())):+.3f} %" if base.mean() != 0 else ""
 
 
 def median_run(rows, enc: str, alg: str) -> dict:
@@ -199,7 +192,7 @@ def tests_table(rows, enc: str) -> str:
     for key, lower in TESTED:
         if (p := pair(rows, enc, key)) is not None:
             pval, verdict, rel = rank_sum(rows, enc, key, lower)
-            cells.append([key, "lower" if lower else "higher", mean_std(p[0]), mean_std(p[1]), difference(key, rel),
+            cells.append([key, "lower" if lower else "higher", mean_std(p[0]), mean_std(p[1]), rel,
                           significant(pval, 3), verdict])
     return f"**{enc}**\n\n" + markdown_rows(["indicator", "better", NSGA2_LABEL, GR_LABEL, "GR vs NSGA-II (means)", "p",
                                              "verdict"], cells)
@@ -246,7 +239,7 @@ def verdict_text(rows) -> str:
                 p, verdict, rel = rank_sum(rows, enc, key, lower)
                 word = {"+": "better (significant)", "-": "worse (significant)",
                         "=": "not significantly different"}.get(verdict, "untested")
-                parts.append(f"{name}: GR-NSGA-II {word}, means differ by {difference(key, rel)} (p = {significant(p, 3)})")
+                parts.append(f"{name}: GR-NSGA-II {word}, means differ by {rel} (p = {significant(p, 3)})")
         lines.append(f"- Measured on {enc}: " + "; ".join(parts) + ".")
     return "\n".join(lines)
 
@@ -271,7 +264,8 @@ def front_figures(results, chosen: dict, planned: float, exact, out: Path) -> No
         ax.axhline(planned, color="0.5", lw=0.8, ls=":")
     save_figure(fig, out / "emu_wuguang_fronts.png")
     fronts = {f"{alg}, {enc} (seed {c['seed']})": c["front"] for (enc, alg), c in chosen.items()}
-    for name, title in (("overlay", "median-HV run of each algorithm and encoding"), ("zoom", "near the planned time (1050 s)")):
+    for name, title in (("overlay", "median-HV run of each algorithm and encoding"),
+                        ("zoom", "near the planned time (1050 s)")):
         fig = plot_fronts(fronts, OBJECTIVES, reference=exact_F, reference_label=exact_label, title=title)
         near = np.vstack([F[np.abs(F[:, 1] - planned) <= 15] for F in fronts.values()])
         if name == "zoom" and len(near):  # the seed's fig. 12 only covers the neighbourhood of the planned time
@@ -335,7 +329,8 @@ def report_values(rows, enc_rows, chosen, problems, exact, args) -> dict:
         "tests": "\n\n".join(tests_table(rows, e) for e in encodings), "table5": table5(encodings, chosen, rows, exact),
         "n_speeds": int(exact["n_speeds"].iloc[0]) if exact is not None else EXACT_N_SPEEDS,
         "exact_table": exact_table(exact), "n_members": ver["n_members"], "n_runs": ver["n_runs"],
-        "train_length_m": f"{case.train.length_m:g}", "verification_table": markdown_rows(["check", "worst value over all members", "required", "result"],
+        "train_length_m": f"{case.train.length_m:g}",
+        "verification_table": markdown_rows(["check", "worst value over all members", "required", "result"],
                                             check_rows(ver, significant)),
         "all_ok": "yes" if ver["all_ok"] else "NO",
         "verdict": (verdict_text(rows) + "\n\n" + discussion.strip()).strip()}, ver
@@ -385,7 +380,8 @@ def main(argv=None) -> int:
     values, ver = report_values(rows, enc_rows, chosen, problems, exact, args)
     write_report(args.out / "emu_wuguang.md", [fill_template(TEMPLATE, values)], newline=False)
     print(values["verdict"])
-    print(f"verification of {ver['n_members']} members in {ver['n_runs']} runs:", "all pass" if ver["all_ok"] else "FAILURES")
+    print(f"verification of {ver['n_members']} members in {ver['n_runs']} runs:",
+          "all pass" if ver["all_ok"] else "FAILURES")
     return 0 if ver["all_ok"] else 1
 
 

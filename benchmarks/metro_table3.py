@@ -32,7 +32,7 @@ PAPER = {"traction_m": 262.37, "cruise_m": 169.15, "coast_m": 369.69, "brake_m":
          "energy_index_kwh": float("nan"), "f": float("nan"), "feasible": True}
 COLUMNS = ["traction_m", "cruise_m", "coast_m", "brake_m", "stop_m", "stop_error_m", "running_time_s", "time_error_s",
            "peak_kmh", "energy_index_kwh", "f", "feasible"]
-BRAKE_MS2 = 1.1
+BRAKE_MS2, COAST_END = 1.1, "1.1 m/s^2 from the coast's end"
 
 
 def quiet_problem(spec):
@@ -140,7 +140,7 @@ def write_report_files(out: Path, table3, weights) -> None:
         "n_seeds": len(fs), "f_best": f"{fs.min():.4f}", "f_median": f"{np.median(fs):.4f}", "f_worst": f"{fs.max():.4f}",
         "grid_f": f"{grid_f:.4f}", "cpu_median": f"{np.median([r['cpu_time_s'] for r in runs3]):.2f}",
         "replay_rows": "\n".join(
-            f"| {name.replace(' lengths', '')}, {'latest braking' if latest else '1.1 m/s^2 from the coast' + chr(39) + 's end'} "
+            f"| {name.replace(' lengths', '')}, {'latest braking' if latest else COAST_END} "
             f"| {tr.energy.net_kwh:.2f} | {tr.running_time_s:.2f} | {tr.position_m[-1]:.2f} | {tr.stop_error_m:.2f} | "
             f"{tr.speed_kmh.max():.2f} |" for (name, latest), tr in replays.items()),
         "paper_peak_kmh": f"{paper['peak_kmh']:.2f}", "paper_brake_m": f"{paper['brake_m']:.2f}",

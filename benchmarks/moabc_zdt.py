@@ -73,7 +73,8 @@ def problem_table(df, p: str) -> str:
                 if a != "NSGA2" and len(base) > 1 and len(g) > 1 else ""
             cells.append(f"{v.mean():.4g} | {v.median():.4g} | {v.std(ddof=1) if len(v) > 1 else 0:.2g} | {mark}")
         rows.append([a, len(g), f"{g.n_eval.mean():.0f}", *cells, f"{g.time_s.mean():.2f}"])
-    header = ["algorithm", "runs", "n_eval", *(c for i in INDICATORS for c in (f"{i} mean", f"{i} median", f"{i} std", "W")), "time s"]
+    header = ["algorithm", "runs", "n_eval", *(c for i in INDICATORS for c in (f"{i} mean", f"{i} median", f"{i} std", "W")),
+              "time s"]
     return f"## {p}\n\n" + markdown_rows(header, rows) + "\n"
 
 

@@ -100,11 +100,12 @@ def yizhuang_report(curves, table, runs, args) -> dict:
     return {"gens": args.gens, "seeds": " ".join(map(str, args.seeds)), "period": args.period,
             "curve_rows": "\n".join(f"| {n} | {how} | {r.energy.net_kwh:.3f} | {r.running_time_s:.2f} |"
                                     for n, (r, how) in curves.items()),
-            "table57_rows": "\n".join(f"| 2, {b:g} | {SEED_TABLE_5_7[b][0]:.2f} | {SEED_TABLE_5_7[b][1]:.2f} | " + " | ".join(
+            "table57_rows": "\n".join("| 2, {:g} | {:.2f} | {:.2f} | ".format(b, *SEED_TABLE_5_7[b]) + " | ".join(
                 f"{at[n, b].energy.net_kwh:.3f} | {at[n, b].running_time_s:.2f}" for n in curves) + " |" for b in B_VALUES),
             "run_rows": "\n".join(f"| {r.reference} | {r.period_s:g} | {r.b_kmh:g} | {r.energy_kwh:.3f} | "
                                   f"{r.running_time_s:.2f} | {r.stop_error_m:.3f} | {r.jerk_ms2:.2f} | {r.regime_changes} | "
-                                  f"{r.speed_error_rms_kmh:.2f} | {r.speed_error_max_kmh:.2f} |" for r in table.itertuples())}
+                                  f"{r.speed_error_rms_kmh:.2f} | {r.speed_error_max_kmh:.2f} |"
+                                  for r in table.itertuples())}
 
 
 def metro_report(curves, table, runs, args) -> dict:

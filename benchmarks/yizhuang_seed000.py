@@ -176,8 +176,8 @@ def report_values(case, ch, base, ref, gaps, tight, args, reports: Path) -> dict
         "tolerance_s": f"{args.tolerance:g}", "n_equal": ", ".join(map(str, args.n_equal)),
         "flat_kwh": f"{fo['energy_kwh']:.2f}", "flat_s": f"{fo['running_time_s']:.2f}",
         "flat_early_s": f"{planned - fo['running_time_s']:.1f}", "cruise_code": f"{cr['code_kmh']:.2f}",
-        "cruise_kwh": f"{cr['energy_kwh']:.2f}", "cruise_s": f"{cr['running_time_s']:.2f}", "coast_m": f"{co['coast_m']:.0f}",
-        "coast_kwh": f"{co['energy_kwh']:.2f}", "coast_s": f"{co['running_time_s']:.2f}",
+        "cruise_kwh": f"{cr['energy_kwh']:.2f}", "cruise_s": f"{cr['running_time_s']:.2f}",
+        "coast_m": f"{co['coast_m']:.0f}", "coast_kwh": f"{co['energy_kwh']:.2f}", "coast_s": f"{co['running_time_s']:.2f}",
         "table55": summary_table(summ[summ["partition"] == NON_EQUAL], seed_55),
         "p55": ranksum(ch, ("ABC", NON_EQUAL), ("MOABC", NON_EQUAL)), "table56": summary_table(summ, seed_56),
         "partition_tests": "\n".join(f"* {alg}: non-equal vs equal-{n}, rank-sum p = "
