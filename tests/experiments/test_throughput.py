@@ -49,3 +49,4 @@ def test_kernel_and_rate_tables_have_the_printed_columns():
     assert list(rates.columns) == ["case", "pop", "evals_per_s", "Mcells_per_s"]
     scaling = tp.scaling_table(1, populations=(2,))
     assert {"wall 1/2", "cpu 2/1", "expected", "balance", "serial ms"} <= set(scaling.columns)
+
