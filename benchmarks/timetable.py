@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from pymoo_rail.cases import load_case
-from pymoo_rail.experiments import load_results, run_study
-from pymoo_rail.experiments.report import add_study_options, fill_template, lower_priority, require_runs, write_report
+from pymoo_rail.experiments.report import add_study_options, fill_template, lower_priority, write_report
+from pymoo_rail.experiments.script import study_results
 from pymoo_rail.experiments.study_file import read_study
 from pymoo_rail.problems import TimetableProblem
 
@@ -48,13 +48,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     lower_priority()
     study = read_study(ROOT.parent / "examples" / "timetable.toml")
-    if not args.report_only:
-        run_study(study, args.work, workers=args.workers, seed_major=True)
-    results = load_results(args.work, study)
-    try:
-        require_runs(results, study, args.work)
-    except FileNotFoundError as error:
-        raise SystemExit(str(error)) from None
+    results = study_results(study, args, seed_major=True)
     # each train exactly optimal alone on the study's grid, in its own direction (the other way climbs
     # where this one descends)
     dx_m = float(results["problem_spec"].iloc[0].get("dx_m", 1.0))
