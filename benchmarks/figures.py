@@ -46,6 +46,7 @@ FIGURES = (
     Figures("closed_loop_study", ("closed_loop_study.png",), "out/closed_loop_study"),
     Figures("journeys", ("journeys.png",)),
     Figures("optimal", ("optimal_front.png", "optimal_profile.png")),
+    Figures("efficiency_study", ("efficiency_study.png",)),  # written where --figure says
     Figures("tracking", ("tracking_metro_a.png", "tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png")),
 )
 
