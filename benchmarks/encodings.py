@@ -35,7 +35,7 @@ import numpy as np
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments import Study, algorithm, load_records, problem, run_study
 from pymoo_rail.experiments.encodings import de_budget_row, de_encodings, front_row
-from pymoo_rail.experiments.report import add_study_options, fill_template, markdown_rows, write_report
+from pymoo_rail.experiments.report import add_study_options, markdown_rows, write_filled
 from pymoo_rail.optimal import min_running_time, optimal_front
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -62,10 +62,8 @@ def cli_job(args) -> None:
                f"{np.median([r[3] for r in mine]):.0f}, median chosen gap {np.median([r[6] for r in mine]):.2f} %, "
                f"median mean gap {np.nanmedian([r[7] for r in mine]):.2f} %"
                for enc in CLI_ENCODINGS for mine in [[r for r in rows if r[0] == enc]]]
-    text = fill_template(TEMPLATES / "default_encoding.md", {"case": args.case, "seeds": args.seeds, "table": table,
-                                                               "medians": "\n".join(medians)})
-    write_report(args.out / "default_encoding.md", [text], newline=False)
-    print(text, end="")
+    print(write_filled(args.out / "default_encoding.md", TEMPLATES / "default_encoding.md", {
+        "case": args.case, "seeds": args.seeds, "table": table, "medians": "\n".join(medians)}), end="")
 
 
 def de_job(args) -> None:
@@ -82,9 +80,8 @@ def de_job(args) -> None:
                         f"{r['running_time_s']:.2f} |" + (f" {r['optimum_kwh']:.3f} | {r['certificate_kwh']:.3f} | "
                                                           f"{r['gap_pct']:.2f} |" if args.reference else ""))
             print(rows[-1], flush=True)
-    write_report(args.out / "problems.md", [fill_template(TEMPLATES / "problems.md", {
-        "evals": args.evals, "header": header, "rule": "|" + "---|" * (header.count("|") - 1),
-        "rows": "\n".join(rows)})], newline=False)
+    write_filled(args.out / "problems.md", TEMPLATES / "problems.md", {
+        "evals": args.evals, "header": header, "rule": "|" + "---|" * (header.count("|") - 1), "rows": "\n".join(rows)})
 
 
 def main(argv=None) -> None:

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -42,30 +43,17 @@ from tqdm import tqdm
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments.reference_audit import (DERIVED, certificate_parts, check_members, coverage_summary,
                                                      coverage_table, members_summary, with_derived_columns)
-from pymoo_rail.experiments.report import (committed_members, fill_template, lower_priority, markdown, member_cases,
-                                          write_report)
+from pymoo_rail.experiments.report import committed_members, lower_priority, markdown, member_cases, write_filled
 
 REPORTS = Path(__file__).resolve().parent / "reports"
 TEMPLATES = Path(__file__).resolve().parent / "templates"
+PROGRESS = partial(tqdm, desc="cases", unit="case")
 PARTS_VARIANTS = ({"n_speeds": 100}, {"n_speeds": 400}, {"n_speeds": 800}, {"tie_j": 0.0})
-
-
-def progress(items):
-    """A progress bar over the cases."""
-    return tqdm(items, desc="cases", unit="case")
-
-
-def chosen_members(limit: int | None):
-    """The committed members, or the first ``limit`` of each case (a quick run)."""
-    table = committed_members(REPORTS)
-    return table if limit is None else table.groupby("case", sort=False).head(limit)
 
 
 def show(path: Path, values: dict) -> None:
     """Fill the report's template (``benchmarks/templates/<name>``), write it and print it."""
-    text = fill_template(TEMPLATES / path.name, values)
-    write_report(path, [text], newline=False)
-    print(text)
+    print(write_filled(path, TEMPLATES / path.name, values))
 
 
 def members(args) -> int:
@@ -76,7 +64,7 @@ def members(args) -> int:
             raise SystemExit(f"--report-only: no {csv_path}; run without --report-only first")
         table = with_derived_columns(pd.read_csv(csv_path))
     else:
-        table = check_members(chosen_members(args.limit), member_cases(), progress=progress)
+        table = check_members(committed_members(REPORTS, args.limit), member_cases(), progress=PROGRESS)
         # 9 digits (1 mWh on 1000 kWh), far below any gap quoted; the derived columns are rebuilt on reading
         table.drop(columns=list(DERIVED)).to_csv(csv_path, index=False, float_format="%.9g")
     s = members_summary(table)
@@ -89,7 +77,7 @@ def members(args) -> int:
 def coverage(args) -> int:
     """The certificate against other grids at every member time; the number of misses."""
     start = time.process_time()
-    result = coverage_table(chosen_members(args.limit), member_cases(), progress=progress)
+    result = coverage_table(committed_members(REPORTS, args.limit), member_cases(), progress=PROGRESS)
     cpu = time.process_time() - start
     s, sentences = coverage_summary(result)
     misses = int(s["misses"].sum())

@@ -282,6 +282,13 @@ def fill_template(template: str | Path, values: Mapping[str, object]) -> str:
 
 
 # ------------------------------------------------------------------------------------ files
+def write_filled(path: str | Path, template: str | Path, values: Mapping[str, object]) -> str:
+    """Write the report ``path`` from its template (:func:`fill_template`), atomically; returns its text."""
+    text = fill_template(template, values)
+    atomic_write_text(path, text)
+    return text
+
+
 def write_report(path: str | Path, lines: Sequence[str], newline: bool = True) -> Path:
     """Write a report's lines (joined by newlines, one more at the end unless ``newline=False``), atomically.
 
@@ -294,8 +301,10 @@ def write_report(path: str | Path, lines: Sequence[str], newline: bool = True) -
 
 
 # ------------------------------------------------------------------------------------ committed members
-def committed_members(reports_dir: str | Path):
+def committed_members(reports_dir: str | Path, limit: int | None = None):
     """Every optimiser member the committed study CSVs in ``reports_dir`` hold (``benchmarks/reports``).
+
+    With ``limit``, only the first ``limit`` members of each case (a quick check).
 
     Returns
     -------
@@ -320,7 +329,8 @@ def committed_members(reports_dir: str | Path):
     for r in j.itertuples():
         rows.append(("journeys", f"section {int(r.section)}", r.case, int(r.section), "strategy",
                      r.running_time_s, r.energy_kwh))
-    return pd.DataFrame(rows, columns=["source", "case", "label", "seed", "member", "running_time_s", "energy_kwh"])
+    table = pd.DataFrame(rows, columns=["source", "case", "label", "seed", "member", "running_time_s", "energy_kwh"])
+    return table if limit is None else table.groupby("case", sort=False).head(limit)
 
 
 def member_cases() -> dict:
