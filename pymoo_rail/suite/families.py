@@ -1,0 +1,234 @@
+"""Seeded, scalable problem families of the suite: instance ``(family, n_var, seed)``, the same everywhere.
+
+A family draws its line with :func:`pymoo_rail.cases.generate_case` (``seed`` and the family's kind
+of service) and cuts it into equal sections, one speed code each, as many as ``n_var`` asks. The
+certified front is the case's (:func:`pymoo_rail.problems.reference.certified_front`): the least
+energy at each running time is a property of the train on the line, whatever the sections, so
+every dimension of an instance has the same known front, computed once per line by the exact
+solver and cached on disk under the case's content hash.
+
+- ``generated-<kind>-bi``: net energy (kWh) and running time (s) inside the planner's window
+  (:func:`pymoo_rail.problems.reference.default_window`), ``n_var`` speed codes (km/h).
+- ``generated-<kind>-single``: net energy under ``|T - T_plan| <= 1 %`` of the planned time (at least
+  1 s), paced speed codes: ``n_var - 1`` shapes and the running time (s); its optimum is certified.
+
+Each instance carries :data:`FAMILY_VERSION` and a checksum of its definition
+(:func:`definition`): the case's content hash, the encoding and its sections, the bounds, the
+objectives, the constraints and the front version. Results of instances with different checksums
+are not comparable.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from pymoo_rail.cases import KINDS, generate_case
+from pymoo_rail.model import Case
+from pymoo_rail.problems import SpeedProfileProblem
+from pymoo_rail.problems.reference import FRONT_VERSION, case_hash
+from pymoo_rail.suite import problems as named
+
+FAMILY_VERSION = "1"
+"""Version of the family definitions; bumped whenever an instance's definition (and so its checksum) changes."""
+N_VAR_RANGE = (2, 1000)
+"""Smallest and largest ``n_var`` of a family instance (the checks and the benchmark cover 10-1000)."""
+DEFAULT_N_VAR = 30
+DEFAULT_SEED = 1
+HV_MARGIN = 0.1
+"""The hypervolume reference point lies this share of the front's range beyond its nadir point."""
+BI_OBJECTIVES = ("energy", "running_time")
+
+
+@dataclass(frozen=True)
+class Family:
+    """One family of seeded instances.
+
+    Attributes
+    ----------
+    name : str
+        ``generated-<kind>-<form>``.
+    kind : str
+        Kind of line (:data:`pymoo_rail.cases.KINDS`): its train and line statistics.
+    form : {"bi", "single"}
+        Energy and running time in the planner's window, or energy at the planned time (1 %).
+    """
+
+    name: str
+    kind: str
+    form: str
+
+    @property
+    def summary(self) -> str:
+        """One line on what the family is."""
+        what = ("net energy and running time in the planner's window, n_var speed codes" if self.form == "bi"
+                else "net energy at the planned time (1 %), n_var - 1 paced shapes and the running time")
+        return f"seeded {self.kind} lines (pymoo_rail.cases.generate_case): {what}"
+
+
+FAMILIES: tuple[Family, ...] = tuple(Family(f"generated-{kind}-{form}", kind, form)
+                                     for form in ("bi", "single") for kind in KINDS)
+
+
+def list_families() -> list[str]:
+    """Names of the suite's scalable families (``generated-<kind>-bi`` and ``generated-<kind>-single``)."""
+    return [f.name for f in FAMILIES]
+
+
+def family(name: str) -> Family:
+    """The family of a name; ``ValueError`` naming it and the known ones otherwise."""
+    for entry in FAMILIES:
+        if entry.name == name:
+            return entry
+    raise ValueError(f"family {name!r} is unknown (known: {', '.join(list_families())})")
+
+
+def instance_name(family_name: str, n_var: int, seed: int) -> str:
+    """The name of an instance, e.g. ``generated-metro-bi-n300-s7``."""
+    return f"{family_name}-n{n_var}-s{seed}"
+
+
+def _check_int(field: str, value, lo: int, hi: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < lo or (hi is not None
+                                                                                              and value > hi):
+        span = f"in [{lo}, {hi}]" if hi is not None else f">= {lo}"
+        raise ValueError(f"{field} = {value!r}: must be an integer {span}")
+    return int(value)
+
+
+class FamilyProblem(SpeedProfileProblem):
+    """An instance of a family: a :class:`~pymoo_rail.problems.SpeedProfileProblem` with its identity.
+
+    Attributes
+    ----------
+    family : str
+    seed : int
+    version : str
+        :data:`FAMILY_VERSION`.
+    checksum : str
+        SHA-256 of :func:`definition` (hex).
+    suite_name : str
+        :func:`instance_name`.
+    """
+
+    family: str
+    seed: int
+    version: str
+    checksum: str
+    suite_name: str
+
+    def hv_reference_point(self) -> np.ndarray:
+        """The fixed hypervolume reference point: the certified front's nadir plus :data:`HV_MARGIN` of its range.
+
+        Taken from the case's bi-objective front in the planner's window (energy kWh, running time s),
+        restricted to this problem's objectives: the single-objective form's point is the energy of
+        the fastest optimal run plus the margin of the front's energy range.
+        """
+        front = self.certified_front()
+        lo, hi = front.clip(self.bi_window_s)
+        energy, _ = front.energy_at(np.array([lo, hi]))
+        ideal = {"energy": float(energy.min()), "running_time": lo}
+        nadir = {"energy": float(energy.max()), "running_time": hi}
+        return np.array([nadir[o] + HV_MARGIN * (nadir[o] - ideal[o]) for o in self.objectives])
+
+    @property
+    def bi_window_s(self) -> tuple[float, float]:
+        """The planner's running-time window of the case (the bi-objective form's constraint)."""
+        from pymoo_rail.problems.reference import default_window
+
+        return default_window(self.min_running_time_s, self.case.planned_time_s)
+
+
+def _settings(entry: Family, case: Case, n_var: int) -> dict:
+    if entry.form == "bi":
+        return dict(objectives=BI_OBJECTIVES, time_window_s="default", encoding="speed_codes", partition="equal",
+                    n_sections=n_var)
+    return dict(objectives=("energy",), time_tolerance_s=named.tolerance_s(case), encoding=named.SINGLE_ENCODING,
+                partition="equal", n_sections=n_var - 1)
+
+
+def definition(problem: SpeedProfileProblem, family_name: str, seed: int) -> dict:
+    """The canonical definition of an instance, the content of its checksum (JSON-ready, floats as text).
+
+    Floats are written with 12 significant digits, so the last bits of a simulated time (the window's
+    ends come from the flat-out run) do not change the checksum across machines.
+    """
+    def text(values) -> list[str]:
+        return [f"{float(v):.12g}" for v in np.atleast_1d(values)]
+
+    window = problem.time_window_s
+    return {"family": family_name, "family_version": FAMILY_VERSION, "seed": int(seed), "n_var": int(problem.n_var),
+            "case_hash": case_hash(problem.case), "encoding": problem.encoding.name,
+            "sections_m": text(problem.encoding.boundaries_m), "xl": text(problem.xl), "xu": text(problem.xu),
+            "objectives": list(problem.objectives), "n_ieq_constr": int(problem.n_ieq_constr),
+            "time_window_s": None if window is None else text(window),
+            "time_tolerance_s": None if problem.time_tolerance_s is None else text(problem.time_tolerance_s),
+            "stop_tolerance_m": problem.stop_tolerance_m, "front_version": FRONT_VERSION}
+
+
+def checksum_of(definition_: dict) -> str:
+    """SHA-256 (hex) of a definition as sorted, compact JSON."""
+    text = json.dumps(definition_, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def get_family_problem(name: str, n_var: int = DEFAULT_N_VAR, seed: int = DEFAULT_SEED) -> FamilyProblem:
+    """Instance ``(name, n_var, seed)`` of a family, the same on every machine.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_families`.
+    n_var : int
+        Number of decision variables, in :data:`N_VAR_RANGE`.
+    seed : int
+        Seed of the line (:func:`pymoo_rail.cases.generate_case`), >= 0.
+
+    Returns
+    -------
+    FamilyProblem
+        ``pareto_front()`` is the certified front (computed by the exact solver on first use and
+        cached on disk), ``checksum`` and ``version`` identify the definition.
+    """
+    entry = family(name)
+    n_var = _check_int("n_var", n_var, N_VAR_RANGE[0], N_VAR_RANGE[1])
+    seed = _check_int("seed", seed, 0)
+    case = generate_case(seed, entry.kind)
+    problem = FamilyProblem(case, **_settings(entry, case, n_var))
+    if problem.n_var != n_var:  # a guard on the encodings: the family promises exactly n_var variables
+        raise RuntimeError(f"{name}: built {problem.n_var} variables for n_var = {n_var}")
+    problem.family, problem.seed, problem.version = name, seed, FAMILY_VERSION
+    problem.checksum = checksum_of(definition(problem, name, seed))
+    problem.suite_name = instance_name(name, n_var, seed)
+    problem.suite_version = FAMILY_VERSION
+    return problem
+
+
+def get_problem(name: str, n_var: int | None = None, seed: int | None = None, **kwargs):
+    """A suite problem by name: a family instance (``n_var``, ``seed``) or a named problem (``**kwargs``).
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_families` or of :func:`pymoo_rail.suite.list_problems`.
+    n_var, seed : int, optional
+        The instance of a family (defaults :data:`DEFAULT_N_VAR` and :data:`DEFAULT_SEED`); a named
+        problem has neither.
+    **kwargs
+        Settings of a named problem (:func:`pymoo_rail.suite.problems.get_problem`); a family instance
+        takes none: it is defined by its name, ``n_var`` and ``seed`` alone.
+    """
+    if isinstance(name, str) and name in list_families():
+        if kwargs:
+            raise ValueError(f"{name}: a family instance is defined by n_var and seed alone; "
+                             f"{', '.join(sorted(kwargs))} = ... would change it")
+        return get_family_problem(name, DEFAULT_N_VAR if n_var is None else n_var,
+                                  DEFAULT_SEED if seed is None else seed)
+    given = [field for field, value in (("n_var", n_var), ("seed", seed)) if value is not None]
+    if given:
+        raise ValueError(f"{given[0]} = {n_var if given[0] == 'n_var' else seed!r}: problem {name!r} is not a family "
+                         f"(families: {', '.join(list_families())})")
+    return named.get_problem(name, **kwargs)
