@@ -3,9 +3,10 @@
 ``optimal_profile`` prices time at ``lambda`` (W = J/s), solves the dynamic programme of
 :mod:`pymoo_rail.optimal.dp` for ``net energy + lambda x time``, and searches ``lambda`` until the
 run takes the requested time. Larger ``lambda`` means faster, costlier runs; the running time
-falls monotonically as ``lambda`` grows, so the search is a safeguarded secant (Illinois) method
-on ``log lambda``. At the solution ``lambda`` is the slope of the front: the energy one more second
-of running time would save.
+falls monotonically as ``lambda`` grows, so the search (:mod:`pymoo_rail.optimal.price_search`) is a
+safeguarded secant (Illinois) method on ``log lambda``. At the solution ``lambda`` is the slope of
+the front: the energy one more second of running time would save. Every run carries an error bound
+(:mod:`pymoo_rail.optimal.certificate`).
 
 The returned :class:`~pymoo_rail.sim.Trajectory` is not the DP's estimate: it is the simulator's
 run of the DP's control sequence (one program row per grid cell), so every figure in it comes from
@@ -16,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -25,17 +26,24 @@ from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
 from pymoo_rail.model import Case, InfeasibleCaseError
 from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.optimal import dp
-from pymoo_rail.sim import Simulator, Trajectory
-from pymoo_rail.sim.kernel import (
-    MODE_COAST,
-    MODE_HOLD,
-    MODE_HOLD_BRAKE,
-    MODE_TOWARD,
-    MODE_TRACTION,
-    OUT_NET_KWH,
-    OUT_REACHED,
-    OUT_RUNNING_TIME_S,
+from pymoo_rail.optimal.certificate import (
+    CERTIFICATE_FACTOR,
+    CERTIFICATE_FLOOR_REL,
+    bound_from_parts_kwh,
+    bound_parts_kwh,
+    move_remainder_j,
+    untied_excess_j,
 )
+from pymoo_rail.optimal.price_search import (
+    ADJUST_WITHIN_S,
+    JUMP_LOG_WIDTH,
+    LAMBDA_MAX_W,
+    LAMBDA_MIN_W,
+    MAX_TIME_ERROR_S,
+    Solve,
+    search_price,
+)
+from pymoo_rail.sim import Simulator, Trajectory
 
 SOLVER_VERSION = "2"
 """Version of the solver's answers: bump it whenever a run the solver returns for a case can change
@@ -51,46 +59,12 @@ DEFAULT_TIME_TOL_S = 0.05
 DEFAULT_TOP_BIAS = 0.5
 # ``profile`` refines the speed grid up to this many nodes when the discrete optimum jumps over the request
 MAX_N_SPEEDS = 4 * DEFAULT_N_SPEEDS
-MAX_TIME_ERROR_S = 0.5
-# Once solves on both sides of the requested time are this close to it, the search stops and moves
-# the last switch of the closer run instead (second-order error: E'' dT^2 / 2, far below 1e-4 kWh)
-ADJUST_WITHIN_S = 0.5
-# A bracket this narrow in log(lambda) (0.2 % of the price) whose ends differ by more than
-# ADJUST_WITHIN_S is a jump of the discrete optimum: further solves only land on its two sides
-# again (measured on the 48.5 km case: 6 of 11 solves), so the closer side within ADJUST_WITHIN_S
-# is moved instead
-JUMP_LOG_WIDTH = 2e-3
-# The certificate is this many times the change when the speed grid is halved (see energy_bound_kwh)
-CERTIFICATE_FACTOR = 2.0
-# ... plus this share of the run's net energy: the two grids can agree by coincidence where a grid
-# of twice the nodes or the uniform node placement still differs (at 2 of 861 times of
-# ``benchmarks/certificate_coverage.py``, by 1.0 and 2.7 Wh beyond the two-grid part, 2.6e-5 and
-# 2.3e-6 of the energy)
-CERTIFICATE_FLOOR_REL = 1.0e-4
 DEFAULT_TIE_J = 100.0
-LAMBDA_MIN_W = 1.0e2
-LAMBDA_MAX_W = 1.0e10
-
-
-@dataclass(frozen=True)
-class _Solve:
-    """One run found at one price of time: a simulator program (one row per cell) and its figures.
-
-    ``speeds`` are the DP's forward run, which the simulator's replay must reproduce; None for a
-    run whose last switch was moved to meet the time (a simulator run from the start).
-    ``dual_gap_j``: how far a moved run may lie above the discrete optimum at its time (0 for a
-    run the DP found at its own price); ``tie_cost_j``: what keeping the regime between near-tied
-    controls cost (``dp.forward_rollout``); both enter :meth:`OptimalSolver.energy_bound_kwh`.
-    """
-
-    lambda_w: float
-    program: np.ndarray
-    speeds: np.ndarray | None
-    energy_j: float
-    time_s: float
-    value_j: float
-    dual_gap_j: float = 0.0
-    tie_cost_j: float = 0.0
+# the constants of the search and the certificate, named here as before they had modules of their own
+__all__ = ["SOLVER_VERSION", "DEFAULT_N_SPEEDS", "DEFAULT_MAX_TARGETS", "DEFAULT_TIME_TOL_S", "DEFAULT_TOP_BIAS",
+           "DEFAULT_TIE_J", "MAX_N_SPEEDS", "MAX_TIME_ERROR_S", "ADJUST_WITHIN_S", "JUMP_LOG_WIDTH",
+           "CERTIFICATE_FACTOR", "CERTIFICATE_FLOOR_REL", "LAMBDA_MIN_W", "LAMBDA_MAX_W", "Solve",
+           "OptimalSolver", "min_running_time", "optimal_profile", "optimal_front"]
 
 
 class OptimalSolver:
@@ -161,7 +135,7 @@ class OptimalSolver:
         self.last_bound_parts: dict[str, float] = {}
         self.certify = bool(certify)
         self._coarse: OptimalSolver | None = None
-        self._history: list[_Solve] = []  # every solve so far: time depends on lambda alone
+        self._history: list[Solve] = []  # every solve so far: time depends on lambda alone
         self.price_shape: np.ndarray | None = None
         self.set_price_shape(price_shape)
         # the arrival speeds the case asks for: (lo, hi), lo = hi = the final speed unless it gives a window
@@ -227,19 +201,29 @@ class OptimalSolver:
             self._min_time_s = self.simulator.check_planned_time(math.inf)
         return self._min_time_s
 
-    def solve_price(self, lambda_w: float) -> _Solve:
+    def solve_price(self, lambda_w: float) -> Solve:
         """The DP optimum of ``net energy + lambda_w x time`` (one backward sweep and forward run)."""
-        if self._tables is None:
-            self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
+        self.transition_tables()
         self.n_solves += 1
-        prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
-        run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, self.tie_j,
-                       self._value, self._floor_k, self._terminal_j, self.singular)
-        solution = self._record(lambda_w, run)
+        solution = self._record(lambda_w, self.run_dp(lambda_w, self.tie_j))
         self._history.append(solution)
         return solution
 
-    def _record(self, lambda_w: float, run: tuple) -> _Solve:
+    def run_dp(self, lambda_w: float, tie_j: float) -> tuple:
+        """:func:`pymoo_rail.optimal.dp.solve` at price ``lambda_w`` and tie rule ``tie_j`` on built tables.
+
+        Returns the DP's raw forward run (modes, targets, speeds, cells done, energy, time, tie cost,
+        value); :meth:`solve_price` records it as a :class:`Solve`.
+        """
+        prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
+        return dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, tie_j,
+                        self._value, self._floor_k, self._terminal_j, self.singular)
+
+    def at_finest_speed_grid(self) -> bool:
+        """Whether ``profile`` may not refine the speed grid any further (``MAX_N_SPEEDS`` nodes)."""
+        return self.n_speeds >= MAX_N_SPEEDS
+
+    def _record(self, lambda_w: float, run: tuple) -> Solve:
         modes, targets, speeds, done, energy, time, tie_cost, value_j = run
         if done < modes.shape[0]:
             x = self.simulator.grid.position_m[done]
@@ -250,225 +234,9 @@ class OptimalSolver:
                                       f"the solver's run arrives at {speeds[-1] * KMH_PER_MS:.3f} km/h: the end speed "
                                       "asked for is out of reach", self.case.name)
         program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
-        return _Solve(lambda_w, program, speeds, energy, time, float(value_j), tie_cost_j=tie_cost)
+        return Solve(lambda_w, program, speeds, energy, time, float(value_j), tie_cost_j=tie_cost)
 
-    def _adjust(self, solution: _Solve, target: float) -> _Solve | None:
-        """Move the run's last switch into the final coast until it takes the requested time.
-
-        The discrete optimum can jump over the requested time (where the front is nearly straight,
-        runs on either side are tied in ``energy + lambda x time``). The last powered phase is then
-        extended (the run is too slow) or cut short (too fast) cell by cell, found by bisection. At
-        an optimum the coast point trades time for energy at the rate ``lambda``, so the moved run
-        stays on the front to first order. Returns None when the run has no powered phase.
-        """
-        program = solution.program
-        modes = program[:, 1]
-        powered = np.flatnonzero((modes == MODE_TRACTION) | (modes == MODE_HOLD) | (modes == MODE_HOLD_BRAKE)
-                                 | (modes == MODE_TOWARD))
-        if powered.size == 0:
-            return None
-        last = int(powered[-1])
-        n_cells = program.shape[0]
-        if solution.time_s > target:  # extend: hold the speed reached (or keep pulling)
-            mode = MODE_TRACTION if modes[last] == MODE_TRACTION else MODE_HOLD_BRAKE
-            slow_end, fast_end = 0, n_cells - 1 - last
-
-            def moved(j):
-                p = program.copy()
-                p[last + 1:last + 1 + j, 1:] = (mode, 0.0)
-                return p
-        else:  # cut short: coast earlier
-            slow_end, fast_end = last + 1, 0
-
-            def moved(j):
-                p = program.copy()
-                p[last + 1 - j:last + 1, 1:] = (MODE_COAST, 0.0)
-                return p
-
-        def run(j):
-            p = moved(j)
-            out = self.simulator.run_batch(p[None])[0]
-            time = out[OUT_RUNNING_TIME_S] if out[OUT_REACHED] > 0 else math.inf
-            return p, out[OUT_NET_KWH] * J_PER_KWH, time
-
-        runs = {slow_end: run(slow_end), fast_end: run(fast_end)}
-        if not runs[slow_end][2] >= target >= runs[fast_end][2]:
-            return None
-        lo, hi = slow_end, fast_end  # lo: run >= target, hi: run <= target
-        while abs(hi - lo) > 1:
-            mid = (lo + hi) // 2
-            runs[mid] = run(mid)
-            if runs[mid][2] >= target:
-                lo = mid
-            else:
-                hi = mid
-        p, energy, time = min((runs[lo], runs[hi]), key=lambda r: abs(r[2] - target))
-        if not self.holds_speed_floor(self.simulator.run(p).speed_ms):
-            return None  # coasting earlier passes a timing point too slowly
-        return _Solve(solution.lambda_w, p, None, energy, time, solution.value_j, tie_cost_j=solution.tie_cost_j)
-
-    def _cold_guess_w(self, target: float) -> float:
-        """A first price of time: the level-track hold condition ``V^2 R'(V) / eta`` at 1.1 x the mean speed."""
-        train = self.case.train
-        _, b, c = train.resistance.coefficients_si(train.mass_kg)
-        v = 1.1 * self.case.line.length_m / target
-        return v * v * (b + 2.0 * c * v) / train.traction_efficiency - train.aux_power_kw * 1000.0
-
-    def _bracket_from_history(self, target: float) -> tuple[_Solve | None, _Solve | None]:
-        """The closest earlier solves on either side of ``target`` (slow: above it, fast: below)."""
-        slow = [h for h in self._history if h.time_s > target]
-        fast = [h for h in self._history if h.time_s < target]
-        return (max(slow, key=lambda h: h.lambda_w) if slow else None,
-                min(fast, key=lambda h: h.lambda_w) if fast else None)
-
-    def _search(self, running_time_s: float, lambda_guess_w: float | None) -> _Solve:
-        """Find ``lambda`` whose optimum takes ``running_time_s`` (within ``time_tol_s``).
-
-        Every solve of this solver is remembered: the running time depends on ``lambda`` alone,
-        so earlier solves (e.g. of a front's neighbouring points) bracket the new target, and the
-        search starts from the interpolated ``log lambda`` instead of a blind guess.
-        """
-        target = running_time_s
-        tol = self.time_tol_s
-        for h in self._history:
-            if abs(h.time_s - target) <= tol:
-                return h
-        slow, fast = self._bracket_from_history(target)
-        if slow is not None and fast is not None and slow.lambda_w < fast.lambda_w:
-            return self._refine(slow, fast, target)
-        if self._history:  # one side known: step on from the earlier solve nearest the target
-            first = min(self._history, key=lambda h: abs(h.time_s - target))
-        else:
-            lam = lambda_guess_w if lambda_guess_w else self._cold_guess_w(target)
-            first = self.solve_price(min(max(lam, LAMBDA_MIN_W), LAMBDA_MAX_W))
-            if abs(first.time_s - target) <= tol:
-                return first
-        # bracket: fast (time below target) at high lambda, slow at low lambda; the step follows
-        # the local slope d(time)/d(log lambda) of the two latest solves when there are two
-        fast = slow = None
-
-        def step(a: _Solve) -> float:
-            others = [h for h in self._history if h is not a and h.lambda_w != a.lambda_w]
-            if others:
-                b = min(others, key=lambda h: abs(math.log(h.lambda_w / a.lambda_w)))
-                slope = (a.time_s - b.time_s) / math.log(a.lambda_w / b.lambda_w)
-                if slope < 0.0:
-                    return min(max(1.5 * abs((a.time_s - target) / slope), 0.05), math.log(8.0))
-            return math.log(2.0)  # no slope known yet: a modest step (8x overshoots by far)
-
-        if first.time_s > target:
-            slow = first
-            while fast is None:
-                if slow.lambda_w >= LAMBDA_MAX_W:
-                    return self._closest(slow, None, target, "fast")
-                s = self.solve_price(min(slow.lambda_w * math.exp(step(slow)), LAMBDA_MAX_W))
-                if abs(s.time_s - target) <= tol:
-                    return s
-                if s.time_s > target:
-                    slow = s
-                else:
-                    fast = s
-        else:
-            fast = first
-            while slow is None:
-                if fast.lambda_w <= LAMBDA_MIN_W:
-                    return self._closest(None, fast, target, "slow")
-                s = self.solve_price(max(fast.lambda_w / math.exp(step(fast)), LAMBDA_MIN_W))
-                if abs(s.time_s - target) <= tol:
-                    return s
-                if s.time_s < target:
-                    fast = s
-                else:
-                    slow = s
-        return self._refine(slow, fast, target)
-
-    def _refine(self, slow: _Solve, fast: _Solve, target: float) -> _Solve:
-        """Illinois regula falsi on ``log lambda`` inside a bracket (slow: too slow, fast: too fast)."""
-        tol = self.time_tol_s
-        # Illinois regula falsi on log(lambda)
-        side = 0
-        # the secant works on log(T - T_min) against log(lambda), close to a straight line (the
-        # running time above the minimum falls like a power of the price of time)
-        t_min = self.min_running_time_s() - 1e-6 * target
-
-        def g(t):
-            return math.log(max(t - t_min, 1e-12)) - math.log(max(target - t_min, 1e-12))
-
-        f_fast, f_slow = g(fast.time_s), g(slow.time_s)
-        f_fast_true, f_slow_true = fast.time_s - target, slow.time_s - target  # (Illinois halves f_*)
-        lo, hi = math.log(slow.lambda_w), math.log(fast.lambda_w)
-        repeats = 0
-        for _ in range(40):
-            near = max(f_slow_true, -f_fast_true) <= ADJUST_WITHIN_S
-            jump = hi - lo < JUMP_LOG_WIDTH and min(f_slow_true, -f_fast_true) <= ADJUST_WITHIN_S
-            if hi - lo < 1e-4 or repeats >= 2 or near or jump:
-                # a jump of the discrete optimum, or close enough on both sides: moving the last
-                # switch of the closer run (``_adjust``, simulations only) meets the time
-                break
-            x = hi - f_fast * (hi - lo) / (f_fast - f_slow)
-            if not (lo < x < hi):
-                x = 0.5 * (lo + hi)
-            s = self.solve_price(math.exp(x))
-            if abs(s.time_s - target) <= tol:
-                return s
-            f = g(s.time_s)
-            # the same run as the end it replaces: the optimum is constant on this side of a jump
-            same = slow if s.time_s > target else fast
-            repeats = repeats + 1 if abs(s.time_s - same.time_s) <= 1e-9 * target else 0
-            if s.time_s > target:
-                slow, lo, f_slow, f_slow_true = s, x, f, s.time_s - target
-                if side == -1:
-                    f_fast *= 0.5
-                side = -1
-            else:
-                fast, hi, f_fast, f_fast_true = s, x, f, s.time_s - target
-                if side == 1:
-                    f_slow *= 0.5
-                side = 1
-        return self._closest(slow, fast, target, "")
-
-    def _closest(self, slow: _Solve | None, fast: _Solve | None, target: float, missing: str) -> _Solve:
-        solved = [s for s in (slow, fast) if s is not None]  # at their own prices
-        if (slow is not None and fast is not None
-                and max(slow.time_s - target, target - fast.time_s) <= ADJUST_WITHIN_S):
-            # the slope of the front at the target lies between the bracket's prices: their
-            # geometric mean (any price on a plateau of the discrete optimum gives the same run)
-            lam = math.sqrt(slow.lambda_w * fast.lambda_w)
-            slow, fast = replace(slow, lambda_w=lam), replace(fast, lambda_w=lam)
-        found = [s for s in (slow, fast) if s is not None]
-        best = min(found, key=lambda s: abs(s.time_s - target))
-        if abs(best.time_s - target) > self.time_tol_s:
-            # weak duality: a run optimal at price lambda_h bounds the discrete optimum at any time T
-            # from below by E_h + lambda_h (T_h - T); a moved run's gap is its excess over the
-            # lower of the bracket's two bounds
-            moved = [replace(m, dual_gap_j=max(m.energy_j - min(h.energy_j + h.lambda_w * (h.time_s - m.time_s)
-                                                                for h in solved), 0.0))
-                     for m in (self._adjust(s, target) for s in found) if m is not None]
-            # a moved run is kept only if it lies on the front within what the time tolerance is
-            # worth there (lambda x time_tol_s): across a jump of the discrete optimum the two
-            # sides differ in more than their last switch, and moving it was measured 2.1 kWh
-            # (0.25 %) above the front on wuguang-crh3 and 0.39 kWh (2.4 %) on a 2.3 km metro
-            # section, where the unmoved run, 0.1-0.3 s off the request, is on it
-            close = [m for m in moved if m.dual_gap_j <= best.lambda_w * self.time_tol_s]
-            candidates = close + [best]
-            if abs(best.time_s - target) > MAX_TIME_ERROR_S and self.n_speeds >= MAX_N_SPEEDS:
-                # no run within the time error allowed and no finer grid to try (``profile``
-                # refines the speed grid, where the jumps are smaller): the moved runs are the answer
-                candidates += moved
-            # compare at the requested time along the front's slope
-            best = min(candidates, key=lambda s: (max(abs(s.time_s - target) - self.time_tol_s, 0.0),
-                                                  s.energy_j + s.lambda_w * (s.time_s - target)))
-        if abs(best.time_s - target) > 0.5:
-            if missing == "fast":
-                raise InfeasibleCaseError("running_time_s", target,
-                                          f"is below the minimum running time {best.time_s:.2f} s the solver reaches "
-                                          f"(flat out {self.min_running_time_s():.2f} s)", self.case.name)
-            if missing == "slow":
-                raise ValueError(f"running_time_s = {target}: longer than the slowest run the speed grid represents "
-                                 f"({best.time_s:.1f} s at lambda = {best.lambda_w:.3g} W)")
-        return best
-
-    def energy_bound_kwh(self, solution: _Solve) -> float:
+    def energy_bound_kwh(self, solution: Solve) -> float:
         """Estimated bound on the run's energy above the optimum at its running time (kWh, >= 0).
 
         The sum of three parts (``docs/optimal.md``, "Certificate"):
@@ -489,6 +257,13 @@ class OptimalSolver:
         optimum meant is that of the simulator's model on this position grid, the model every
         optimiser's run is evaluated with.
         """
+        # the two grids compared through their dual functions at the run's price, min E + lambda T
+        other = self.coarse_solver().solve_price(solution.lambda_w)
+        self.last_bound_parts = bound_parts_kwh(solution, other, untied_excess_j(self, solution))
+        return bound_from_parts_kwh(self.last_bound_parts)
+
+    def coarse_solver(self) -> OptimalSolver:
+        """The solver on a speed grid of half the nodes (same position grid and model) the certificate compares with."""
         if self._coarse is None:
             self._coarse = OptimalSolver(self.case, self.dx_m, max(self.n_speeds // 2, 3), self.max_targets,
                                          self.time_tol_s, self.top_bias, self.tie_j, certify=False,
@@ -496,23 +271,7 @@ class OptimalSolver:
                                          singular=self.singular)
             self._coarse.simulator = self.simulator  # same grid and model: share them
             self._coarse._min_time_s = self._min_time_s
-        # the two grids compared through their dual functions at the run's price, min E + lambda T:
-        # the coarse optimum at lambda moved along the slope lambda to this run's time is the coarse
-        # front's supporting line there. One solve, and no search that a jump of the coarse optimum
-        # could end on a run far from this time (measured: 8.1 kWh of "grid error" on wuguang-crh3
-        # at 1110 s from a moved coarse run, against 0.16 kWh through the supporting line)
-        other = self._coarse.solve_price(solution.lambda_w)
-        moved_j = other.energy_j + solution.lambda_w * (other.time_s - solution.time_s)
-        self.last_bound_parts = {"grid_kwh": CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) / J_PER_KWH,
-                                 "floor_kwh": CERTIFICATE_FLOOR_REL * abs(solution.energy_j) / J_PER_KWH,
-                                 "moved_kwh": solution.dual_gap_j / J_PER_KWH,
-                                 "kept_regimes_kwh": solution.tie_cost_j / J_PER_KWH,
-                                 "untied_kwh": self._untied_excess_j(solution) / J_PER_KWH}
-        parts = self.last_bound_parts
-        # the duality gap of a moved run and the untied run's advantage both measure how far the run
-        # lies above the supporting line at lambda (on a moved run they coincide): the larger counts
-        return (parts["grid_kwh"] + parts["floor_kwh"]
-                + max(parts["moved_kwh"], parts["kept_regimes_kwh"], parts["untied_kwh"]))
+        return self._coarse
 
     def transition_tables(self) -> tuple:
         """The DP's transitions of this solver's model (:func:`pymoo_rail.optimal.dp.transitions`), built once.
@@ -524,7 +283,7 @@ class OptimalSolver:
             self._tables = dp.transitions(self.simulator.model, self.n_speeds, self.max_targets, self.top_bias)
         return self._tables
 
-    def solves(self) -> list[_Solve]:
+    def solves(self) -> list[Solve]:
         """Every run this solver found at a price of time so far (``lambda_w``, ``time_s``, ``energy_j`` ...)."""
         return list(self._history)
 
@@ -536,46 +295,12 @@ class OptimalSolver:
         closest solves on either side of ``target_s`` (the front is convex); the chord minus the line
         bounds the error. With no solve on one side, or for a run that is not one of this solver's
         solves (a moved run, within ``time_tol_s``; a run of the finer grid ``profile`` fell back
-        to): ``lambda |time_s - target_s|``, the first-order term itself.
+        to): ``lambda |time_s - target_s|``, the first-order term itself
+        (:func:`pymoo_rail.optimal.certificate.move_remainder_j`).
         """
-        slow = [h for h in self._history if h.time_s >= target_s]
-        fast = [h for h in self._history if h.time_s <= target_s]
-        first_order = abs(lambda_w * (time_s - target_s))
-        if not slow or not fast:
-            return first_order
-        a = min(slow, key=lambda h: h.time_s)
-        b = max(fast, key=lambda h: h.time_s)
-        if a.time_s - b.time_s <= 0.0:
-            return 0.0
-        w = (target_s - b.time_s) / (a.time_s - b.time_s)
-        chord_j = b.energy_j + w * (a.energy_j - b.energy_j)
-        here = min((h for h in self._history if abs(h.time_s - time_s) <= 1e-9 * max(time_s, 1.0)),
-                   key=lambda h: h.energy_j, default=None)
-        if here is None:  # a moved run (not solved at a price): it is within time_tol_s of the target
-            return first_order
-        line_j = here.energy_j + lambda_w * (here.time_s - target_s)
-        return max(chord_j - line_j, 0.0)
+        return move_remainder_j(self._history, time_s, lambda_w, target_s)
 
-    def _untied_excess_j(self, solution: _Solve) -> float:
-        """How much better, at the run's price of time, the forward run without the tie rule is (J, >= 0).
-
-        Keeping the regime between near-tied controls changes the rest of the run too, so its cost
-        is measured on the whole run: the forward run with ``tie_j = 0`` at the same price, compared
-        in ``energy + lambda x time`` (measured: 6.1 Wh on a 1.7 km metro section, 0.07 %, ``benchmarks/certificate.py``).
-        """
-        if self.tie_j <= 0.0:
-            return 0.0
-        lam = solution.lambda_w
-        prices = lam if self.price_shape is None else lam * self.price_shape
-        run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, 0.0,
-                       self._value, self._floor_k, self._terminal_j, self.singular)
-        _, _, _, done, energy, time, _, _ = run
-        if done < self.simulator.grid.n_nodes - 1:
-            return 0.0
-        mean_price = lam if self.price_shape is None else lam * float(np.mean(self.price_shape))
-        return max(solution.energy_j + mean_price * solution.time_s - (energy + mean_price * time), 0.0)
-
-    def trajectory(self, solution: _Solve) -> Trajectory:
+    def trajectory(self, solution: Solve) -> Trajectory:
         """Replay a solution's controls in the simulator: the returned run is the simulator's own."""
         tr = self.simulator.run(solution.program)
         speeds = tr.speed_ms if solution.speeds is None else solution.speeds
@@ -599,11 +324,11 @@ class OptimalSolver:
             raise InfeasibleCaseError("running_time_s", running_time_s,
                                       f"is below the minimum running time {fastest:.2f} s of the train on this line",
                                       self.case.name)
-        solution = self._search(running_time_s, lambda_guess_w)
+        solution = search_price(self, running_time_s, lambda_guess_w)
         if abs(solution.time_s - running_time_s) > MAX_TIME_ERROR_S:
             # the discrete optimum jumps over the requested time at this lambda: a finer speed grid
             # makes the jumps smaller
-            if self.n_speeds >= MAX_N_SPEEDS:
+            if self.at_finest_speed_grid():
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
                                    f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
