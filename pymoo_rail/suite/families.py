@@ -20,8 +20,6 @@ are not comparable.
 
 from __future__ import annotations
 
-import hashlib
-import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,6 +29,8 @@ from pymoo_rail.model import Case
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.problems.reference import FRONT_VERSION, case_hash
 from pymoo_rail.suite import problems as named
+from pymoo_rail.suite.identity import as_text, checksum_of
+from pymoo_rail.suite.trips import TripProblem, trip_problem
 
 FAMILY_VERSION = "1"
 """Version of the family definitions; bumped whenever an instance's definition (and so its checksum) changes."""
@@ -41,6 +41,8 @@ DEFAULT_SEED = 1
 HV_MARGIN = 0.1
 """The hypervolume reference point lies this share of the front's range beyond its nadir point."""
 BI_OBJECTIVES = ("energy", "running_time")
+TRIP_KINDS = ("metro", "suburban")
+"""Kinds of line of the whole-trip families (many stops: the short lines)."""
 
 
 @dataclass(frozen=True)
@@ -53,8 +55,10 @@ class Family:
         ``generated-<kind>-<form>``.
     kind : str
         Kind of line (:data:`pymoo_rail.cases.KINDS`): its train and line statistics.
-    form : {"bi", "single"}
-        Energy and running time in the planner's window, or energy at the planned time (1 %).
+    form : {"bi", "single", "trip"}
+        Energy and running time in the planner's window, energy at the planned time (1 %), or the
+        energy of a whole trip of ``n_var`` sections with a fixed total running time
+        (:mod:`pymoo_rail.suite.trips`).
     """
 
     name: str
@@ -64,13 +68,15 @@ class Family:
     @property
     def summary(self) -> str:
         """One line on what the family is."""
-        what = ("net energy and running time in the planner's window, n_var speed codes" if self.form == "bi"
-                else "net energy at the planned time (1 %), n_var - 1 paced shapes and the running time")
+        what = {"bi": "net energy and running time in the planner's window, n_var speed codes",
+                "single": "net energy at the planned time (1 %), n_var - 1 paced shapes and the running time",
+                "trip": "net energy of a trip of n_var sections, their running times summing to the plan"}[self.form]
         return f"seeded {self.kind} lines (pymoo_rail.cases.generate_case): {what}"
 
 
-FAMILIES: tuple[Family, ...] = tuple(Family(f"generated-{kind}-{form}", kind, form)
-                                     for form in ("bi", "single") for kind in KINDS)
+FAMILIES: tuple[Family, ...] = (*(Family(f"generated-{kind}-{form}", kind, form)
+                                     for form in ("bi", "single") for kind in KINDS),
+                                  *(Family(f"generated-{kind}-trip", kind, "trip") for kind in TRIP_KINDS))
 
 
 def list_families() -> list[str]:
@@ -153,12 +159,11 @@ def _settings(entry: Family, case: Case, n_var: int) -> dict:
 def definition(problem: SpeedProfileProblem, family_name: str, seed: int) -> dict:
     """The canonical definition of an instance, the content of its checksum (JSON-ready, floats as text).
 
-    Floats are written with 12 significant digits, so the last bits of a simulated time (the window's
-    ends come from the flat-out run) do not change the checksum across machines.
+    Floats are written as :func:`~pymoo_rail.suite.identity.as_text` (12 significant digits), so the
+    last bits of a simulated time (the window's ends come from the flat-out run) do not change the
+    checksum across machines.
     """
-    def text(values) -> list[str]:
-        return [f"{float(v):.12g}" for v in np.atleast_1d(values)]
-
+    text = as_text
     window = problem.time_window_s
     return {"family": family_name, "family_version": FAMILY_VERSION, "seed": int(seed), "n_var": int(problem.n_var),
             "case_hash": case_hash(problem.case), "encoding": problem.encoding.name,
@@ -169,13 +174,7 @@ def definition(problem: SpeedProfileProblem, family_name: str, seed: int) -> dic
             "stop_tolerance_m": problem.stop_tolerance_m, "front_version": FRONT_VERSION}
 
 
-def checksum_of(definition_: dict) -> str:
-    """SHA-256 (hex) of a definition as sorted, compact JSON."""
-    text = json.dumps(definition_, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()
-
-
-def get_family_problem(name: str, n_var: int = DEFAULT_N_VAR, seed: int = DEFAULT_SEED) -> FamilyProblem:
+def get_family_problem(name: str, n_var: int = DEFAULT_N_VAR, seed: int = DEFAULT_SEED) -> FamilyProblem | TripProblem:
     """Instance ``(name, n_var, seed)`` of a family, the same on every machine.
 
     Parameters
@@ -196,12 +195,21 @@ def get_family_problem(name: str, n_var: int = DEFAULT_N_VAR, seed: int = DEFAUL
     entry = family(name)
     n_var = _check_int("n_var", n_var, N_VAR_RANGE[0], N_VAR_RANGE[1])
     seed = _check_int("seed", seed, 0)
+    if entry.form == "trip":
+        return _identify(trip_problem(entry.kind, n_var, seed), name, n_var, seed,
+                         lambda p: p.definition())
     case = generate_case(seed, entry.kind)
     problem = FamilyProblem(case, **_settings(entry, case, n_var))
     if problem.n_var != n_var:  # a guard on the encodings: the family promises exactly n_var variables
         raise RuntimeError(f"{name}: built {problem.n_var} variables for n_var = {n_var}")
+    return _identify(problem, name, n_var, seed, lambda p: definition(p, name, seed))
+
+
+def _identify(problem, name: str, n_var: int, seed: int, describe):
+    """Set an instance's family, seed, version, checksum (of ``describe(problem)``) and names."""
     problem.family, problem.seed, problem.version = name, seed, FAMILY_VERSION
-    problem.checksum = checksum_of(definition(problem, name, seed))
+    problem.checksum = checksum_of({"family": name, "family_version": FAMILY_VERSION, "seed": int(seed),
+                                    "n_var": int(n_var), **describe(problem)})
     problem.suite_name = instance_name(name, n_var, seed)
     problem.suite_version = FAMILY_VERSION
     return problem

@@ -6,6 +6,7 @@ import sys
 import numpy as np
 import pytest
 
+from pymoo_rail.journeys import front_energy, project_to_budget
 from pymoo_rail.problems import reference as ref
 from pymoo_rail.suite import FAMILY_VERSION, get_problem, list_families, list_problems
 from pymoo_rail.suite.families import definition, instance_name
@@ -16,18 +17,19 @@ PINNED = {
     ("generated-metro-bi", 10, 7): "eda7f924b353",
     ("generated-metro-single", 10, 7): "c333c9d8e374",
     ("generated-intercity-bi", 300, 7): "0c8ce84b9a5b",
+    ("generated-metro-trip", 10, 1): "317462ae87a9",
 }
 
 
 def test_families_and_problems_are_distinct_names():
     families = list_families()
-    assert len(families) == 8 and len(set(families)) == 8
-    assert {f.rsplit("-", 1)[1] for f in families} == {"bi", "single"}
+    assert len(families) == 10 and len(set(families)) == 10
+    assert {f.rsplit("-", 1)[1] for f in families} == {"bi", "single", "trip"}
     assert not set(families) & set(list_problems())
     assert get_problem("metro-a-bi").suite_name == "metro-a-bi"  # the named problems still answer
 
 
-@pytest.mark.parametrize("name", ["generated-metro-bi", "generated-high-speed-single"])
+@pytest.mark.parametrize("name", ["generated-metro-bi", "generated-high-speed-single", "generated-suburban-trip"])
 @pytest.mark.parametrize("n_var", [2, 10, 37, 1000])
 def test_n_var_is_exactly_what_was_asked(name, n_var):
     problem = get_problem(name, n_var=n_var, seed=3)
@@ -104,3 +106,25 @@ def test_unknown_names_and_family_arguments_on_named_problems():
         get_problem("yizhuang-bi", n_var=10)
     with pytest.raises(ValueError, match="seed = 3: problem 'yizhuang-bi' is not a family"):
         get_problem("yizhuang-bi", seed=3)
+
+
+def test_a_trip_optimum_is_exact_and_shorter_trips_are_its_first_sections():
+    short, trip = (get_problem("generated-metro-trip", n_var=n, seed=4) for n in (5, 40))
+    assert np.array_equal(short.sections, trip.sections[:5]) and len(set(trip.sections)) > 1
+    assert all(c.initial_speed_ms == 0.0 == c.final_speed_ms for c in trip.pool)
+    times, energy = trip.optimum
+    assert times.sum() == pytest.approx(trip.total_time_s) and trip.pareto_front()[0, 0] == energy
+    # no split on the budget costs less: random splits projected onto it, and moves of one second
+    rng = np.random.default_rng(0)
+    X = project_to_budget(rng.uniform(trip.xl, trip.xu, (200, trip.n_var)), trip.xl, trip.xu, trip.total_time_s)
+    out = trip.evaluate(X, return_as_dictionary=True)
+    assert np.all(np.abs(out["H"]) < 1e-6) and np.all(out["F"][:, 0] >= energy - 1e-9)
+    for i, j in rng.integers(0, trip.n_var, (50, 2)):
+        moved = times.copy()
+        moved[i] += 1.0
+        moved[j] -= 1.0
+        if i != j and trip.xl[j] <= moved[j] and moved[i] <= trip.xu[i]:
+            assert trip.evaluate(moved[None, :])[0][0, 0] >= energy - 1e-9
+    # the section curves are convex and decreasing: the slowest split in the box costs least
+    slowest = sum(front_energy(f, f["running_time_s"].iloc[-1]) for f in trip.fronts)
+    assert slowest < energy < trip.hv_reference_point()[0]
