@@ -128,3 +128,16 @@ def test_a_trip_optimum_is_exact_and_shorter_trips_are_its_first_sections():
     # the section curves are convex and decreasing: the slowest split in the box costs least
     slowest = sum(front_energy(f, f["running_time_s"].iloc[-1]) for f in trip.fronts)
     assert slowest < energy < trip.hv_reference_point()[0]
+
+
+def test_a_line_the_exact_solver_gives_up_on_has_no_front_and_says_so(monkeypatch):
+    problem = get_problem("generated-intercity-bi", n_var=10, seed=7)
+
+    def gives_up(*args, **kwargs):
+        raise RuntimeError("running_time_s = 1753.7: the closest optimum takes 1745.10 s; refine the grid")
+
+    monkeypatch.setattr(ref, "certified_front", gives_up)
+    with pytest.raises(ref.NoExactFrontError, match="generated-intercity-bi-n10-s7: the exact solver gave up"):
+        problem.pareto_front()
+    with pytest.raises(ref.NoExactFrontError, match="refine the grid"):
+        problem.hv_reference_point()
