@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.cases import KINDS
-from pymoo_rail.problems import reference
+from pymoo_rail.optimal import reference
 from pymoo_rail.suite import get_problem, list_families
 
 N_VARS = (10, 30, 100, 300, 1000)

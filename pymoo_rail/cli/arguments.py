@@ -53,12 +53,16 @@ def _parsed(text: str, kind: type, what: str):
         raise argparse.ArgumentTypeError(f"invalid {what}: {text!r}") from None
 
 
+def _int_at_least(text: str, least: int) -> int:
+    value = _parsed(text, int, "integer")
+    if value < least:
+        raise argparse.ArgumentTypeError(f"must be at least {least}, got {value}")
+    return value
+
+
 def positive_int(text: str) -> int:
     """argparse type: an integer of at least 1."""
-    value = _parsed(text, int, "integer")
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
-    return value
+    return _int_at_least(text, 1)
 
 
 def positive_float(text: str) -> float:
@@ -71,10 +75,7 @@ def positive_float(text: str) -> float:
 
 def random_seed(text: str) -> int:
     """argparse type: a random seed, an integer >= 0."""
-    value = _parsed(text, int, "integer")
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {value}")
-    return value
+    return _int_at_least(text, 0)
 
 
 def out_dir(value: str) -> Path:

@@ -29,9 +29,10 @@ from pymoo.optimize import minimize
 from pymoo_rail.experiments.fronts import choose_member, distinct_front
 from pymoo_rail.experiments.penalty import PenalisedConstraints, handles_constraints
 from pymoo_rail.optimal import optimal_profile
-from pymoo_rail.problems import reference as certified
+from pymoo_rail.optimal.reference import NoExactFrontError
 from pymoo_rail.problems.encodings import decision_columns
 from pymoo_rail.problems.objectives import time_objectives
+from pymoo_rail.problems.reference import mirrored
 
 DEFAULT_TIME_TOLERANCE_S = 1.0
 """How close to the planned time a member counts as punctual when the problem has no tolerance (s)."""
@@ -212,13 +213,13 @@ def optimum_at(problem, trajectory, reference: bool = True) -> Optimum:
         return Optimum("optimum: skipped (--no-reference)")
     try:
         front = problem.certified_front()
-    except certified.NoExactFrontError as err:
+    except NoExactFrontError as err:
         return Optimum(f"optimum: none certified for this form ({str(err).split('no exact front: ')[-1]})")
     except (RuntimeError, ValueError) as err:  # the solver could not meet one of the front's running times
         return _without_front(problem, trajectory, err)
     front_F = None
     if problem.n_obj == 2:
-        front_F, _ = certified.mirrored(front, problem.objectives, 200, problem.time_window_s)
+        front_F, _ = mirrored(front, problem.objectives, 200, problem.time_window_s)
     lo, hi = front.time_range_s
     t = trajectory.running_time_s
     if not lo <= t <= hi:

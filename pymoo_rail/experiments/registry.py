@@ -207,11 +207,17 @@ def _ref_dirs(n_obj: int, n_points: int):
     return get_reference_directions("energy", n_obj, n_points, seed=1)
 
 
-@_forwards("pymoo.algorithms.moo.nsga2", "NSGA2")
-def _nsga2(problem, **params):
-    from pymoo.algorithms.moo.nsga2 import NSGA2
+def _pymoo_algorithm(module: str, name: str, *also: str) -> Callable[..., Any]:
+    """The factory of pymoo's ``module.name`` built from its keywords alone (``also``: classes they reach too)."""
+    @_forwards(module, name, *also)
+    def factory(problem, **params):
+        return getattr(importlib.import_module(module), name)(**params)
 
-    return NSGA2(**params)
+    factory.__doc__ = f"pymoo's {name} (keyword arguments go to {module}.{name})."
+    return factory
+
+
+_nsga2 = _pymoo_algorithm("pymoo.algorithms.moo.nsga2", "NSGA2")
 
 
 @_forwards("pymoo.algorithms.moo.nsga3", "NSGA3")
@@ -230,39 +236,11 @@ def _moead(problem, pop_size: int = 100, n_neighbors: int = 20, **params):
     return MOEAD(ref_dirs=ref_dirs, n_neighbors=min(n_neighbors, len(ref_dirs)), **params)
 
 
-@_forwards("pymoo.algorithms.moo.sms", "SMSEMOA")
-def _smsemoa(problem, **params):
-    from pymoo.algorithms.moo.sms import SMSEMOA
-
-    return SMSEMOA(**params)
-
-
-@_forwards("pymoo.algorithms.moo.age", "AGEMOEA")
-def _agemoea(problem, **params):
-    from pymoo.algorithms.moo.age import AGEMOEA
-
-    return AGEMOEA(**params)
-
-
-@_forwards("pymoo.algorithms.soo.nonconvex.de", "DE", "Variant")  # DE hands its keywords to its variant too
-def _de(problem, **params):
-    from pymoo.algorithms.soo.nonconvex.de import DE
-
-    return DE(**params)
-
-
-@_forwards("pymoo.algorithms.soo.nonconvex.pso", "PSO")
-def _pso(problem, **params):
-    from pymoo.algorithms.soo.nonconvex.pso import PSO
-
-    return PSO(**params)
-
-
-@_forwards("pymoo.algorithms.soo.nonconvex.ga", "GA")
-def _ga(problem, **params):
-    from pymoo.algorithms.soo.nonconvex.ga import GA
-
-    return GA(**params)
+_smsemoa = _pymoo_algorithm("pymoo.algorithms.moo.sms", "SMSEMOA")
+_agemoea = _pymoo_algorithm("pymoo.algorithms.moo.age", "AGEMOEA")
+_de = _pymoo_algorithm("pymoo.algorithms.soo.nonconvex.de", "DE", "Variant")  # DE hands its keywords to its variant too
+_pso = _pymoo_algorithm("pymoo.algorithms.soo.nonconvex.pso", "PSO")
+_ga = _pymoo_algorithm("pymoo.algorithms.soo.nonconvex.ga", "GA")
 
 
 def _rail_algorithm(name: str, module: str) -> Any:

@@ -30,7 +30,7 @@ from pymoo_rail.journeys.fronts import (
 )
 from pymoo_rail.journeys.journey import Journey, as_journey
 from pymoo_rail.model import Case, CaseError, InfeasibleCaseError
-from pymoo_rail.problems.reference import case_hash
+from pymoo_rail.optimal.reference import case_hash
 from pymoo_rail.rowcache import RowCache
 from pymoo_rail.sim import Simulator
 
@@ -112,7 +112,7 @@ def section_fronts(journey: Journey | Case, fronts: FrontSource = DEFAULT_FRONT_
         ``case -> running times`` for a callable source, replacing that default grid.
     cache_path : path, optional
         A CSV file of finished section fronts (:class:`pymoo_rail.rowcache.RowCache`). A section is
-        read back only under the same key: its content (:func:`~pymoo_rail.problems.reference.case_hash`,
+        read back only under the same key: its content (:func:`~pymoo_rail.optimal.reference.case_hash`,
         so a renamed section keeps its front and a changed one under the same name is computed
         anew), the version of the source (``pymoo_rail.optimal.solver.SOLVER_VERSION``,
         :data:`~pymoo_rail.journeys.fronts.STRATEGY_VERSION`, both for ``"combined"``; a callable is

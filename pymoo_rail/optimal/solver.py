@@ -48,8 +48,8 @@ from pymoo_rail.sim import Simulator, Trajectory
 SOLVER_VERSION = "2"
 """Version of the solver's answers: bump it whenever a run the solver returns for a case can change
 (DP, search, certificate, or the simulator that replays the run), so on-disk caches of its runs
-(:func:`pymoo_rail.problems.reference.exact_points`, :func:`pymoo_rail.journeys.section_fronts`)
-stop serving the old rows; bump ``pymoo_rail.problems.reference.FRONT_VERSION`` with it.
+(:func:`pymoo_rail.optimal.reference.exact_points`, :func:`pymoo_rail.journeys.section_fronts`)
+stop serving the old rows; bump ``pymoo_rail.optimal.reference.FRONT_VERSION`` with it.
 1: the solver of front versions 5 and 6 (rows cached before carried no version); 2: the singular speeds
 as states and the end speed an equality (the shipped fronts of version 6, rest to rest, move by at
 most 0.0045 kWh, 0.005 %, within their certificates: not recomputed)."""

@@ -190,7 +190,7 @@ class SpeedProfileProblem(Problem):
     time_window_s : (float, float) or "default", optional
         Adds the constraint ``lo <= T <= hi`` on the running time: keeps a Pareto front on the
         times a timetable planner would use. ``"default"`` is
-        :func:`pymoo_rail.problems.reference.default_window` (0.5 % above the minimum running
+        :func:`pymoo_rail.optimal.reference.default_window` (0.5 % above the minimum running
         time to 1.3 x the planned time), the range the certified front covers.
     weights : sequence of float, optional
         One weight per objective: minimise ``sum w_i f_i / scale_i`` (a single objective).
@@ -342,7 +342,7 @@ class SpeedProfileProblem(Problem):
         if isinstance(window, str):
             if window != "default":
                 raise ValueError(f"time_window_s = {window!r}: give (lo, hi) in seconds or 'default'")
-            from pymoo_rail.problems.reference import default_window
+            from pymoo_rail.optimal.reference import default_window
 
             return default_window(self.min_running_time_s, case.planned_time_s)
         try:
@@ -358,17 +358,17 @@ class SpeedProfileProblem(Problem):
 
     # ------------------------------------------------------------------ known front
     def certified_front(self):
-        """The case's certified energy / running-time front (:mod:`pymoo_rail.problems.reference`).
+        """The case's certified energy / running-time front (:mod:`pymoo_rail.optimal.reference`).
 
         Computed once per case content by the exact solver and cached on disk; raises
-        :class:`~pymoo_rail.problems.reference.NoExactFrontError` for forms that have none.
+        :class:`~pymoo_rail.optimal.reference.NoExactFrontError` for forms that have none.
         """
-        from pymoo_rail.problems import reference
+        from pymoo_rail.optimal import reference as certified
 
         reason = self._no_exact_front_reason()
         if reason:
-            raise reference.NoExactFrontError(f"{self.describe()}: no exact front: {reason}")
-        return reference.certified_front(self.case, self.simulator.grid.dx_m)
+            raise certified.NoExactFrontError(f"{self.describe()}: no exact front: {reason}")
+        return certified.certified_front(self.case, self.simulator.grid.dx_m)
 
     def _no_exact_front_reason(self) -> str:
         if self.tracker is not None:
@@ -395,11 +395,12 @@ class SpeedProfileProblem(Problem):
         ``pareto_front(n_pareto_points=n)`` at most ``n`` evenly spaced points (fewer where some are
         dominated). pymoo caches the first answer: pass ``use_cache=False`` to ask again with another ``n``.
         """
+        from pymoo_rail.optimal import reference as certified
         from pymoo_rail.problems import reference
 
         front = self.certified_front()
         if len(self.objectives) == 1:
-            energy, _, _ = reference.constrained_optimum(front, self.time_tolerance_s, window_s=self.time_window_s)
+            energy, _, _ = certified.constrained_optimum(front, self.time_tolerance_s, window_s=self.time_window_s)
             return np.array([[energy]])
         if n_pareto_points is not None and (isinstance(n_pareto_points, bool)
                                             or not isinstance(n_pareto_points, (int, np.integer))

@@ -8,7 +8,7 @@
 See ``docs/suite.md`` for the problems, how their fronts were computed and how exact they are.
 """
 
-from pymoo_rail.problems.reference import CertifiedFront, NoExactFrontError
+from pymoo_rail.optimal.reference import CertifiedFront, NoExactFrontError
 from pymoo_rail.suite.families import (
     FAMILIES,
     FAMILY_VERSION,

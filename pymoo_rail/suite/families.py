@@ -2,13 +2,13 @@
 
 A family draws its line with :func:`pymoo_rail.cases.generate_case` (``seed`` and the family's kind
 of service) and cuts it into equal sections, one speed code each, as many as ``n_var`` asks. The
-certified front is the case's (:func:`pymoo_rail.problems.reference.certified_front`): the least
+certified front is the case's (:func:`pymoo_rail.optimal.reference.certified_front`): the least
 energy at each running time is a property of the train on the line, whatever the sections, so
 every dimension of an instance has the same known front, computed once per line by the exact
 solver and cached on disk under the case's content hash.
 
 - ``generated-<kind>-bi``: net energy (kWh) and running time (s) inside the planner's window
-  (:func:`pymoo_rail.problems.reference.default_window`), ``n_var`` speed codes (km/h).
+  (:func:`pymoo_rail.optimal.reference.default_window`), ``n_var`` speed codes (km/h).
 - ``generated-<kind>-single``: net energy under ``|T - T_plan| <= 1 %`` of the planned time (at least
   1 s), paced speed codes: ``n_var - 1`` shapes and the running time (s); its optimum is certified.
 
@@ -27,7 +27,7 @@ import numpy as np
 from pymoo_rail.cases import KINDS, generate_case
 from pymoo_rail.model import Case
 from pymoo_rail.problems import SpeedProfileProblem
-from pymoo_rail.problems.reference import FRONT_VERSION, NoExactFrontError, case_hash
+from pymoo_rail.optimal.reference import FRONT_VERSION, NoExactFrontError, case_hash, default_window
 from pymoo_rail.suite import problems as named
 from pymoo_rail.suite.identity import as_text, checksum_of
 from pymoo_rail.suite.trips import TripProblem, trip_problem
@@ -160,8 +160,6 @@ class FamilyProblem(SpeedProfileProblem):
     @property
     def bi_window_s(self) -> tuple[float, float]:
         """The planner's running-time window of the case (the bi-objective form's constraint)."""
-        from pymoo_rail.problems.reference import default_window
-
         return default_window(self.min_running_time_s, self.case.planned_time_s)
 
 

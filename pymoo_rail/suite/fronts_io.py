@@ -1,7 +1,7 @@
 """The suite's shipped fronts: verification against a fresh solve, and best-known fronts.
 
 Certified fronts are shipped in ``pymoo_rail/suite/fronts/<case>-<key>.csv`` (the key holds the
-case's content hash, see :mod:`pymoo_rail.problems.reference`), so ``pareto_front()`` of a suite
+case's content hash, see :mod:`pymoo_rail.optimal.reference`), so ``pareto_front()`` of a suite
 problem reads them instead of solving. :func:`verify` solves again and fails on any drift beyond
 the certificate. Forms without an exact front (``metro-a-4obj``) ship a *best-known* front: the
 non-dominated union of long optimiser runs, labelled as such and versioned.
@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.atomic import atomic_write_text
-from pymoo_rail.problems import reference
+from pymoo_rail.optimal import reference
 from pymoo_rail.suite.problems import CASES, METRO_4OBJ, METRO_4OBJ_OBJECTIVES, get_problem
 
 BEST_KNOWN_VERSION = "3"
@@ -165,6 +165,5 @@ def compute_best_known_front(name: str = METRO_4OBJ, seeds=BEST_KNOWN_SEEDS, pop
              f"encoding {problem.encoding.name}); not certified")
     table.attrs.update(label=label, version=BEST_KNOWN_VERSION, **best_known_key(problem), runs=2 * len(seeds))
     if write:
-        header = "".join(f"# {k}: {v}\n" for k, v in table.attrs.items())
-        atomic_write_text(best_known_path(name), header + table.to_csv(index=False, float_format="%.9g"))
+        atomic_write_text(best_known_path(name), reference.commented_csv_text(table.attrs, table))
     return table

@@ -1,7 +1,7 @@
 """The named problems of the benchmark suite: which case, which form, which encoding.
 
 Every case gives two problems: ``<case>-bi``, energy and running time inside the planner's
-running-time window (:func:`pymoo_rail.problems.reference.default_window`), whose Pareto front is
+running-time window (:func:`pymoo_rail.optimal.reference.default_window`), whose Pareto front is
 the certified front of the exact solver; and ``<case>-single``, energy under
 ``|T - T_plan| <= 1 % of T_plan`` (at least 1 s), whose optimum is the front's least energy in that
 window; its decisions are paced speed codes (a shape per section and the running time inside the
@@ -20,11 +20,11 @@ from functools import lru_cache
 from pymoo_rail.cases import load_case
 from pymoo_rail.model import Case
 from pymoo_rail.problems.encodings import encoding_settings
-from pymoo_rail.problems.reference import PUNCTUAL_TOLERANCE_REL, punctual_tolerance_s
+from pymoo_rail.optimal.reference import PUNCTUAL_TOLERANCE_REL, punctual_tolerance_s
 
 TOLERANCE_REL = PUNCTUAL_TOLERANCE_REL
 """Running-time tolerance of the single-objective forms, relative to the planned time (the fronts'
-punctuality window, :data:`pymoo_rail.problems.reference.PUNCTUAL_TOLERANCE_REL`)."""
+punctuality window, :data:`pymoo_rail.optimal.reference.PUNCTUAL_TOLERANCE_REL`)."""
 SECTIONS_PER_LINE = 12
 """Speed-code sections of a suite problem: gradient/limit sections split to at most length / 12."""
 
@@ -141,7 +141,7 @@ def get_problem(name: str, **kwargs):
     SpeedProfileProblem
         With ``suite_name`` and ``suite_version`` (:data:`SUITE_VERSION`) set.
         ``problem.pareto_front()`` is the certified front (``-bi``), the certified optimum
-        (``-single``); ``metro-a-4obj`` raises :class:`~pymoo_rail.problems.reference.NoExactFrontError`
+        (``-single``); ``metro-a-4obj`` raises :class:`~pymoo_rail.optimal.reference.NoExactFrontError`
         and :func:`pymoo_rail.suite.best_known_front` gives its best-known front.
     """
     from pymoo_rail.problems import SpeedProfileProblem

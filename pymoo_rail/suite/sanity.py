@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pymoo_rail.problems.reference import NoExactFrontError
+from pymoo_rail.optimal.reference import NoExactFrontError
 from pymoo_rail.suite.fronts_io import best_known_front
 from pymoo_rail.suite.problems import get_problem
 

@@ -20,7 +20,7 @@ import pandas as pd
 from pymoo_rail.cases import generate_case
 from pymoo_rail.journeys import RunningTimeAllocationProblem, allocate_on_fronts, front_energy, strategy_front
 from pymoo_rail.model import Case
-from pymoo_rail.problems.reference import case_hash
+from pymoo_rail.optimal.reference import case_hash
 from pymoo_rail.suite.identity import as_text
 
 POOL_SIZE = 8

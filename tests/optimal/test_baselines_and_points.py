@@ -10,7 +10,7 @@ import pytest
 
 from pymoo_rail.optimal.baselines import strategy_baselines
 from pymoo_rail.problems import SpeedProfileProblem
-from pymoo_rail.problems.reference import exact_points
+from pymoo_rail.optimal.reference import exact_points
 
 PLANNED_S = 150.0  # Liu (2019) 5.1.1: Tongjinan Rd -> Jinghai Rd
 

@@ -5,7 +5,7 @@ import pytest
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.problems import SpeedProfileProblem
-from pymoo_rail.problems.reference import constrained_optimum
+from pymoo_rail.optimal.reference import constrained_optimum
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.pacing import DEFAULT_TIME_TOL_S
 

@@ -11,7 +11,8 @@ from pymoo.util.display.output import pareto_front_if_possible
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.problems import SpeedProfileProblem
-from pymoo_rail.problems import reference as ref
+from pymoo_rail.optimal import reference as ref
+from pymoo_rail.optimal.reference import compute, store
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +21,7 @@ def cache(tmp_path_factory):
     path = tmp_path_factory.mktemp("front-cache")
     mp = pytest.MonkeyPatch()
     mp.setenv(ref.CACHE_ENV, str(path))
-    mp.setattr(ref, "SHIPPED_DIR", path / "none")
+    mp.setattr(store, "SHIPPED_DIR", path / "none")
     ref.forget_fronts()
     yield path
     ref.forget_fronts()
@@ -158,7 +159,7 @@ def test_a_damaged_cached_front_is_set_aside_and_computed_again(cache, metro, da
     shipped = cache / "shipped"
     shipped.mkdir(exist_ok=True)
     (shipped / path.name).write_text(not_a_number)
-    monkeypatch.setattr(ref, "SHIPPED_DIR", shipped)
+    monkeypatch.setattr(store, "SHIPPED_DIR", shipped)
     ref.forget_fronts()
     with pytest.raises(ValueError, match=f"{path.name}: column 'energy_kwh'"):
         ref.certified_front(metro, n_times=5)
@@ -179,7 +180,7 @@ def test_front_computation_reports_progress_and_is_quiet_off_a_terminal(cache, m
     ref.certified_front(metro, 1.0, 5, use_cache=False)
     assert capsys.readouterr().err == ""
     # forced on, with the bar's delay at 0 s: the bar names the case and counts the solves
-    monkeypatch.setattr(ref, "PROGRESS_DELAY_S", 0.0)
+    monkeypatch.setattr(compute, "PROGRESS_DELAY_S", 0.0)
     ref.certified_front(metro, 1.0, 5, use_cache=False, progress=True)
     err = capsys.readouterr().err
     assert "certified front of metro-a" in err and f"{total}/{total}" in err

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from pymoo_rail.journeys import front_energy, project_to_budget
-from pymoo_rail.problems import reference as ref
+from pymoo_rail.optimal import reference as ref
 from pymoo_rail.suite import FAMILY_VERSION, get_problem, list_families, list_problems
 from pymoo_rail.suite.families import definition, instance_name
 

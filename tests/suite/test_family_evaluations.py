@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from pymoo_rail.problems import reference as ref
+from pymoo_rail.optimal import reference as ref
 from pymoo_rail.suite import get_problem
 from pymoo_rail.suite.evaluations import (
     REFERENCE_DIMENSIONS,

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from pymoo.util.nds.non_dominated_sorting import find_non_dominated
 
-from pymoo_rail.problems import reference as ref
+from pymoo_rail.optimal import reference as ref
+from pymoo_rail.optimal.reference import store
 from pymoo_rail.suite import CASES, NoExactFrontError, best_known_front, get_problem, list_problems
 from pymoo_rail.suite.problems import tolerance_s
 from pymoo_rail.suite.sanity import nsga2_against_random
@@ -45,7 +46,7 @@ def test_pareto_front_is_read_not_solved(monkeypatch):
     def no_solver(*args, **kwargs):
         raise AssertionError("the solver ran although the front is shipped")
 
-    monkeypatch.setattr(ref, "compute_front", no_solver)
+    monkeypatch.setattr(store, "compute_front", no_solver)
     ref.forget_fronts()
     problem = get_problem("metro-a-bi")
     pf = problem.pareto_front()
@@ -106,7 +107,7 @@ def test_single_form_optimum_is_a_solved_node(name):
 @pytest.mark.parametrize("name", list_problems())
 def test_every_problem_nsga2_beats_random_sampling(name, seed):
     """The done-when sweep: every suite problem and seeds 1-5, NSGA2(100, 200 generations) against random
-    sampling of the same budget (the sum of the per-case CPU times of `benchmarks/suite.py --sanity --seeds 5`
+    sampling of the same budget (the sum of the per-case CPU times of `suite_report.sanity_table(seeds=5)`
     is in docs/suite.md)."""
     result = nsga2_against_random(name, seed=seed)
     assert np.isfinite(result.igd_nsga2) and result.igd_nsga2 < result.igd_random, result

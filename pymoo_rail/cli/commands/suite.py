@@ -21,7 +21,7 @@ def add_parser(sub) -> None:
 
 
 def _list() -> int:
-    from pymoo_rail.problems.reference import find_front
+    from pymoo_rail.optimal.reference import find_front
     from pymoo_rail.suite import list_problems, suite_case
     from pymoo_rail.suite.problems import split
 
