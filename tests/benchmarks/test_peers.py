@@ -49,7 +49,9 @@ def test_cpu_breakdown_finds_the_solvers_kernels():
     """Every part is measured (a renamed kernel would read as 0 s) and the parts add up to the whole."""
     b = _script().cpu_breakdown("yizhuang", 150.0)
     assert b["tables_s"] > 0.0 and b["sweeps_s"] > 0.0 and b["forward_runs_s"] > 0.0
-    assert b["forward_runs"] == b["sweeps"] >= 3  # one per solve: the search's, the half grid's, the untied run's
+    # a forward run per solve (the search's, the half grid's, the untied run's); a sweep per solve but the
+    # untied run's where it reuses the chosen run's (same price)
+    assert b["forward_runs"] >= 3 and b["forward_runs"] - 1 <= b["sweeps"] <= b["forward_runs"]
     assert 0.0 <= b["rest_s"] < b["cpu_s"]
 
 
