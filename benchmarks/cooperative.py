@@ -11,15 +11,22 @@ Each run is compared with the exact uncoordinated baseline at its phi (``exact_b
 train exactly optimal alone, recomputed here: about a CPU second each): median, IQR and a one-sample
 Wilcoxon signed-rank test. The report also shows, from the kernel's traces, how much regenerated
 energy there is to share at each offset. Records: ``--work`` (a second invocation skips finished
-runs); report: ``<--out>/cooperative.md``.
+runs); report: ``<--out>/cooperative.md``. The offsets study's seeds 1-10 at x = -45 s are the user's
+call of docs/cooperative.md (``minimize(CooperativeTrainsProblem(case, offset_s=-45), GA(pop_size=60),
+("n_eval", 6000), seed=s)``).
+
+``--nested OUTER_POP OUTER_GEN`` runs instead the nested GA of the paper once (``nested_minimize``,
+inner GA 100 x 80, seed 1) after timing one evaluation, and writes ``<--out>/cooperative_nested.md``.
 
 Usage: ``python benchmarks/cooperative.py [--seeds 15] [--phis 0.7,0.4,0] [--phi-seeds 15] [--workers 2]``
-(set ``NUMBA_NUM_THREADS=1`` when the pool has several workers).
+(set ``NUMBA_NUM_THREADS=1`` when the pool has several workers), ``python benchmarks/cooperative.py
+--nested 8 6 --offset 45``.
 """
 
 from __future__ import annotations
 
 import argparse
+import time
 from pathlib import Path
 
 import numpy as np
@@ -28,16 +35,17 @@ import pandas as pd
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments import load_results, run_study
 from pymoo_rail.experiments.cooperative import (
+    best_clocked_runs,
     exact_baselines,
     offsets_study,
-    problem_label,
     savings_table,
     sharing_potential,
 )
-from pymoo_rail.experiments.report import add_study_options, lower_priority
+from pymoo_rail.experiments.report import add_study_options, lower_priority, write_report
 from pymoo_rail.problems import CooperativeTrainsProblem
 from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S
-from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem
+from pymoo_rail.problems.cooperative_baseline import exact_baseline
+from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem, nested_minimize
 
 REPORTS = Path(__file__).parent / "reports"
 # the earlier model (the paper's subsection encoding on its own integrator, DE with the punctuality
@@ -62,27 +70,17 @@ def savings_lines(table: pd.DataFrame) -> list[str]:
     return lines
 
 
-def best_runs(results: pd.DataFrame, x: float, label: str, make_problem) -> list:
-    """The clocked runs of the best stored result at offset x (none if the study has no such run)."""
-    sel = results[results["problem"] == problem_label(1.0, x)] if results is not None else []
-    if len(sel) == 0:
-        return []
-    best = sel.iloc[int(np.argmin([float(np.min(F[:, 0])) for F in sel["F"]]))]
-    x_best = np.asarray(best["X"])[int(np.argmin(best["F"][:, 0]))]
-    return [(label, make_problem(x).simulate(x_best[None, :])["clocked"][0])]
-
-
 def potential_lines(results: pd.DataFrame, paper_results, base) -> list[str]:
     """Regenerated energy per train and offset, from the traces of the exact runs and of the best GA runs."""
     case = load_case("cooperative-pair")
     lines = ["| x (s) | runs | A regenerates (kWh, when on the clock) | of it while B moves | B regenerates | "
              "of it while A moves | shared |", "|---|---|---|---|---|---|---|"]
     for x in SEED_001_OFFSETS_S:
-        candidates = [("exact, alone", base.clocked_pair(x))]
-        candidates += best_runs(results, x, "best GA, speed codes", lambda o: CooperativeTrainsProblem(case, o))
-        candidates += best_runs(paper_results, x, "best GA, paper's encoding",
-                                lambda o: CooperativeSeedProblem(case, o))
-        for label, runs in candidates:
+        candidates = [("exact, alone", base.clocked_pair(x)),
+                      ("best GA, speed codes", best_clocked_runs(results, x, lambda o: CooperativeTrainsProblem(case, o))),
+                      ("best GA, paper's encoding",
+                       best_clocked_runs(paper_results, x, lambda o: CooperativeSeedProblem(case, o)))]
+        for label, runs in [(label, runs) for label, runs in candidates if runs is not None]:
             pot = sharing_potential(runs)
             a, b = pot.iloc[0], pot.iloc[1]
             lines.append(f"| {x:+g} | {label} | {a.regen_kwh:.2f} ({a.braking_from_s:.0f}-{a.braking_to_s:.0f} s) | "
@@ -92,31 +90,27 @@ def potential_lines(results: pd.DataFrame, paper_results, base) -> list[str]:
     return lines
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", type=int, default=15)
-    parser.add_argument("--phis", default="0.7,0.4,0")
-    parser.add_argument("--phi-seeds", type=int, default=15)
-    parser.add_argument("--paper-seeds", type=int, default=0,
-                        help="also the same GA call on the paper's encoding (CooperativeSeedProblem), this many seeds")
-    parser.add_argument("--workers", type=int, default=2)
-    add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "cooperative_study", REPORTS)
-    args = parser.parse_args()
-    lower_priority()
-    phis = [float(p) for p in args.phis.split(",") if p.strip()]
-
+def run_studies(args, phis: list[float]):
+    """Run (or, with ``--report-only``, read) the offsets, gradient and paper-encoding studies."""
     studies = [(offsets_study("cooperative_offsets", [1.0], args.seeds), args.work / "offsets")]
     if phis and args.phi_seeds > 0:
         studies.append((offsets_study("cooperative_gradients", phis, args.phi_seeds), args.work / "gradients"))
-    paper = (offsets_study("cooperative_paper_encoding", [1.0], args.paper_seeds, paper_encoding=True),
-             args.work / "paper_encoding")
-    for study, directory in studies + ([paper] if args.paper_seeds > 0 else []):
+    paper_dir = args.work / "paper_encoding"
+    paper = [(offsets_study("cooperative_paper_encoding", [1.0], args.paper_seeds, paper_encoding=True), paper_dir)
+             ] if args.paper_seeds > 0 else []  # a study needs a seed
+    for study, directory in studies + paper:
         if not args.report_only:
             run_study(study, directory, workers=args.workers, seed_major=True)
-    results = pd.concat([load_results(d) for _, d in studies if d.exists()], ignore_index=True)
-    baselines = exact_baselines(load_case("cooperative-pair"), [1.0] + phis)
+    missing = [str(d) for _, d in studies if not d.exists()]
+    if missing:
+        raise SystemExit(f"no study records in {', '.join(missing)}: run without --report-only first")
+    results = pd.concat([load_results(d) for _, d in studies], ignore_index=True)
+    return results, (load_results(paper_dir) if paper_dir.exists() else None)
+
+
+def report_lines(results, paper_results, baselines) -> list[str]:
+    """The report: savings per (phi, offset), the baselines, what there is to share, the paper's encoding."""
     table = savings_table(results, baselines)
-    paper_results = load_results(paper[1]) if paper[1].exists() else None
     paper_table = savings_table(paper_results, {1.0: baselines[1.0]}) if paper_results is not None else None
     lines = ["# Two trains sharing braking energy (Chen et al. 2017): statistics over seeds", "",
              "Generated by `benchmarks/cooperative.py` from the study records in `out/cooperative_study/` (not tracked). "
@@ -145,15 +139,66 @@ def main() -> None:
                   "`GA(pop_size=60)` and 6000 evaluations, against the same exact baseline.", ""]
         lines += savings_lines(paper_table)
         lines += ["", f"CPU time of these runs: {paper_table['cpu_s'].sum():.0f} s."]
-    lines += ["", "The study records are not kept in the repository (`benchmarks/reports` keeps numbers only): "
-              "`python benchmarks/cooperative.py --paper-seeds 15` recomputes them, seeded, with the same results "
-              "(about 24 CPU minutes).",
-              "How these compare with the earlier model and with the paper: `docs/cooperative.md`.",
-              "A row with fewer seeds than asked for comes from a study stopped early (`--report-only`).", ""]
-    text = "\n".join(lines)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "cooperative.md").write_text(text)
-    print(text)
+    return lines + ["", "The study records are not kept in the repository (`benchmarks/reports` keeps numbers only): "
+                    "`python benchmarks/cooperative.py --paper-seeds 15` recomputes them, seeded, with the same results "
+                    "(about 24 CPU minutes).",
+                    "How these compare with the earlier model and with the paper: `docs/cooperative.md`.",
+                    "A row with fewer seeds than asked for comes from a study stopped early (`--report-only`).", ""]
+
+
+def nested_lines(args, case) -> list[str]:
+    """The nested GA of Chen et al. (2017), once, at ``--nested OUTER_POP OUTER_GEN`` (inner GA 100 x 80)."""
+    outer_pop, outer_gen = args.nested
+    problem = CooperativeSeedProblem(case, args.offset)
+    X = problem.xl + np.random.default_rng(0).random((100, problem.n_var)) * (problem.xu - problem.xl)
+    problem.evaluate(X[:2])  # compile first
+    start = time.process_time()
+    for _ in range(3):
+        problem.evaluate(X)
+    per_eval_s = (time.process_time() - start) / (3 * X.shape[0])
+    paper, asked = 24 * 20 * 100 * 80, outer_pop * outer_gen * 100 * 80  # pymoo's GA: pop_size per generation
+    base, start = exact_baseline(case), time.process_time()
+    x, f, _ = nested_minimize(problem, outer_pop_size=outer_pop, outer_n_gen=outer_gen, seed=1, verbose=True)
+    cpu_s, sol = time.process_time() - start, problem.decode(x)
+    return ["# The nested GA of Chen et al. (2017), once", "",
+            f"Generated by `python benchmarks/cooperative.py --nested {outer_pop} {outer_gen} --offset {args.offset:g}` "
+            f"(`CooperativeSeedProblem(load_case(\"cooperative-pair\"), {args.offset:g})`, `nested_minimize`).", "",
+            f"- size: outer GA {outer_pop} x {outer_gen} on the braking distances, inner GA 100 x 80: {asked:,} "
+            f"evaluations; {cpu_s / 60:.1f} CPU min (one evaluation {1e3 * per_eval_s:.2f} ms CPU measured before "
+            "the run)",
+            f"- the paper's size (24 x 20, 100 x 80) is {paper:,} evaluations, estimated {paper * per_eval_s / 60:.0f} "
+            f"CPU min: `python benchmarks/cooperative.py --nested 24 20 --offset {args.offset:g}`",
+            f"- result: {f:.3f} kWh (traction A {sol.traction_a_kwh:.3f} + B {sol.traction_b_kwh:.3f} - shared "
+            f"{sol.shared_kwh:.3f}), feasible: {sol.feasible}, constraints "
+            + ", ".join(f"{k} {v:.3g}" for k, v in sol.constraints.items()),
+            f"- exact uncoordinated baseline {base.energy_kwh:.3f} kWh: saving {100 * (1 - f / base.energy_kwh):.2f} %",
+            f"- braking distances: A {x[problem.brake_columns[0]]:.1f} m, B {x[problem.brake_columns[1]]:.1f} m", ""]
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=15)
+    parser.add_argument("--phis", default="0.7,0.4,0")
+    parser.add_argument("--phi-seeds", type=int, default=15)
+    parser.add_argument("--paper-seeds", type=int, default=0,
+                        help="also the same GA call on the paper's encoding (CooperativeSeedProblem), this many seeds")
+    parser.add_argument("--nested", type=int, nargs=2, metavar=("OUTER_POP", "OUTER_GEN"),
+                        help="instead: the paper's nested GA once (inner GA 100 x 80), report cooperative_nested.md")
+    parser.add_argument("--offset", type=float, default=45.0, help="offset of the --nested run (s)")
+    parser.add_argument("--workers", type=int, default=2)
+    add_study_options(parser, Path(__file__).resolve().parents[1] / "out" / "cooperative_study", REPORTS)
+    args = parser.parse_args(argv)
+    lower_priority()
+    case = load_case("cooperative-pair")
+    if args.nested:
+        path, lines = args.out / "cooperative_nested.md", nested_lines(args, case)
+    else:
+        phis = [float(p) for p in args.phis.split(",") if p.strip()]
+        results, paper_results = run_studies(args, phis)
+        path, lines = args.out / "cooperative.md", report_lines(results, paper_results,
+                                                                 exact_baselines(case, [1.0] + phis))
+    write_report(path, lines, newline=False)
+    print("\n".join(lines))
 
 
 if __name__ == "__main__":

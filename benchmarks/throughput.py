@@ -15,25 +15,35 @@ Prints, measured in this one run:
 5. the done-when lines: <= 20 ns per cell per core, >= 1.7x on 2 threads at population >= 200,
    MOABC <= 0.3 s.
 
+``--jit`` measures instead the batch kernel (yizhuang, 200 speed-code programs) against the same
+code without JIT (``NUMBA_DISABLE_JIT=1``), and the first call with an empty and a warm Numba cache,
+each in a child process of this script.
+
 Wall-clock ratios are only meaningful on a quiet machine: the script prints the load average
 next to them. CPU time per cell is not distorted by other load (as long as the core is not
 shared with a sibling thread). Every timing is the minimum over ``--repeats`` rounds.
 
-Usage: ``python benchmarks/throughput.py [--repeats 5] [--quick]``
+Usage: ``python benchmarks/throughput.py [--repeats 5] [--quick]``, ``python benchmarks/throughput.py --jit``
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
+import subprocess
+import sys
+import tempfile
 import time
 
 import numba
 import numpy as np
+import pandas as pd
 from numba import njit
 
 from pymoo_rail.cases import load_case
+from pymoo_rail.experiments.report import markdown
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.simulator import PARALLEL_MIN_CELLS
@@ -182,63 +192,96 @@ def moabc_row(threads: int) -> dict:
     return row
 
 
-def main() -> None:
+def jit_worker(repeats: int) -> dict:
+    """Time ``run_batch`` in this process (JIT state from the environment): rate, CPU per run, first call."""
+    t0 = time.perf_counter()
+    problem = SpeedProfileProblem(load_case("yizhuang"))
+    sim, programs = problem.simulator, _programs(problem, 200)
+    sim.run_batch(programs[:2])  # compile or load from cache
+    first_call_s = time.perf_counter() - t0
+    t1, c1 = time.perf_counter(), time.process_time()
+    for _ in range(repeats):
+        sim.run_batch(programs)
+    return {"evals_per_s": 200 * repeats / (time.perf_counter() - t1),
+            "cpu_us_per_eval": 1e6 * (time.process_time() - c1) / (200 * repeats), "first_call_s": first_call_s}
+
+
+def jit_rows(repeats: int) -> list[str]:
+    """The kernel with an empty and a warm cache, and without JIT (one repeat: pure Python is slow)."""
+    def child(n: int, **env) -> dict:
+        out = subprocess.run([sys.executable, __file__, "--jit-worker", "--repeats", str(n)], env=dict(os.environ, **env),
+                             check=True, capture_output=True, text=True)
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    with tempfile.TemporaryDirectory() as cache:
+        cold, warm = child(repeats, NUMBA_CACHE_DIR=cache), child(repeats, NUMBA_CACHE_DIR=cache)
+    nojit = child(1, NUMBA_DISABLE_JIT="1")
+    return [f"yizhuang, population 200: {warm['evals_per_s']:.1f} evaluations/s JIT, {nojit['evals_per_s']:.1f} without",
+            f"speed-up: wall clock {warm['evals_per_s'] / nojit['evals_per_s']:.1f}x, CPU time per evaluation "
+            f"{nojit['cpu_us_per_eval'] / warm['cpu_us_per_eval']:.1f}x ({warm['cpu_us_per_eval']:.1f} us JIT, all "
+            f"threads; {nojit['cpu_us_per_eval']:.1f} us without)",
+            f"first call: {cold['first_call_s']:.2f} s with an empty cache (compilation), {warm['first_call_s']:.2f} s "
+            "warm (cache=True)"]
+
+
+def print_kernel_and_rates(repeats: int, quick: bool) -> float:
+    """Sections 1 and 2; returns the yizhuang ns per cell."""
+    bound = chain_ns_per_cell(repeats)
+    kernel = pd.DataFrame(kernel_rows(repeats, quick))
+    kernel["/ bound"] = kernel["ns_per_cell"] / bound
+    print(f"\n1. Kernel on one core (CPU time, population 200); latency bound: one cell's dependency chain takes "
+          f"{bound:.1f} ns on this CPU\n" + markdown(kernel, 2))
+    rates = pd.DataFrame(rate_rows(repeats, quick))
+    rates["Mcells_per_s"] = rates.pop("cells_per_s") / 1e6
+    print("\n2. Simulator.run_batch, all threads (wall clock)\n" + markdown(rates, 1))
+    return float(kernel["ns_per_cell"].iloc[0])
+
+
+def print_scaling(repeats: int) -> pd.DataFrame:
+    """Section 3: 1 against 2 threads, serial against parallel, and the speed-up a quiet machine would show."""
+    scaling = pd.DataFrame(scaling_rows(repeats))
+    scaling["wall 1/2"] = scaling["t1"] / scaling["t2"]
+    scaling["cpu 2/1"] = scaling["cpu2"] / scaling["cpu1"]
+    scaling["expected"] = scaling["balance"] * scaling["cpu1"] / scaling["cpu2"]
+    for col in ("serial", "t1", "t2"):
+        scaling[col + " ms"] = 1e3 * scaling.pop(col)
+    print(f"\n3. Thread scaling, yizhuang (wall clock, min of {repeats}; load average {os.getloadavg()[0]:.2f}; Numba "
+          f"threading layer {numba.threading_layer()}); run_batch goes serial below {PARALLEL_MIN_CELLS} cells.\n"
+          "   cpu 2/1: CPU time of all threads with 2 threads over 1 thread (spinning and overhead show here even on "
+          "a busy machine); balance: speed-up the static schedule allows; expected = balance / (cpu 2/1), the "
+          "2-thread speed-up of a quiet machine\n" + markdown(scaling.drop(columns=["cpu1", "cpu2"]), 3))
+    return scaling
+
+
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--quick", action="store_true", help="yizhuang only")
-    args = parser.parse_args()
-    load = os.getloadavg()[0]
-    print(f"{os.cpu_count()} CPUs, {numba.config.NUMBA_NUM_THREADS} Numba threads, load average {load:.2f} at start")
-
-    bound = chain_ns_per_cell(args.repeats)
-    kernel = kernel_rows(args.repeats, args.quick)
-    print("\n1. Kernel on one core (CPU time, population 200)")
-    print(f"   latency bound: one cell's dependency chain takes {bound:.1f} ns on this CPU")
-    print(f"   {'case':18s} {'cells/run':>9s} {'ns/cell':>8s} {'/ bound':>8s}")
-    for row in kernel:
-        print(f"   {row['case']:18s} {row['cells_per_run']:9.0f} {row['ns_per_cell']:8.1f} "
-              f"{row['ns_per_cell'] / bound:8.2f}")
-
-    print("\n2. Simulator.run_batch, all threads (wall clock)")
-    print(f"   {'case':18s} {'pop':>5s} {'evals/s':>10s} {'Mcells/s':>9s}")
-    for row in rate_rows(args.repeats, args.quick):
-        print(f"   {row['case']:18s} {row['pop']:5d} {row['evals_per_s']:10.0f} {row['cells_per_s'] / 1e6:9.1f}")
-
-    scaling = scaling_rows(args.repeats)
-    print(f"\n3. Thread scaling, yizhuang (wall clock, min of {args.repeats}; load average "
-          f"{os.getloadavg()[0]:.2f}; Numba threading layer {numba.threading_layer()}); run_batch goes serial "
-          f"below {PARALLEL_MIN_CELLS} cells")
-    print("   wall: measured; cpu 2/1: CPU time of all threads with 2 threads over 1 thread (spinning and")
-    print("   overhead show here even on a busy machine); balance: speed-up the static schedule allows;")
-    print("   expected = balance / (cpu 2/1), the 2-thread speed-up of a quiet machine")
-    print(f"   {'pop':>5s} {'cells':>9s} {'serial ms':>10s} {'1 thr ms':>9s} {'2 thr ms':>9s} "
-          f"{'wall 1/2':>9s} {'cpu 2/1':>8s} {'balance':>8s} {'expected':>9s}")
-    for row in scaling:
-        row["expected"] = row["balance"] * row["cpu1"] / row["cpu2"]
-        print(f"   {row['pop']:5d} {row['cells']:9d} {1e3 * row['serial']:10.3f} {1e3 * row['t1']:9.3f} "
-              f"{1e3 * row['t2']:9.3f} {row['t1'] / row['t2']:8.2f}x {row['cpu2'] / row['cpu1']:8.2f} "
-              f"{row['balance']:8.2f} {row['expected']:8.2f}x")
-
+    parser.add_argument("--jit", action="store_true", help="the kernel against the same code without JIT")
+    parser.add_argument("--jit-worker", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.jit_worker:
+        print(json.dumps(jit_worker(args.repeats)))
+        return
+    print(f"{os.cpu_count()} CPUs, {numba.config.NUMBA_NUM_THREADS} Numba threads, load average "
+          f"{os.getloadavg()[0]:.2f} at start")
+    if args.jit:
+        print("\n".join(jit_rows(4 * args.repeats)))
+        return
+    ns = print_kernel_and_rates(args.repeats, args.quick)
+    scaling = print_scaling(args.repeats)
     moabc = [moabc_row(1), moabc_row(numba.config.NUMBA_NUM_THREADS)]
-    print("\n4. MOABC 40 x 100 on yizhuang (warm)")
-    for row in moabc:
-        print(f"   {row['threads']} thread(s): {row['wall_s']:.3f} s wall, {row['cpu_s']:.3f} s CPU, "
-              f"{row['n_eval']} evaluations")
-
-    ns = kernel[0]["ns_per_cell"]
-    big = [row["t1"] / row["t2"] for row in scaling if row["pop"] >= 200]
-    best_moabc = min(row["wall_s"] for row in moabc)
-    moabc_cpu = moabc[0]["cpu_s"]
-    expected = min(row["expected"] for row in scaling if row["pop"] >= 200)
-    print(f"\n5. Done-when (load average now {os.getloadavg()[0]:.2f}; wall-clock lines need a quiet machine)")
-    print(f"   kernel {ns:.1f} ns/cell per core (yizhuang)             <= 20    : {'yes' if ns <= 20 else 'NO'}")
-    print(f"   2-thread speed-up at pop >= 200: {min(big):.2f}x            >= 1.7x : "
-          f"{'yes' if min(big) >= 1.7 else 'NO'}")
-    print(f"   (expected on a quiet machine from CPU time and balance: {expected:.2f}x)")
-    print(f"   MOABC 40 x 100 warm: {best_moabc:.3f} s wall                 <= 0.3 s: "
-          f"{'yes' if best_moabc <= 0.3 else 'NO'}")
-    print(f"   MOABC 40 x 100 warm, 1 thread: {moabc_cpu:.3f} s CPU          <= 0.3 s: "
-          f"{'yes' if moabc_cpu <= 0.3 else 'NO'}")
+    print("\n4. MOABC 40 x 100 on yizhuang (warm)\n" + markdown(pd.DataFrame(moabc), 3))
+    big = scaling[scaling["pop"] >= 200]
+    best_moabc, moabc_cpu = min(row["wall_s"] for row in moabc), moabc[0]["cpu_s"]
+    verdict = {True: "yes", False: "NO"}
+    print(f"\n5. Done-when (load average now {os.getloadavg()[0]:.2f}; wall-clock lines need a quiet machine)\n"
+          f"   kernel {ns:.1f} ns/cell per core (yizhuang) <= 20: {verdict[ns <= 20]}\n"
+          f"   2-thread speed-up at pop >= 200: {big['wall 1/2'].min():.2f}x >= 1.7x: "
+          f"{verdict[big['wall 1/2'].min() >= 1.7]} (expected on a quiet machine from CPU time and balance: "
+          f"{big['expected'].min():.2f}x)\n"
+          f"   MOABC 40 x 100 warm: {best_moabc:.3f} s wall <= 0.3 s: {verdict[best_moabc <= 0.3]}; 1 thread "
+          f"{moabc_cpu:.3f} s CPU <= 0.3 s: {verdict[moabc_cpu <= 0.3]}")
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pymoo_rail.experiments.report import add_study_options, lower_priority
+from pymoo_rail.experiments.report import add_study_options, lower_priority, require_runs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -87,8 +87,13 @@ def main(argv=None) -> None:
         study = replace(study, seeds=tuple(range(1, args.seeds + 1)))
     if not args.report_only:
         print(run_study(study, args.work, workers=args.workers, seed_major=True), flush=True)
+    results = load_results(args.work, study=study)
+    try:
+        require_runs(results, study, args.work)  # a missing record is an error, not an empty report
+    except FileNotFoundError as error:
+        raise SystemExit(str(error)) from None
     args.out.mkdir(parents=True, exist_ok=True)
-    write_report(args.out, load_results(args.work, study=study), study)
+    write_report(args.out, results, study)
     print(f"wrote {args.out / 'yizhuang_loads.md'}")
 
 

@@ -15,7 +15,8 @@ Guarantees:
   previous complete file or the new one, never a part.
 - **Concurrent writers.** :meth:`RowCache.add` re-reads the file and rewrites it while holding an
   OS file lock (``filelock``, ``<file>.lock``, released by the system when its holder dies), so two
-  processes adding rows to one file lose none of each other's rows.
+  processes adding rows to one file lose none of each other's rows. The lock file is deleted as the
+  lock is released (:func:`pymoo_rail.lockfiles.release_removing`): none is left beside the CSV.
 - **Corrupt files.** A file that does not parse, whose last line is cut off, or whose rows lack
   their key or a value is moved aside to ``<file>.corrupt-<UTC time>`` with a
   :class:`CorruptCacheWarning` naming both files; its rows are then computed again. A file
@@ -31,14 +32,16 @@ import io
 import json
 import os
 import warnings
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
 from filelock import FileLock
 
 from pymoo_rail.atomic import atomic_write_text
+from pymoo_rail.lockfiles import release_removing
 
 KEY_COLUMN = "cache_key"
 """Last column of every row: :func:`row_key` of the row's key fields."""
@@ -172,9 +175,16 @@ class RowCache:
         return table[table[KEY_COLUMN] == row_key(fields)].reset_index(drop=True)
 
     # ------------------------------------------------------------------ writing
-    def _lock(self) -> FileLock:
+    @contextmanager
+    def _lock(self) -> Iterator[None]:
+        """Hold the file's lock; its lock file is gone once released."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        return FileLock(self.lock_path, thread_local=False)
+        lock = FileLock(self.lock_path, thread_local=False)
+        lock.acquire()
+        try:
+            yield
+        finally:
+            release_removing(lock)
 
     def add(self, rows: pd.DataFrame, fields: Mapping[str, object],
             replace: Callable[[pd.DataFrame], np.ndarray] | None = None) -> pd.DataFrame:

@@ -16,7 +16,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "pymoo_rail"
 
 # layer of every room; a room may import rooms of its own or a lower layer
 LAYERS = {
-    "atomic": 0, "rowcache": 0, "constants": 0, "algorithms": 0, "indicators": 0,
+    "atomic": 0, "lockfiles": 0, "rowcache": 0, "constants": 0, "algorithms": 0, "indicators": 0,
     "model": 1,
     "cases": 2,
     "sim": 3,

@@ -68,14 +68,18 @@ def _add_rows(path: str, first: int, n: int) -> None:
         cache.add(pd.DataFrame({"t": [float(i)]}), KEY)
 
 
-def test_two_processes_adding_to_one_file_lose_no_row(tmp_path):
+def test_three_processes_adding_to_one_file_lose_no_row_and_leave_no_lock_file(tmp_path):
+    # the lock file is deleted at every release while others wait on it: a waiter that locked the
+    # deleted file must retry on the new one, or two writers overlap and rows are lost
     path = str(tmp_path / "rows.csv")
     context = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    workers = [context.Process(target=_add_rows, args=(path, first, 25)) for first in (0, 1000)]
+    workers = [context.Process(target=_add_rows, args=(path, first, 25)) for first in (0, 1000, 2000)]
     for w in workers:
         w.start()
     for w in workers:
         w.join(timeout=120)
-    assert [w.exitcode for w in workers] == [0, 0]
+    assert [w.exitcode for w in workers] == [0, 0, 0]
     t = np.sort(RowCache(path, value_columns=("t",)).rows(KEY)["t"].to_numpy())
-    np.testing.assert_array_equal(t, np.r_[np.arange(25), np.arange(1000, 1025)])
+    np.testing.assert_array_equal(t, np.r_[np.arange(25), np.arange(1000, 1025), np.arange(2000, 2025)])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rows.csv"]
+

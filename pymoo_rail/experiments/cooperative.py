@@ -104,3 +104,23 @@ def sharing_potential(runs, time_step_s: float = 0.1) -> pd.DataFrame:
                          braking_from_s=float(mid[regen[j] > 0].min()) if regen[j].any() else np.nan,
                          braking_to_s=float(mid[regen[j] > 0].max()) if regen[j].any() else np.nan))
     return pd.DataFrame(rows)
+
+
+def best_clocked_runs(results: pd.DataFrame | None, offset_s: float, problem) -> list | None:
+    """The two trains' clocked runs of the best stored result at ``offset_s`` (phi 1), or None without one.
+
+    Parameters
+    ----------
+    results : pandas.DataFrame or None
+        A study's stored runs with their decisions (``X``) and objectives (``F``).
+    offset_s : float
+        The departure offset (s).
+    problem : callable
+        ``offset_s -> `` the problem that simulates a decision (``simulate(X)["clocked"]``).
+    """
+    sel = results[results["problem"] == problem_label(1.0, offset_s)] if results is not None else []
+    if len(sel) == 0:
+        return None
+    best = sel.iloc[int(np.argmin([float(np.min(F[:, 0])) for F in sel["F"]]))]
+    x_best = np.asarray(best["X"])[int(np.argmin(best["F"][:, 0]))]
+    return problem(offset_s).simulate(x_best[None, :])["clocked"][0]

@@ -129,6 +129,27 @@ def front_indicators(F: np.ndarray, pf: np.ndarray | None) -> dict[str, float]:
     return out
 
 
+def raw_indicators(F: np.ndarray, pf: np.ndarray, hv_ref_point: np.ndarray) -> dict[str, float]:
+    """The indicators papers print for a front ``F`` against a true front ``pf``, all in raw objective units.
+
+    ``sp`` Schott's spacing and ``delta`` Deb's spread (NaN below 2 points), ``gd`` / ``igd`` pymoo's
+    mean distances, ``gd_vv`` Van Veldhuizen's form (:func:`gd_van_veldhuizen`) and ``hv`` the
+    hypervolume to ``hv_ref_point`` (not normalised, unlike :func:`front_indicators`).
+    """
+    from pymoo.indicators.gd import GD
+    from pymoo.indicators.hv import HV
+    from pymoo.indicators.igd import IGD
+
+    from pymoo_rail.indicators import Spread
+
+    F = np.asarray(F, dtype=float)
+    spread = len(F) > 1
+    return {"sp": float(spacing_indicator()(F)) if spread else float("nan"),
+            "delta": float(Spread(pf)(F)) if spread else float("nan"),
+            "gd": float(GD(pf)(F)), "gd_vv": gd_van_veldhuizen(F, pf), "igd": float(IGD(pf)(F)),
+            "hv": float(HV(ref_point=np.asarray(hv_ref_point, dtype=float))(F))}
+
+
 def convergence_point(F: np.ndarray, pf: np.ndarray | None) -> dict[str, float]:
     """The cheap per-generation values: best per objective, and IGD / HV where ``pf`` is known."""
     out: dict[str, float] = {}

@@ -14,6 +14,7 @@ import argparse
 import math
 import numbers
 import os
+import string
 from pathlib import Path
 from typing import Callable, Iterable, Mapping, Sequence
 
@@ -124,6 +125,32 @@ def report_runs(results, run_row: Callable[[Mapping], dict], columns: Sequence[s
     return table[list(columns)], {}, False
 
 
+def require_runs(results, study, work_dir: str | Path) -> None:
+    """Refuse a report whose study has runs without a stored record (instead of writing an empty one).
+
+    Parameters
+    ----------
+    results : pandas.DataFrame
+        The stored runs (:func:`pymoo_rail.experiments.load_results`), with their ``run_id``.
+    study : pymoo_rail.experiments.Study
+        The study the report is written from.
+    work_dir : str or pathlib.Path
+        Where the records were read from (named in the message).
+
+    Raises
+    ------
+    FileNotFoundError
+        Some run of ``study`` has no record; the message names the first ones (problem / algorithm
+        / seed) and how many are missing.
+    """
+    stored = set(results["run_id"]) if "run_id" in getattr(results, "columns", ()) else set()
+    missing = [run for run in study.runs() if run.run_id not in stored]
+    if missing:
+        named = ", ".join(f"{r.problem.display} / {r.algorithm.display} / seed {r.seed}" for r in missing[:3])
+        raise FileNotFoundError(f"{work_dir}: no stored record of {len(missing)} of the {len(study.runs())} runs of "
+                                f"study {study.name!r} (e.g. {named}): run the study first (without --report-only)")
+
+
 # ------------------------------------------------------------------------------------ numbers
 def _missing(value) -> bool:
     """None, or a number that is not finite (NaN, +-inf)."""
@@ -213,6 +240,42 @@ def markdown(table, digits: int = 4, missing: str | None = None) -> str:
 
     return markdown_rows(list(table.columns), ([cell(v) for v in row]
                                                for row in table.astype(object).itertuples(index=False)))
+
+
+# ------------------------------------------------------------------------------------ templates
+def fill_template(template: str | Path, values: Mapping[str, object]) -> str:
+    """A report's text: its markdown template with every ``${name}`` replaced by ``str(values[name])``.
+
+    A report's prose is written by hand in markdown (``benchmarks/templates/<report>.md``); the
+    script computes only the numbers and tables it names. ``$$`` writes a literal ``$``.
+
+    Parameters
+    ----------
+    template : str or pathlib.Path
+        The template file.
+    values : mapping
+        The value of each placeholder.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    KeyError
+        A placeholder has no value (the message names the template and the placeholder).
+    ValueError
+        A value names no placeholder of the template (a typo on one side or the other).
+    """
+    text = string.Template(Path(template).read_text(encoding="utf-8"))
+    names = {m.group("named") or m.group("braced") for m in text.pattern.finditer(text.template)} - {None}
+    missing = sorted(names - set(values))
+    if missing:
+        raise KeyError(f"template {template}: no value for {', '.join('${' + n + '}' for n in missing)}")
+    unused = sorted(set(values) - names)
+    if unused:
+        raise ValueError(f"template {template}: no placeholder for the value(s) {', '.join(unused)}")
+    return text.substitute({k: str(v) for k, v in values.items()})
 
 
 # ------------------------------------------------------------------------------------ files

@@ -45,6 +45,7 @@ from pymoo_rail.experiments.registry import build_algorithm, build_problem, chec
 from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
 from pymoo_rail.experiments.store import (CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, LegacyRecordError,
                                           RecordError, ResultStore, writing)
+from pymoo_rail.lockfiles import release_removing
 
 # per-individual outputs a rail problem puts next to F (DESIGN.md section 3); kept with the front
 EXTRA_KEYS = ("energy_kwh", "running_time_s", "stop_error_m")
@@ -411,6 +412,7 @@ def run_study(study: Study, directory: str | Path, workers: int | None = None, s
             executor = _executor(stack, scheduler, workers, len(pending))
             _Dispatch(store, executor, report, bar, inputs, trusted, local=scheduler is None,
                       progress=progress).run(pending, window=2 * workers)
+    store.remove_idle_locks()  # a finished study leaves no lock files (and no empty locks/) behind
     return report
 
 
@@ -491,7 +493,7 @@ class _Dispatch:
             raise
         finally:
             for _, lock in in_flight.values():
-                lock.release()
+                release_removing(lock)
 
     def claim(self, run: RunSpec, blocking: bool) -> Any:
         """The run's lock when it is to be computed here; ``"busy"`` (another process holds it) or
@@ -501,7 +503,7 @@ class _Dispatch:
             return "busy"
         state, reason = _stored_state(self.store, run, self.inputs[run.run_id].fingerprint)
         if state == "stored":  # another process finished it while we were busy
-            lock.release()
+            release_removing(lock)
             self.report.n_elsewhere += 1
             self.bar.update(1)
             return None
@@ -525,7 +527,7 @@ class _Dispatch:
             try:
                 self.finish(run, *future.result())
             finally:
-                lock.release()
+                release_removing(lock)
 
     def finish(self, run: RunSpec, status: str, payload: dict) -> None:
         if status == "ok":

@@ -89,6 +89,24 @@ def rank_sum(sample: Sequence[float], baseline: Sequence[float], lower_better: b
     return u, p, "+" if better else "-"
 
 
+def compare_means(sample: Sequence[float], baseline: Sequence[float],
+                  lower_better: bool = True) -> tuple[bool, float, float] | None:
+    """Whether ``sample``'s mean beats ``baseline``'s, by how much, and the rank-sum p of the difference.
+
+    Returns
+    -------
+    (bool, float, float) or None
+        (sample's mean better, (mean sample - mean baseline) / |mean baseline| in percent (NaN for a
+        zero baseline mean), two-sided p of :func:`rank_sum`); None when a side has fewer than 2 values.
+    """
+    a, b = np.asarray(sample, dtype=float), np.asarray(baseline, dtype=float)
+    if len(a) < 2 or len(b) < 2:
+        return None
+    better = a.mean() < b.mean() if lower_better else a.mean() > b.mean()
+    rel = (a.mean() - b.mean()) / abs(b.mean()) * 100 if b.mean() != 0 else float("nan")
+    return bool(better), float(rel), rank_sum(a, b)[1]
+
+
 def rank_sum_tests(results: pd.DataFrame, baseline: str, indicators: Sequence[str] | None = None,
                    alpha: float = 0.05) -> pd.DataFrame:
     """Each algorithm against ``baseline`` on each problem and indicator (see :func:`rank_sum`).

@@ -45,6 +45,7 @@ from filelock import FileLock, Timeout
 
 from pymoo_rail.atomic import TEMP_PREFIX, atomic_write_text, is_abandoned_temp
 from pymoo_rail.experiments.spec import canonical_json
+from pymoo_rail.lockfiles import release_removing
 
 RECORD_FORMAT = "pymoo-rail/run-record/2"
 # records written before checksums and input fingerprints: readable, but always redone by a study
@@ -263,8 +264,8 @@ class ResultStore:
     def claim(self, run_id: str, wait: bool = False) -> FileLock | None:
         """Take the lock of one run: the holder alone computes it.
 
-        Returns the held lock (release it with ``.release()``), or None when another process
-        holds it and ``wait`` is false. The operating system releases the lock of a process
+        Returns the held lock (release it with :func:`pymoo_rail.lockfiles.release_removing`, which
+        also deletes its file), or None when another process holds it and ``wait`` is false. The operating system releases the lock of a process
         that dies, so a killed study never blocks the next one.
         """
         path = self.locks_dir / f"{run_id}.lock"
@@ -274,17 +275,25 @@ class ResultStore:
             raise StoreError(path, "the lock file is not a regular file (a symbolic link or another kind of "
                                    "file was put in its place): remove it and start the study again")
         lock = FileLock(path, thread_local=False)
-        try:
-            with writing(path):
-                lock.acquire(timeout=-1 if wait else 0)
-        except Timeout:
-            return None
-        except StoreError:
-            raise
-        except OSError as err:
-            raise StoreError(path, f"cannot take the lock of run {run_id} ({err.strerror or err}): check the "
-                                   "file and the folder's permissions", err.errno) from err
-        return lock
+        for attempt in range(3):
+            try:
+                with writing(path):
+                    lock.acquire(timeout=-1 if wait else 0)
+                return lock
+            except Timeout:
+                return None
+            except StoreError:
+                raise
+            except FileNotFoundError as err:
+                if attempt == 2:
+                    raise StoreError(path, f"cannot take the lock of run {run_id}: its folder keeps vanishing "
+                                           "(another process removing it?)", err.errno) from err
+                with writing(path):  # a study that finished meanwhile removed the empty locks/ folder
+                    self.locks_dir.mkdir(parents=True, exist_ok=True)
+            except OSError as err:
+                raise StoreError(path, f"cannot take the lock of run {run_id} ({err.strerror or err}): check the "
+                                       "file and the folder's permissions", err.errno) from err
+        return None  # not reached: the loop returns or raises
 
     # ------------------------------------------------------------------ reading
     def check(self, path: Path) -> dict:
@@ -368,8 +377,8 @@ class ResultStore:
     def remove_idle_locks(self) -> int:
         """Delete the lock files of stored runs that no process holds, and ``locks/`` once it is empty.
 
-        ``filelock`` leaves a lock file behind on release (deleting it there would race with a
-        process about to take it). Here a lock is deleted only while held, and only for a run
+        The study runner deletes each claim's file as it releases it; this removes what an
+        interrupted or older study left. A lock is deleted only while held, and only for a run
         whose record is stored: a process that still opened the old file finds the run stored and
         skips it, so no run is computed twice. Returns how many lock files were deleted.
         """
@@ -384,11 +393,8 @@ class ResultStore:
                 lock.acquire(timeout=0)
             except (Timeout, OSError):
                 continue  # held by a running process, or not ours to take
-            try:
-                path.unlink(missing_ok=True)
-                removed += 1
-            finally:
-                lock.release()
+            release_removing(lock)
+            removed += 1
         try:
             self.locks_dir.rmdir()  # only if empty
         except OSError:

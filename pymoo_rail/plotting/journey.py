@@ -41,3 +41,42 @@ def plot_timed_run(timed, run):
     ax_v.set_title(f"{timed.journey.name}: {run.energy_kwh:.1f} kWh net; bars = time windows")
     fig.tight_layout()
     return fig
+
+
+def plot_split_costs(sweep, best, equal, title: str):
+    """Three panels: line energy against trip time per split, the cost of a rule of thumb, one trip's split.
+
+    ``sweep`` is :func:`pymoo_rail.journeys.compare.split_sweep`; ``best`` and ``equal`` are the
+    :class:`~pymoo_rail.journeys.Allocation` of one trip (optimal and equal supplement), drawn as
+    per-section supplements in the third panel; ``title`` names the line in the first panel.
+    """
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    trip_min = sweep["trip_time_s"].to_numpy() / 60
+    opt_e, eq_e, pr_e = (sweep[c].to_numpy() for c in ("optimal_kwh", "equal_kwh", "proportional_kwh"))
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
+    ax = axes[0]
+    ax.plot(trip_min, opt_e, label="energy-optimal split")
+    ax.plot(trip_min, eq_e, "--", label="equal supplement")
+    ax.plot(trip_min, pr_e, ":", label="proportional supplement")
+    ax.set(xlabel="trip time incl. dwells (min)", ylabel="net energy of the line (kWh)", title=title)
+    ax.legend()
+    ax = axes[1]
+    ax.plot(trip_min, eq_e - opt_e, "--", label="equal supplement")
+    ax.plot(trip_min, pr_e - opt_e, ":", label="proportional supplement")
+    ax.set(xlabel="trip time incl. dwells (min)", ylabel="extra energy over the optimal split (kWh)",
+           title="cost of a rule-of-thumb split")
+    ax.legend()
+    ax = axes[2]
+    x = np.arange(len(best.table))
+    ax.bar(x - 0.2, best.table.supplement_s, 0.4, label="energy-optimal")
+    ax.bar(x + 0.2, equal.table.supplement_s, 0.4, label="equal")
+    ax.set_xticks(x, [f"{k}" for k in x])
+    ax.set(xlabel=f"section (0 = {best.table.label.iloc[0]})", ylabel="running-time supplement over flat-out (s)",
+           title=f"split of a {best.trip_time_s / 60:.0f}-min trip")
+    ax.legend(loc="lower right")
+    for a in axes:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig

@@ -418,7 +418,7 @@ def drive_cell(m, program, totals, i, v, row, hold_speed):
 
 
 # No reference counting inside: the run allocates nothing, and NRT incref/decref pairs on the
-# model's arrays in every inlined helper call were half the cost of a cell (benchmarks/simulator.py).
+# model's arrays in every inlined helper call were half the cost of a cell (benchmarks/throughput.py --jit).
 @njit(cache=True, _nrt=False)
 def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     """Simulate one run; write the summary into ``out`` and, if ``record``, the trace arrays.

@@ -132,27 +132,6 @@ def test_independent_limit_check_catches_an_overspeed(wuguang):
     assert excess[2] > 0 and excess[3] < 0
 
 
-def test_resolution_gaps_of_members_against_each_grid(wuguang):
-    """``--resolution``: a member on the front at one of its times has no gap to the interpolated
-    front nor to the optimum at its own time; one between the front's times lies below the chord
-    (the front is convex) but not below the optimum solved at its own time beyond the certificate."""
-    import pandas as pd
-
-    from benchmarks import emu_wuguang
-    from pymoo_rail.optimal import ReferenceAtTime
-
-    ref = ReferenceAtTime(wuguang, n_speeds=30)  # a coarse grid: cheap, and the same solves the script makes
-    on, middle = ref.at(1060.0), ref.at(1070.0)
-    runs = pd.DataFrame({"problem": ["on", "middle"], "CV": [np.zeros(1), np.zeros(1)],
-                         "F": [np.array([[on["optimal_kwh"], 1060.0]]), np.array([[middle["optimal_kwh"], 1070.0]])]})
-    table = emu_wuguang.resolution(runs, n_speeds=(30,), times_s=(1060.0,), front_times_s=(1050.0, 1060.0, 1090.0))
-    row = table.iloc[0]
-    assert row["E(1060 s) kWh"] == pytest.approx(on["optimal_kwh"]) and row["certificate 1060 s kWh"] > 0
-    assert abs(row["lowest on %"]) < 1e-9 and abs(row["same at own time on %"]) < 1e-9
-    assert row["lowest middle %"] < -0.01  # below the chord from 1060 to 1090 s
-    assert row["same at own time middle %"] * middle["optimal_kwh"] / 100 > -middle["energy_bound_kwh"]
-
-
 @pytest.mark.slow
 def test_reduced_study_end_to_end(tmp_path):
     """The benchmark script with a reduced study (3 seeds, 3000 evaluations, population 30) on

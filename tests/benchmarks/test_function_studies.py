@@ -63,7 +63,7 @@ def test_grnsga2_reduced_study_gives_runs_report_and_fronts(tmp_path):
     assert (report.n_runs, report.n_finished) == (8, 8)
     out = tmp_path / "rep"
     out.mkdir()
-    gr.write_report(out, load_results(tmp_path / "work", study=study), ["zdt1"], list(gr.ALGORITHMS))
+    gr.write_report_files(out, load_results(tmp_path / "work", study=study), ["zdt1"], list(gr.ALGORITHMS))
     table = pd.read_csv(out / "grnsga2_zdt_runs.csv")
     assert len(table) == 8 and set(table.algorithm) == set(gr.ALGORITHMS) and set(table.seed) == {1, 2}
     assert (table.n_eval >= 800).all() and (table.cpu_s > 0).all() and (table.igd > 0).all()
@@ -75,7 +75,7 @@ def test_grnsga2_reduced_study_gives_runs_report_and_fronts(tmp_path):
     assert "Runs per problem and algorithm: 2" in text and (out / "grnsga2_zdt1_fronts.png").stat().st_size > 0
     assert "Reading (30-run study)" not in text  # the 30-run reading is not shown for other studies
     _rebuilt_from_csv_alone(out, "grnsga2_zdt_runs.csv", "grnsga2_zdt.md", tmp_path / "none",
-                            lambda o, r: gr.write_report(o, r, ["zdt1"], list(gr.ALGORITHMS)))
+                            lambda o, r: gr.write_report_files(o, r, ["zdt1"], list(gr.ALGORITHMS)))
 
 
 def _rebuilt_from_csv_alone(out: Path, csv_name: str, report_name: str, no_records: Path, write) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.util
 import sys
+from types import SimpleNamespace
 from pathlib import Path
 
 import numpy as np
@@ -89,22 +90,9 @@ def test_reduced_yizhuang_study_reproduces_the_qualitative_results(tmp_path, yiz
     # the report and figures are written
     reports = tmp_path / "reports"
     reports.mkdir()
-    ys.write_report(tmp_path, reports, seeds, TOLERANCE_S, (10,), reference=False, energy_variants=False)
+    args = SimpleNamespace(seeds=len(seeds), tolerance=TOLERANCE_S, n_equal=(10,), out=tmp_path, reports=reports)
+    ys.write_report_files(args, results)
     text = (reports / "yizhuang_seed000.md").read_text()
     assert "Table 5-5" in text and "Table 5-6" in text
     assert (reports / "yizhuang_seed000_front.png").stat().st_size > 0
     assert (reports / "yizhuang_seed000_convergence.png").stat().st_size > 0
-
-
-def test_energy_variants_are_computed_once_and_read_back_from_the_row_cache(tmp_path):
-    ys = _script()
-    rows = [{"variant": "as modelled", "same_codes_kwh": 12.34, "same_codes_time_s": 150.2},
-            {"variant": "no regeneration, other train", "same_codes_kwh": 2.0, "same_codes_time_s": 151.0,
-             "reopt_kwh": 1.9, "reopt_time_s": 150.0, "cruise_kwh": 3.0, "flat_out_kwh": 4.0}]
-    calls = []
-    key = {"x": "[0.5, 0.25]", "tolerance_s": 1.0, "v": 4}
-    first = ys.cached_variants(tmp_path / "variants.csv", key, lambda: calls.append(1) or rows)
-    again = ys.cached_variants(tmp_path / "variants.csv", key, lambda: calls.append(1) or rows)
-    assert first == again == rows and len(calls) == 1  # a variant keeps only the values it has
-    ys.cached_variants(tmp_path / "variants.csv", {**key, "tolerance_s": 2.0}, lambda: calls.append(1) or rows)
-    assert len(calls) == 2  # other inputs: computed again

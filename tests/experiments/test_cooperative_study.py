@@ -44,3 +44,26 @@ def test_paper_encoding_study_uses_the_seed_problem():
     assert {p.name for p in study.problems} == {"cooperative_seed"} and "cooperative_seed" in PROBLEMS
     with pytest.raises(ValueError, match=r"phi = 0.4"):
         offsets_study("p", [0.4], 2, paper_encoding=True)
+
+
+def test_best_clocked_runs_resimulates_the_least_energy_member_of_the_offset():
+    import pandas as pd
+
+    from pymoo_rail.experiments.cooperative import best_clocked_runs
+
+    simulated = []
+
+    class Problem:
+        def __init__(self, offset_s):
+            self.offset_s = offset_s
+
+        def simulate(self, X):
+            simulated.append((self.offset_s, X.tolist()))
+            return {"clocked": [("runs of", X[0, 0])]}
+
+    results = pd.DataFrame({"problem": [problem_label(1.0, 45.0), problem_label(1.0, 45.0), problem_label(1.0, 0.0)],
+                            "F": [np.array([[5.0], [4.0]]), np.array([[3.0], [6.0]]), np.array([[1.0]])],
+                            "X": [np.array([[10.0], [11.0]]), np.array([[12.0], [13.0]]), np.array([[14.0]])]})
+    assert best_clocked_runs(results, 45.0, Problem) == ("runs of", 12.0)  # run 2, its first member
+    assert simulated == [(45.0, [[12.0]])]
+    assert best_clocked_runs(results, 90.0, Problem) is None and best_clocked_runs(None, 45.0, Problem) is None

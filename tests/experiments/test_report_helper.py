@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from pymoo_rail.experiments.report import fixed, markdown, markdown_rows, mean_std, significant, write_report
 
@@ -35,3 +36,31 @@ def test_markdown_formats_float_cells_only(tmp_path):
     path = write_report(tmp_path / "r.md", ["# title", "", "text"])
     assert path.read_text() == "# title\n\ntext\n"
     assert write_report(tmp_path / "s.md", ["a", "b"], newline=False).read_text() == "a\nb"
+
+
+def test_fill_template_fills_every_placeholder_and_names_what_is_missing_or_unused(tmp_path):
+    import pytest
+
+    from pymoo_rail.experiments.report import fill_template
+
+    template = tmp_path / "r.md"
+    template.write_text("# ${title}\n\n${table} costs $$5, ${n} runs\n")
+    assert fill_template(template, {"title": "T", "table": "| a |", "n": 3}) == "# T\n\n| a | costs $5, 3 runs\n"
+    with pytest.raises(KeyError, match=r"no value for \$\{n\}"):
+        fill_template(template, {"title": "T", "table": ""})
+    with pytest.raises(ValueError, match="no placeholder for the value.s. runs"):
+        fill_template(template, {"title": "T", "table": "", "n": 1, "runs": 2})
+
+
+def test_require_runs_names_the_missing_record(tmp_path):
+    from pymoo_rail.experiments import Study, algorithm, problem
+    from pymoo_rail.experiments.report import require_runs
+
+    study = Study("s", problems=[problem("zdt1")], algorithms=[algorithm("nsga2", pop_size=10)], seeds=2,
+                  budget={"n_gen": 2})
+    first, second = study.runs()
+    require_runs(pd.DataFrame({"run_id": [first.run_id, second.run_id]}), study, tmp_path)  # all there
+    with pytest.raises(FileNotFoundError, match=r"1 of the 2 runs of study 's' \(e.g. zdt1 / nsga2 / seed 2\)"):
+        require_runs(pd.DataFrame({"run_id": [first.run_id]}), study, tmp_path)
+    with pytest.raises(FileNotFoundError, match="2 of the 2 runs"):
+        require_runs(pd.DataFrame(), study, tmp_path)

@@ -129,3 +129,25 @@ def test_tables_of_the_small_study(pool_study_dir, tmp_path):
     igd = (tmp_path / "igd.md").read_text()
     assert igd.count("**") == 2 * 3  # one best mean per problem
     assert "Wilcoxon rank-sum" in igd
+
+
+def test_compare_means_gives_direction_relative_difference_and_the_rank_sum_p():
+    from pymoo_rail.experiments.stats import compare_means, rank_sum
+
+    better, rel, p = compare_means([1.0, 2.0, 3.0], [4.0, 5.0, 6.0])
+    assert better and rel == pytest.approx(-60.0) and p == rank_sum([1.0, 2.0, 3.0], [4.0, 5.0, 6.0])[1]
+    assert compare_means([1.0, 2.0, 3.0], [4.0, 5.0, 6.0], lower_better=False)[0] is False
+    assert compare_means([1.0], [4.0, 5.0]) is None
+    assert np.isnan(compare_means([1.0, 2.0], [-1.0, 1.0])[1])  # zero baseline mean: no relative difference
+
+
+def test_raw_indicators_vanish_on_the_true_front_and_need_two_points_for_spread():
+    from pymoo.problems import get_problem
+
+    from pymoo_rail.experiments.metrics import raw_indicators
+
+    pf = get_problem("zdt1").pareto_front(100)
+    on = raw_indicators(pf, pf, np.array([1.1, 1.1]))
+    assert on["gd"] == on["igd"] == on["gd_vv"] == 0.0 and 0.85 < on["hv"] < 0.88 and on["sp"] >= 0
+    one = raw_indicators(pf[:1] + 0.1, pf, np.array([1.1, 1.1]))
+    assert np.isnan(one["sp"]) and np.isnan(one["delta"]) and one["gd"] > 0.09

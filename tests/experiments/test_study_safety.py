@@ -366,3 +366,12 @@ def test_trust_on_the_command_line_runs_and_replots_an_import_path_study(tmp_pat
     assert "--trust" in capsys.readouterr().err
     assert main(["plot", "study", str(out), "--out", str(tmp_path / "figures"), "--trust"]) == 0
     assert list((tmp_path / "figures").rglob("front_*.png"))  # with the true front, rebuilt because trusted
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_run_study_from_python_leaves_no_lock_files(tmp_path, workers):
+    # the library call, not only the CLI: each claim's file goes as the claim is released
+    report = run_study(_zdt_study(seeds=3), tmp_path / "out", workers=workers, progress=False)
+    assert report.n_finished == 3
+    assert not (tmp_path / "out" / "locks").exists()
+    assert [p.name for p in (tmp_path / "out").rglob("*.lock")] == []

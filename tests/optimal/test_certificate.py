@@ -89,7 +89,7 @@ def test_the_default_placement_is_not_beaten_on_yizhuang_section_9_10():
 
 @pytest.mark.slow
 def test_no_placement_or_finer_grid_beats_the_default_beyond_its_certificate_at_the_worst_times():
-    """The worst times of ``benchmarks/certificate_coverage.py`` before the fix: wuguang-crh3 at 1108-1110 s
+    """The worst times of ``benchmarks/reference_check.py --check coverage`` before the fix: wuguang-crh3 at 1108-1110 s
     (a jump of 2.1 s at 6.5 MW; a moved run 2.1 kWh above the front) and the closest margins it prints."""
     wuguang = load_case("wuguang-crh3")
     times = [1050.53, 1108.5, 1109.73, 1109.98, 1110.0]

@@ -107,7 +107,7 @@ def test_single_form_optimum_is_a_solved_node(name):
 @pytest.mark.parametrize("name", list_problems())
 def test_every_problem_nsga2_beats_random_sampling(name, seed):
     """The done-when sweep: every suite problem and seeds 1-5, NSGA2(100, 200 generations) against random
-    sampling of the same budget (the sum of the per-case CPU times of `benchmarks/suite.py --sanity --seeds 5`
+    sampling of the same budget (the sum of the per-case CPU times of `suite_report.sanity_table(seeds=5)`
     is in docs/suite.md)."""
     result = nsga2_against_random(name, seed=seed)
     assert np.isfinite(result.igd_nsga2) and result.igd_nsga2 < result.igd_random, result

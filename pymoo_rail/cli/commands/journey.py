@@ -18,8 +18,11 @@ def add_parser(sub) -> None:
                                 "that meets every timing point, and write into --out: timing.csv (time and speed "
                                 "at every timing point, window and check), trajectory_<k>.csv per section and "
                                 "journey.png.",
-                    epilog="example:\n  pymoo-rail journey tracks/../journeys/J.json "
-                           "--train trains/CH_Stadler_KISS_SBB.json")
+                    epilog="example (from the repository's root: a journey TTOBench first published, which "
+                           "the SBB KISS can meet; the released version cannot be met):\n"
+                           "  pymoo-rail journey tests/data/ttobench/journeys/"
+                           "CH_StGallen_Wil_Journey_01_first_published.json \\\n"
+                           "      --train tests/data/ttobench/trains/CH_Stadler_KISS_SBB.json --out out/j")
     p.add_argument("journey", metavar="JOURNEY", help="TTOBench journey JSON file, or a .toml journey "
                                                        "(track, train and timing points, docs/ttobench.md)")
     p.add_argument("--track", default=None, metavar="T.json",

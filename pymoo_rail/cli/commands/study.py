@@ -79,7 +79,7 @@ def study_outputs(directory: Path, out: Path, baseline: str | None, plots: bool,
 
 def run(args) -> int:
     """Run (or resume) the study file of ``args`` and write its tables; returns the exit code."""
-    from pymoo_rail.experiments import ResultStore, read_study, run_study
+    from pymoo_rail.experiments import read_study, run_study
     from pymoo_rail.experiments.registry import UntrustedCodeError
     from pymoo_rail.experiments.spec import StudyError
 
@@ -104,7 +104,6 @@ def run(args) -> int:
     except StudyError as err:
         raise UsageError("--scheduler" if err.field == "scheduler" else "FILE", str(err)) from None
     say(str(report))
-    ResultStore(out).remove_idle_locks()  # a finished study leaves no lock files behind
     written = study_outputs(out, out, baseline, plots=not args.no_plots, trusted=args.trust)
     say(f"wrote {len(written)} tables and figures under {out / 'tables'}"
         + ("" if args.no_plots else f" and {out / 'figures'}"))

@@ -33,7 +33,7 @@ PARTITIONS = ("gradient_limit", "equal")
 # reference: a code and a coasting point, where it had one variable: one cruise speed, no
 # coasting). Cutting such sections into 1 km pieces instead (49 codes on the reference) left NSGA2
 # up to 5 % above the optimum on the reference family: holding a speed over many pieces needs many
-# equal codes (benchmarks/sparse_encoding.py prints both).
+# equal codes (benchmarks/encodings.py --job sparse prints both).
 SPARSE_MEAN_SECTION_M = 2000.0
 
 
