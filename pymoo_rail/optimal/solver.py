@@ -340,7 +340,10 @@ class OptimalSolver:
             # makes the jumps smaller
             if self.at_finest_speed_grid():
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
-                                   f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
+                                   f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W), more than "
+                                   f"{MAX_TIME_ERROR_S} s off, at n_speeds = {self.n_speeds} (profile refines up to "
+                                   f"{MAX_N_SPEEDS}): the discrete optimum jumps over this time; another n_speeds "
+                                   "or dx_m moves the jumps")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
                                   self.top_bias, self.tie_j, self.certify, self.price_shape, self.speed_floor_ms,
                                   self.singular)
