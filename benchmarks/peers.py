@@ -16,7 +16,10 @@ Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--qu
 ``python benchmarks/peers.py --generated N [--first-seed S] [--intervals 300 1000] [--repeats R] --mseetc PATH``:
 the reference and ms-eetc on N generated intercity lines (``pymoo_rail.cases.generate_case``) x 3
 running times, with differences in % of traction energy, CPU ratios and every certificate violation
-(report ``benchmarks/reports/peers_generated.md``).
+(report ``benchmarks/reports/peers_generated.md``, its table beside it as CSV). ms-eetc at a large N is slow
+(minutes per answer): ``--mseetc-only --intervals 2000 --cache FILE.csv`` fills a cache in the background
+(resumable), and a run with ``--intervals 300 2000 --cache FILE.csv`` reads N=2000 from it (NaN where missing)
+while running N=300 side by side; ``--refresh`` rewrites the report from its CSV with the cache read again.
 (``--quick``: only the two intercity cases; ``--breakdown``: also where pymoo-rail's CPU time goes, per
 Numba kernel of the exact solver, from a second run under cProfile). Writes ``benchmarks/reports/peers.md``.
 """
