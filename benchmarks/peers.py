@@ -399,8 +399,11 @@ def main_generated(args) -> None:
             " boundary speeds at least 1 m/s (`comparable_case`), at 1.05, 1.2 and 1.5 x the minimum running time."
             " Energies net (kWh), pymoo-rail's moved to the requested time along lambda; `bound_kwh` its"
             " certificate; CPU `time.process_time` (pymoo-rail: tables, search, replay and certificate from a"
-            f" fresh solver; ms-eetc: IPOPT, best of {args.repeats}). Load average (1 min) at the start and the end:"
-            f" {load_at_start:.2f} / {os.getloadavg()[0]:.2f}.", "",
+            f" fresh solver; ms-eetc: IPOPT, best of {args.repeats})."
+            + (" Rewritten with `--refresh` from the table of that run (its CSV beside this report), the largest N"
+               " read again from `--cache`." if args.refresh else
+               f" Load average (1 min) at the start and the end: {load_at_start:.2f} / {os.getloadavg()[0]:.2f}."),
+            "",
             *generated_summary(table, intervals), "", markdown(table.drop(columns=["features"])), "",
             "Features of the lines:", "",
             *[f"- seed {s}: {f}" for s, f in table.groupby("seed")["features"].first().items()], ""]
