@@ -387,7 +387,7 @@ def main_generated(args) -> None:
         table = refresh_cached(pd.read_csv(args.report.with_suffix(".csv")), cache)
     else:
         table = generated_rows(seeds, args.mseetc, args.mseetc_python, intervals, args.repeats, cache)
-        table.to_csv(args.report.with_suffix(".csv"), index=False)
+    table.to_csv(args.report.with_suffix(".csv"), index=False)
     from pymoo_rail.experiments.report import markdown
 
     text = ["# pymoo-rail's exact solver beside ms-eetc on generated lines", "",
