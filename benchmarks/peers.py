@@ -16,7 +16,10 @@ Usage: ``python benchmarks/peers.py [--mseetc PATH --mseetc-python PYTHON] [--qu
 ``python benchmarks/peers.py --generated N [--first-seed S] [--intervals 300 1000] [--repeats R] --mseetc PATH``:
 the reference and ms-eetc on N generated intercity lines (``pymoo_rail.cases.generate_case``) x 3
 running times, with differences in % of traction energy, CPU ratios and every certificate violation
-(report ``benchmarks/reports/peers_generated.md``).
+(report ``benchmarks/reports/peers_generated.md``, its table beside it as CSV). ms-eetc at a large N is slow
+(minutes per answer): ``--mseetc-only --intervals 2000 --cache FILE.csv`` fills a cache in the background
+(resumable), and a run with ``--intervals 300 2000 --cache FILE.csv`` reads N=2000 from it (NaN where missing)
+while running N=300 side by side; ``--refresh`` rewrites the report from its CSV with the cache read again.
 (``--quick``: only the two intercity cases; ``--breakdown``: also where pymoo-rail's CPU time goes, per
 Numba kernel of the exact solver, from a second run under cProfile). Writes ``benchmarks/reports/peers.md``.
 """
@@ -35,6 +38,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from pymoo_rail.constants import J_PER_KWH
@@ -287,8 +291,62 @@ def mseetc_track(case, track_id: str) -> dict:
                           "values": [[a, g] for a, _, g in case.line.gradients]}}
 
 
-def generated_rows(seeds, checkout: Path | None, python: str, intervals: tuple[int, ...], repeats: int) -> pd.DataFrame:
-    """pymoo-rail and ms-eetc on generated lines at 1.05, 1.2 and 1.5 x the minimum running time."""
+CACHE_KEY = ("seed", "n", "time_s", "v0_ms", "v_end_ms")
+
+
+def mseetc_cached(caches: list[Path], seed: int, case, t: float, n: int, checkout: Path | None, python: str,
+                  repeats: int) -> tuple[float, float, float]:
+    """(energy kWh, CPU s, end speed m/s) of ms-eetc at N = ``n``, read from the CSVs ``caches`` or run and appended
+    to the first (NaN when it is in none and ``checkout`` is None, or ms-eetc fails).
+
+    The key is the seed, N, the running time (to 1 ms) and the boundary speeds, so a rerun resumes where an
+    interrupted one stopped, and a change of the minimum running time (the simulator's) reruns.
+    """
+    key = (seed, n, round(t, 3), round(case.initial_speed_ms, 6), round(case.final_speed_ms, 6))
+    for cache in (c for c in caches if c.exists()):
+        table = pd.read_csv(cache)
+        hit = table[np.all([table[c].to_numpy() == k for c, k in zip(CACHE_KEY, key)], axis=0)]
+        if len(hit):
+            r = hit.iloc[-1]
+            return float(r.energy_kwh), float(r.cpu_s), float(r.end_ms)
+    if checkout is None:
+        return math.nan, math.nan, math.nan
+    try:
+        result = run_mseetc_full(checkout, python, f"generated_{seed}", t, n,
+                                 {f"generated_{seed}": mseetc_track(case, f"generated_{seed}")},
+                                 case.initial_speed_ms, case.final_speed_ms, repeats)
+    except subprocess.CalledProcessError:
+        result = (math.nan, math.nan, math.nan)
+    if caches:
+        row = pd.DataFrame([dict(zip(CACHE_KEY, key)) | dict(zip(("energy_kwh", "cpu_s", "end_ms"), result))
+                            | {"load": os.getloadavg()[0]}])
+        row.to_csv(caches[0], mode="a", header=not caches[0].exists(), index=False)
+    return result
+
+
+def mseetc_only(seeds, checkout: Path, python: str, intervals: tuple[int, ...], cache: Path) -> None:
+    """Fill ``cache`` with ms-eetc's answers on the generated lines, without solving them here."""
+    from pymoo_rail.optimal import min_running_time
+
+    for seed in seeds:
+        case = comparable_case(seed)
+        t_min = min_running_time(case)
+        for factor in GENERATED_FACTORS:
+            for n in intervals:
+                start = time.time()
+                energy, cpu, v_end = mseetc_cached([cache], seed, case, factor * t_min, n, checkout, python, 1)
+                print(f"seed {seed} x{factor} N={n}: {energy:.4f} kWh, {cpu:.1f} s CPU, end {v_end:.3f} m/s"
+                      f" ({time.time() - start:.0f} s wall)", flush=True)
+
+
+def generated_rows(seeds, checkout: Path | None, python: str, intervals: tuple[int, ...], repeats: int,
+                   cache: dict[int, list[Path]] | None = None) -> pd.DataFrame:
+    """pymoo-rail and ms-eetc on generated lines at 1.05, 1.2 and 1.5 x the minimum running time.
+
+    ``cache``: N -> the CSVs of ms-eetc's answers at that N, read only (:func:`mseetc_cached`; NaN where
+    missing); the other N run here.
+    """
+    cache = cache or {}
     from pymoo_rail.optimal import OptimalSolver, min_running_time
 
     rows = []
@@ -307,12 +365,8 @@ def generated_rows(seeds, checkout: Path | None, python: str, intervals: tuple[i
                    "bound_kwh": tr.summary["energy_bound_kwh"], "traction_kwh": tr.energy.traction_kwh,
                    "end_error_ms": abs(tr.speed_ms[-1] - case.final_speed_ms), "cpu_s": cpu, "features": features}
             for n in intervals if checkout is not None else ():
-                try:
-                    energy, cpu_m, v_end = run_mseetc_full(checkout, python, f"generated_{seed}", t, n,
-                                                           {f"generated_{seed}": mseetc_track(case, f"generated_{seed}")},
-                                                           case.initial_speed_ms, case.final_speed_ms, repeats)
-                except subprocess.CalledProcessError:
-                    energy, cpu_m, v_end = math.nan, math.nan, math.nan
+                energy, cpu_m, v_end = (mseetc_cached(cache[n], seed, case, t, n, None, python, repeats) if n in cache
+                                        else mseetc_cached([], seed, case, t, n, checkout, python, repeats))
                 row[f"ms{n}_kwh"], row[f"ms{n}_cpu_s"], row[f"ms{n}_end_ms"] = energy, cpu_m, v_end
             rows.append(row)
             print({k: (round(v, 4) if isinstance(v, float) else v) for k, v in row.items() if k != "features"},
@@ -327,6 +381,9 @@ def generated_summary(table: pd.DataFrame, intervals: tuple[int, ...]) -> list[s
         return ["(ms-eetc not run)"]
     best = f"ms{max(intervals)}_kwh"
     ok = table[best].notna()
+    lines = table.groupby("seed").first()
+    out.append(f"- {len(lines)} lines: {int(lines.features.str.contains('descent').sum())} with long descents under"
+               f" limits, {int((lines.end_ms > 1.0).sum())} with ends at more than ms-eetc's 1 m/s")
     diff = 100.0 * (table["energy_kwh"] - table[best]) / table["traction_kwh"]
     out.append(f"- {int(ok.sum())} answers with ms-eetc N={max(intervals)}; pymoo-rail minus ms-eetc in % of"
                f" pymoo-rail's traction energy: median {diff[ok].median():+.4f} %, range {diff[ok].min():+.4f} .."
@@ -345,6 +402,17 @@ def generated_summary(table: pd.DataFrame, intervals: tuple[int, ...]) -> list[s
     return out
 
 
+def refresh_cached(table: pd.DataFrame, cache: dict[int, list[Path]]) -> pd.DataFrame:
+    """``table`` (of :func:`generated_rows`) with the columns of the cached N read again from the caches."""
+    table = table.copy()
+    for n, caches in cache.items():
+        for i, row in table.iterrows():
+            case = comparable_case(int(row.seed))
+            energy, cpu, v_end = mseetc_cached(caches, int(row.seed), case, float(row.time_s), n, None, "", 1)
+            table.loc[i, [f"ms{n}_kwh", f"ms{n}_cpu_s", f"ms{n}_end_ms"]] = energy, cpu, v_end
+    return table
+
+
 def main_generated(args) -> None:
     """``--generated N``: the reference and ms-eetc side by side on generated lines."""
     from pymoo_rail.cases import load_case
@@ -354,7 +422,12 @@ def main_generated(args) -> None:
     load_at_start = os.getloadavg()[0]
     seeds = args.seeds if args.seeds else range(args.first_seed, args.first_seed + args.generated)
     intervals = tuple(args.intervals)
-    table = generated_rows(seeds, args.mseetc, args.mseetc_python, intervals, args.repeats)
+    cache = {max(intervals): args.cache} if args.cache else {}  # the slow N: read, never run here
+    if args.refresh:  # the table of an earlier run, with the slow N's answers cached since
+        table = refresh_cached(pd.read_csv(args.report.with_suffix(".csv")), cache)
+    else:
+        table = generated_rows(seeds, args.mseetc, args.mseetc_python, intervals, args.repeats, cache)
+    table.to_csv(args.report.with_suffix(".csv"), index=False)
     from pymoo_rail.experiments.report import markdown
 
     text = ["# pymoo-rail's exact solver beside ms-eetc on generated lines", "",
@@ -366,8 +439,11 @@ def main_generated(args) -> None:
             " boundary speeds at least 1 m/s (`comparable_case`), at 1.05, 1.2 and 1.5 x the minimum running time."
             " Energies net (kWh), pymoo-rail's moved to the requested time along lambda; `bound_kwh` its"
             " certificate; CPU `time.process_time` (pymoo-rail: tables, search, replay and certificate from a"
-            f" fresh solver; ms-eetc: IPOPT, best of {args.repeats}). Load average (1 min) at the start and the end:"
-            f" {load_at_start:.2f} / {os.getloadavg()[0]:.2f}.", "",
+            f" fresh solver; ms-eetc: IPOPT, best of {args.repeats})."
+            + (" Rewritten with `--refresh` from the table of that run (its CSV beside this report), the largest N"
+               " read again from `--cache`." if args.refresh else
+               f" Load average (1 min) at the start and the end: {load_at_start:.2f} / {os.getloadavg()[0]:.2f}."),
+            "",
             *generated_summary(table, intervals), "", markdown(table.drop(columns=["features"])), "",
             "Features of the lines:", "",
             *[f"- seed {s}: {f}" for s, f in table.groupby("seed")["features"].first().items()], ""]
@@ -388,10 +464,25 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=1, help="ms-eetc solves per answer (best CPU time)")
     parser.add_argument("--report", type=Path, default=HERE / "reports" / "peers_generated.md",
                         help="where the generated lines' report goes")
+    parser.add_argument("--cache", type=Path, nargs="+", default=[],
+                        help="CSVs of ms-eetc's answers at the largest N: read (not run) with --generated/--seeds,"
+                             " filled (the first) with --mseetc-only")
+    parser.add_argument("--mseetc-only", action="store_true", help="only fill --cache with ms-eetc's answers")
+    parser.add_argument("--refresh", action="store_true",
+                        help="rewrite the report from its CSV (an earlier run), reading --cache again")
     args = parser.parse_args()
+    if args.mseetc_only:
+        seeds = args.seeds if args.seeds else range(args.first_seed, args.first_seed + args.generated)
+        mseetc_only(seeds, args.mseetc, args.mseetc_python, tuple(args.intervals), args.cache[0])
+        return
     if args.generated or args.seeds:
         main_generated(args)
         return
+    main_named(args)
+
+
+def main_named(args) -> None:
+    """The named cases (``CASES``) beside ms-eetc (run here or recorded), GPOPS-II and the closed form."""
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import OptimalSolver
 

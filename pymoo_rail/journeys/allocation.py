@@ -23,6 +23,7 @@ from pymoo_rail.journeys.fronts import (
     FRONT_COLUMNS,
     FrontSource,
     convex_front,
+    convex_fronts,
     front_energy,
     front_slopes,
     strategy_front,
@@ -179,7 +180,7 @@ def allocate_on_fronts(fronts: Sequence[pd.DataFrame], total_time_s: float) -> t
     Returns ``(running_times_s, energies_kwh, price_kwh_per_s)``; the price is the marginal energy
     saved per extra second, equal across every section whose time is strictly inside a segment.
     """
-    fronts = [convex_front(f, f"fronts[{k}]") for k, f in enumerate(fronts)]
+    fronts = convex_fronts(fronts)
     lo = np.array([f["running_time_s"].iloc[0] for f in fronts])
     hi = np.array([f["running_time_s"].iloc[-1] for f in fronts])
     total = float(total_time_s)

@@ -73,6 +73,18 @@ def convex_front(front: pd.DataFrame, name: str = "front") -> pd.DataFrame:
     return front.iloc[hull].reset_index(drop=True)
 
 
+def convex_fronts(fronts: Sequence[pd.DataFrame]) -> list[pd.DataFrame]:
+    """:func:`convex_front` of each front (named ``fronts[k]`` in errors), a front given several times
+    taken once: a trip of many sections over few distinct lines repeats the same DataFrame."""
+    done: dict[int, pd.DataFrame] = {}
+    out = []
+    for k, front in enumerate(fronts):
+        if id(front) not in done:
+            done[id(front)] = convex_front(front, f"fronts[{k}]")
+        out.append(done[id(front)])
+    return out
+
+
 def front_energy(front: pd.DataFrame, running_time_s: float | np.ndarray) -> np.ndarray:
     """Energy on the piecewise-linear front at given running times (inside its time range)."""
     t = front["running_time_s"].to_numpy(dtype=float)

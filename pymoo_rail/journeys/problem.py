@@ -9,7 +9,7 @@ import pandas as pd
 from pymoo.core.problem import Problem
 from pymoo.core.repair import Repair
 
-from pymoo_rail.journeys.fronts import convex_front
+from pymoo_rail.journeys.fronts import convex_fronts
 from pymoo_rail.model import CaseError, InfeasibleCaseError
 
 
@@ -32,7 +32,7 @@ class RunningTimeAllocationProblem(Problem):
     """
 
     def __init__(self, fronts: Sequence[pd.DataFrame], total_time_s: float, **kwargs):
-        self.fronts = [convex_front(f, f"fronts[{k}]") for k, f in enumerate(fronts)]
+        self.fronts = convex_fronts(fronts)
         if not self.fronts:
             raise CaseError("fronts", [], "needs at least one section front")
         self._t = [f["running_time_s"].to_numpy(dtype=float) for f in self.fronts]

@@ -749,7 +749,8 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
 
 
 def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray,
-          floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None, singular: bool = True):
+          floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None, singular: bool = True,
+          sing: tuple | None = None, reuse: bool = False):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
@@ -763,17 +764,24 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     regimes J) and the cost-to-go from the initial speed (J).
     Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
     energy, and the tables already hold it.
+
+    ``sing``: arrays ``(sing_v, sing_p, sing_val)`` (each (n_nodes, 2)) to hold the singular speeds and
+    their cost-to-go (default: new ones). ``reuse``: ``value`` and ``sing`` still hold the sweep of an
+    earlier solve at the same price and settings: only the forward run is made (the certificate's run
+    without the tie rule reuses the chosen run's sweep).
     """
     n = model.position_m.shape[0]
+    if sing is None:
+        sing = (np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2)))
+    sing_v, sing_p, sing_val = sing
+    if reuse:
+        return _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, sing_val)
     prices = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,)))
     if floor_k is None:
         floor_k = np.zeros(n, dtype=np.int64)
     if terminal_j is None:
         terminal_j = np.zeros(value.shape[1])
     price = prices + model.aux_power_w
-    sing_v = np.empty((n, 2))
-    sing_p = np.empty((n, 2))
-    sing_val = np.empty((n, 2))
     if singular:
         singular_speeds(model, price, value.shape[1], float(bias), sing_v, sing_p)
     else:
@@ -781,6 +789,13 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
         sing_p[:] = -1.0
     backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v, sing_p, sing_val, int(max_targets),
                    float(bias))
+    return _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, sing_val)
+
+
+def _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, sing_val):
+    """The forward run of :func:`solve` on a swept cost-to-go, and the cost-to-go from the initial speed."""
+    n = model.position_m.shape[0]
+    price = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,))) + model.aux_power_w
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)

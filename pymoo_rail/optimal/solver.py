@@ -129,6 +129,9 @@ class OptimalSolver:
         self.time_tol_s = check_number("time_tol_s", time_tol_s, positive=True, error=FieldError)
         self._value = np.empty((self.simulator.grid.n_nodes, self.n_speeds))
         self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
+        self._swept = None  # (price, shape, floor) of the cost-to-go in _value and _sing
+        n_nodes = self.simulator.grid.n_nodes
+        self._sing = (np.empty((n_nodes, 2)), np.empty((n_nodes, 2)), np.empty((n_nodes, 2)))  # dp.solve's
         self._min_time_s: float | None = None
         self.n_solves = 0  # DP solves so far (for benchmarks)
         # the parts of the last certificate (kWh): grid, moved run, kept regimes, untied run (for benchmarks)
@@ -158,6 +161,7 @@ class OptimalSolver:
             price_shape = shape
         self.price_shape = price_shape
         self._history = []
+        self._swept = None
         if self._coarse is not None:
             self._coarse.set_price_shape(price_shape)
 
@@ -179,6 +183,7 @@ class OptimalSolver:
         self.speed_floor_ms = speed_floor_ms
         self._floor_k = floor_k
         self._history = []
+        self._swept = None
         if self._coarse is not None:
             self._coarse.set_speed_floor(speed_floor_ms)
 
@@ -216,8 +221,12 @@ class OptimalSolver:
         value); :meth:`solve_price` records it as a :class:`Solve`.
         """
         prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
-        return dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, tie_j,
-                        self._value, self._floor_k, self._terminal_j, self.singular)
+        # the cost-to-go of the last sweep still holds at its price and settings: only the forward run
+        key = (lambda_w, id(self.price_shape), id(self._floor_k))
+        run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, tie_j,
+                       self._value, self._floor_k, self._terminal_j, self.singular, self._sing, self._swept == key)
+        self._swept = key
+        return run
 
     def at_finest_speed_grid(self) -> bool:
         """Whether ``profile`` may not refine the speed grid any further (``MAX_N_SPEEDS`` nodes)."""
@@ -236,7 +245,7 @@ class OptimalSolver:
         program = np.column_stack([self.simulator.model.position_m[1:], modes.astype(float), targets])
         return Solve(lambda_w, program, speeds, energy, time, float(value_j), tie_cost_j=tie_cost)
 
-    def energy_bound_kwh(self, solution: Solve) -> float:
+    def energy_bound_kwh(self, solution: Solve, traction_kwh: float = 0.0) -> float:
         """Estimated bound on the run's energy above the optimum at its running time (kWh, >= 0).
 
         The sum of three parts (``docs/optimal.md``, "Certificate"):
@@ -246,7 +255,8 @@ class OptimalSolver:
           ``lambda`` (the coarse front's supporting line there), differs from this run by
           ``delta``; if the DP's error falls like ``spacing^p``, the finer solve's error is
           ``|delta| / (2^p - 1)``, and ``2 |delta|`` covers any ``p >= 0.58``;
-        - a floor of ``1e-4`` of the run's net energy, for where the two grids agree by coincidence;
+        - a floor of ``1e-4`` of the run's net energy or ``5e-4`` of its traction energy
+          ``traction_kwh`` (the larger), for where the two grids agree by coincidence or err alike;
         - the run above the supporting line at ``lambda``: for a moved run, its weak-duality gap to
           the bracketing runs (``dual_gap_j``); for any run, how much better the forward run
           without the tie rule is at the same price; the larger of the two.
@@ -259,7 +269,7 @@ class OptimalSolver:
         """
         # the two grids compared through their dual functions at the run's price, min E + lambda T
         other = self.coarse_solver().solve_price(solution.lambda_w)
-        self.last_bound_parts = bound_parts_kwh(solution, other, untied_excess_j(self, solution))
+        self.last_bound_parts = bound_parts_kwh(solution, other, untied_excess_j(self, solution), traction_kwh)
         return bound_from_parts_kwh(self.last_bound_parts)
 
     def coarse_solver(self) -> OptimalSolver:
@@ -330,7 +340,10 @@ class OptimalSolver:
             # makes the jumps smaller
             if self.at_finest_speed_grid():
                 raise RuntimeError(f"running_time_s = {running_time_s}: the closest optimum takes "
-                                   f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W); refine the grid")
+                                   f"{solution.time_s:.2f} s (lambda = {solution.lambda_w:.6g} W), more than "
+                                   f"{MAX_TIME_ERROR_S} s off, at n_speeds = {self.n_speeds} (profile refines up to "
+                                   f"{MAX_N_SPEEDS}): the discrete optimum jumps over this time; another n_speeds "
+                                   "or dx_m moves the jumps")
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
                                   self.top_bias, self.tie_j, self.certify, self.price_shape, self.speed_floor_ms,
                                   self.singular)
@@ -339,7 +352,7 @@ class OptimalSolver:
             return tr
         tr = self.trajectory(solution)
         if self.certify:
-            tr = replace(tr, summary=dict(tr.summary, energy_bound_kwh=self.energy_bound_kwh(solution)))
+            tr = replace(tr, summary=dict(tr.summary, energy_bound_kwh=self.energy_bound_kwh(solution, tr.energy.traction_kwh)))
         return tr
 
 

@@ -3,21 +3,32 @@
 >>> from pymoo_rail.suite import get_problem, list_problems
 >>> problem = get_problem("yizhuang-bi")        # energy and running time, the planner's window
 >>> pf = problem.pareto_front()                 # the certified front (shipped, or cached on disk)
+>>> problem = get_problem("generated-metro-bi", n_var=300, seed=7)   # a seeded, scalable family instance
 
 See ``docs/suite.md`` for the problems, how their fronts were computed and how exact they are.
 """
 
 from pymoo_rail.optimal.reference import CertifiedFront, NoExactFrontError
+from pymoo_rail.suite.families import (
+    FAMILIES,
+    FAMILY_VERSION,
+    Family,
+    FamilyProblem,
+    get_problem,
+    list_families,
+)
 from pymoo_rail.suite.fronts_io import best_known_front, compute_best_known_front, verify
+from pymoo_rail.suite.ioh_logger import IOHLogger
 from pymoo_rail.suite.problems import (
     CASES,
     SUITE_VERSION,
     SuiteCase,
-    get_problem,
     list_problems,
     suite_case,
     tolerance_s,
 )
 
-__all__ = ["get_problem", "list_problems", "suite_case", "tolerance_s", "CASES", "SUITE_VERSION", "SuiteCase",
+__all__ = ["get_problem", "list_problems", "list_families", "Family", "FamilyProblem", "FAMILIES", "FAMILY_VERSION",
+           "IOHLogger",
+           "suite_case", "tolerance_s", "CASES", "SUITE_VERSION", "SuiteCase",
            "verify", "best_known_front", "compute_best_known_front", "CertifiedFront", "NoExactFrontError"]
