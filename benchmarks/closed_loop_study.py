@@ -9,14 +9,20 @@ through the exact plan's price of time (``cost_kwh = net energy + lambda x laten
 the lateness, stop error, comfort (acceleration variation) and advice changes are reported beside
 it, with Wilcoxon rank-sum tests of every controller against the best curve-tracking one.
 
+The worlds are computed by :func:`pymoo_rail.experiments.loop_study.run_loop_study`: one record per world
+in a result store (``out/closed_loop_study/store``), in chunks handed to a process pool
+(``--workers``), so a stopped study resumes where it was when run again. With the tuned trackers
+(default), each case's PID and fuzzy PID are first tuned on its plan by pymoo's DE
+(:func:`pymoo_rail.experiments.loop_study.tuned_trackers`).
+
 Writes ``benchmarks/reports/closed_loop_study.md``, ``closed_loop_study_summary.csv`` and the
-figure ``closed_loop_study.png``; the per-run rows go to ``out/closed_loop_study/runs.csv``
-(``--report-only`` rebuilds the report from them).
+figure ``closed_loop_study.png`` (not tracked); the per-run rows also go to
+``out/closed_loop_study/runs.csv`` (``--report-only`` rebuilds the report from the store).
 
 Usage: ``python benchmarks/closed_loop_study.py [--runs 200] [--runs-long 200] [--seed 1]
-[--cases yizhuang metro-a wuguang-crh3 ttobench-ref] [--report-only]``. The defaults are the full
-study (200 worlds per case); ``--runs-long`` sets the worlds of the lines over 10 km (about 15 s
-of CPU per world with all eight controllers and the exact optima, against 1.5 s on yizhuang).
+[--workers 2] [--cases yizhuang metro-a wuguang-crh3 ttobench-ref] [--report-only]``. The
+defaults are the full study (200 worlds per case); ``--runs-long`` sets the worlds of the lines
+over 10 km.
 """
 
 from __future__ import annotations
@@ -28,50 +34,24 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from pymoo_rail.cases import load_case  # noqa: E402
-from pymoo_rail.control.study import STUDY_CONTROLLERS, loop_runs, loop_summary  # noqa: E402
-from pymoo_rail.experiments.stats import rank_sum  # noqa: E402
+from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, loop_summary, study_planned_time  # noqa: E402
+from pymoo_rail.experiments.loop_study import (  # noqa: E402
+    LoopStudyCase,
+    load_loop_rows,
+    loop_tests,
+    run_loop_study,
+    tuned_trackers,
+)
 from pymoo_rail.plotting import save_figure  # noqa: E402
-from pymoo_rail.sim import Simulator  # noqa: E402
-from pymoo_rail.experiments.report import fixed
+from pymoo_rail.experiments.report import fixed, lower_priority  # noqa: E402
 
 REPORTS = Path(__file__).parent / "reports"
 OUT = Path(__file__).parents[1] / "out" / "closed_loop_study"
 CASES = ("yizhuang", "metro-a", "wuguang-crh3", "ttobench-ref")
-# metro-a's own 70 s is 0.4 % above its flat-out run: no disturbed train could be on time, so the
-# study plans it 8 % above the minimum running time, like the other cases' margins
-MARGIN = 1.08
-TRACKING = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis")
-
-
-def planned_time(case) -> float:
-    """The case's planned time, or 8 % above its minimum where the case leaves less."""
-    fastest = Simulator(case).min_running_time_s()
-    return float(max(case.planned_time_s, round(MARGIN * fastest)))
-
-
-def tests_table(runs: pd.DataFrame) -> pd.DataFrame:
-    """Each controller against the best curve-tracking one of its case (lowest median gap to the exact optimum)."""
-    rows = []
-    for case, g in runs.groupby("case", sort=False):
-        medians = g.groupby("controller")["gap_pct"].median()
-        best = min(TRACKING, key=lambda n: medians.get(n, np.inf))
-        base = g[g["controller"] == best]
-        for name in STUDY_CONTROLLERS:
-            if name == best:
-                continue
-            mine = g[g["controller"] == name]
-            for measure in ("gap_pct", "cost_kwh", "lateness_abs_s"):
-                a = mine["lateness_s"].abs() if measure == "lateness_abs_s" else mine[measure]
-                b = base["lateness_s"].abs() if measure == "lateness_abs_s" else base[measure]
-                u, p, verdict = rank_sum(a.to_numpy(), b.to_numpy())
-                rows.append({"case": case, "controller": name, "against": best, "measure": measure,
-                             "median": float(np.median(a)), "median_against": float(np.median(b)), "p_value": p,
-                             "verdict": verdict})
-    return pd.DataFrame(rows)
+TRACKING = ("tracking_pid", "tracking_fuzzy_pid", "tracking_hysteresis") + TUNED_CONTROLLERS
 
 
 def figure(runs: pd.DataFrame, path: Path) -> None:
@@ -80,7 +60,8 @@ def figure(runs: pd.DataFrame, path: Path) -> None:
 
     cases = list(dict.fromkeys(runs["case"]))
     fig, axes = plt.subplots(1, len(cases), figsize=(4.2 * len(cases), 4.0), squeeze=False)
-    colors = dict(zip(STUDY_CONTROLLERS, plt.get_cmap("tab10").colors))
+    palette = plt.get_cmap("tab20").colors
+    colors = dict(zip(STUDY_CONTROLLERS + TUNED_CONTROLLERS, palette[::2] + palette[1::2]))
     for ax, case in zip(axes[0], cases):
         g = runs[runs["case"] == case]
         for name, h in g.groupby("controller", sort=False):
@@ -97,20 +78,23 @@ def figure(runs: pd.DataFrame, path: Path) -> None:
     save_figure(fig, path, dpi=80)
 
 
-def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
-    summary = loop_summary(runs)
-    summary.to_csv(REPORTS / "closed_loop_study_summary.csv", index=False, float_format="%.6g")
-    tests = tests_table(runs)
-    figure(runs, REPORTS / "closed_loop_study.png")
-    lines = ["# Closed-loop study: tracking, recovery, re-planning and driver advice on disturbed trains", "",
-             f"Produced by `benchmarks/closed_loop_study.py --runs {args.runs} --runs-long {args.runs_long} "
-             f"--seed {args.seed}`" + (f" in {seconds:.0f} s of CPU." if seconds else " (report rebuilt from the runs)."),
-             "Worlds per case: " + ", ".join(f"{c} {n}" for c, n in runs.groupby('case', sort=False)['run'].nunique().items())
-             + ". Energy at equal arrival, two ways: `gap to exact`, the run's energy above the real train's exact "
-             "optimum at the run's own running time (the exact solver on the world's own model, restriction known "
-             "from the start); `cost_kwh = net energy + lambda x lateness` with the exact plan's price of time. On "
-             "time: within 2 s of the plan, among the worlds where the real train flat out could be.", "",
-             "| case | controller | median gap to exact % | median cost kWh | median energy kWh | median lateness s "
+def header(runs: pd.DataFrame, seconds: float | None, args) -> list[str]:
+    worlds = runs.groupby(["case", "run"], sort=False)["world_cpu_s"].first()
+    return ["# Closed-loop study: tracking, recovery, re-planning and driver advice on disturbed trains", "",
+            f"Produced by `benchmarks/closed_loop_study.py --runs {args.runs} --runs-long {args.runs_long} "
+            f"--seed {args.seed}`; {worlds.sum():.0f} s of CPU in the worlds (every controller and the exact optima)"
+            + (f", {seconds:.0f} s in the main process (the tuning)." if seconds else "."),
+            "Worlds per case: " + ", ".join(f"{c} {n}" for c, n in worlds.groupby(level=0, sort=False).size().items())
+            + "; CPU per world (median): " + ", ".join(
+                f"{c} {v:.1f} s" for c, v in worlds.groupby(level=0, sort=False).median().items())
+            + ". Energy at equal arrival, two ways: `gap to exact`, the run's energy above the real train's exact "
+            "optimum at the run's own running time (the exact solver on the world's own model, restriction known "
+            "from the start); `cost_kwh = net energy + lambda x lateness` with the exact plan's price of time. On "
+            "time: within 2 s of the plan, among the worlds where the real train flat out could be.", ""]
+
+
+def summary_lines(summary: pd.DataFrame) -> list[str]:
+    lines = ["| case | controller | median gap to exact % | median cost kWh | median energy kWh | median lateness s "
              "| on time (of possible) | late | median stop error m | median accel. variation m/s^2 "
              "| s per advice change | ms per re-plan |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -121,28 +105,63 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
                      f"{int(r['n_can_be_on_time'])} | {fixed(100 * r['late_share'], 0, missing='n/a')} % "
                      f"| {fixed(r['median_stop_error_m'], 3, missing='n/a')} | {fixed(r['median_jerk_ms2'], missing='n/a')} "
                      f"| {fixed(r['median_seconds_per_change'], 1, missing='n/a')} | {fixed(r['median_decision_cpu_ms'], 1, missing='n/a')} |")
-    lines += ["", "## Driver advice (1.5 s reaction) against the policy's own controls, world by world", "",
-              "Paired by world: `cost_kwh` of the advised run over that of `optimal_controls` (both re-plan every "
-              "10 s from the same states of the same worlds).", "",
-              "| case | worlds | median extra cost | 90th percentile | worlds over 1 % |", "|---|---|---|---|---|"]
+    return lines
+
+
+def advice_lines(runs: pd.DataFrame) -> list[str]:
+    lines = ["", "## Driver advice (1.5 s reaction) against the policy's own controls, world by world", "",
+             "Paired by world: `cost_kwh` of the advised run over that of `optimal_controls` (both re-plan every "
+             "10 s from the same states of the same worlds).", "",
+             "| case | worlds | median extra cost | 90th percentile | worlds over 1 % |", "|---|---|---|---|---|"]
     for case, g in runs.groupby("case", sort=False):
         adv = g[g["controller"] == "advice"].set_index("run")["cost_kwh"]
         opt = g[g["controller"] == "optimal_controls"].set_index("run")["cost_kwh"]
         extra = 100.0 * (adv / opt.reindex(adv.index) - 1.0)
         lines.append(f"| {case} | {len(extra)} | {extra.median():+.2f} % | {extra.quantile(0.9):+.2f} % "
                      f"| {int((extra > 1.0).sum())} |")
-    lines += ["", "## Wilcoxon rank-sum tests against the best curve tracking of each case", "",
-              "`+`: significantly lower (better) than the tracking controller at p < 0.05, `-`: higher, `=`: no "
-              "significant difference.", "",
-              "| case | controller | against | measure | median | median of tracking | p | verdict |",
-              "|---|---|---|---|---|---|---|---|"]
+    return lines
+
+
+def tests_lines(tests: pd.DataFrame) -> list[str]:
+    lines = ["", "## Wilcoxon signed-rank tests (paired by world) against the best curve tracking of each case", "",
+             "`+`: significantly lower (better) than the tracking controller at p < 0.05, `-`: higher, `=`: no "
+             "significant difference.", "",
+             "| case | controller | against | measure | median | median of tracking | p | verdict |",
+             "|---|---|---|---|---|---|---|---|"]
     for _, r in tests.iterrows():
         lines.append(f"| {r['case']} | {r['controller']} | {r['against']} | {r['measure']} | {fixed(r['median'], 3, missing='n/a')} "
                      f"| {fixed(r['median_against'], 3, missing='n/a')} | {fixed(r['p_value'], 4, missing='n/a')} | {r['verdict']} |")
-    lines += ["", "![energy against lateness](closed_loop_study.png)", ""]
+    return lines
+
+
+def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
+    runs = pd.concat([runs[runs["case"] == name] for name in args.cases])  # the cases in the order asked
+    summary = loop_summary(runs)
+    summary.to_csv(REPORTS / "closed_loop_study_summary.csv", index=False, float_format="%.6g")
+    figure(runs, REPORTS / "closed_loop_study.png")
+    lines = (header(runs, seconds, args) + summary_lines(summary) + advice_lines(runs)
+             + tests_lines(loop_tests(runs, TRACKING)) + ["", "![energy against lateness](closed_loop_study.png)", ""])
     text = "\n".join(lines)
     (REPORTS / "closed_loop_study.md").write_text(text, encoding="utf-8")
     return text
+
+
+def study_items(names, runs: int, runs_long: int, tune: bool) -> list:
+    """Each case with its planned time, worlds and (with ``tune``) the PID and fuzzy PID tuned on its plan."""
+    from pymoo_rail.control.policy import OptimalPolicy
+
+    items = []
+    for name in names:
+        case = load_case(name)
+        planned = study_planned_time(case)
+        n = runs if case.line.length_m <= 10_000 else runs_long
+        tuned = {}
+        if tune:
+            plan = OptimalPolicy(case, planned, certify=False).plan
+            tuned = tuned_trackers(case, plan)
+            print(f"{name}: tuned {tuned}", flush=True)
+        items.append(LoopStudyCase(case, planned, n, tuned))
+    return items
 
 
 def main() -> None:
@@ -151,23 +170,25 @@ def main() -> None:
     parser.add_argument("--runs-long", type=int, default=None, help="worlds per case over 10 km (default: --runs)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--cases", nargs="+", default=list(CASES))
+    parser.add_argument("--workers", type=int, default=1, help="processes of the pool")
+    parser.add_argument("--chunk", type=int, default=5, help="worlds of one case per task")
+    parser.add_argument("--no-tuning", action="store_true", help="leave out the tuned PID and fuzzy PID")
+    parser.add_argument("--work", type=Path, default=OUT / "store", help="the result store (resumable)")
     parser.add_argument("--report-only", action="store_true")
     args = parser.parse_args()
     args.runs_long = args.runs if args.runs_long is None else args.runs_long
+    lower_priority()
     OUT.mkdir(parents=True, exist_ok=True)
-    path = OUT / "runs.csv"
     if args.report_only:
-        print(report(pd.read_csv(path), None, args))
+        runs = load_loop_rows(args.work)
+        print(report(runs, None, args))
         return
     started = time.process_time()
-    frames = []
-    for name in args.cases:
-        case = load_case(name)
-        n = args.runs if case.line.length_m <= 10_000 else args.runs_long
-        frames.append(loop_runs(case, n, args.seed, planned_time_s=planned_time(case)))
-        pd.concat(frames).to_csv(path, index=False)
-        print(f"{name}: {n} worlds, {time.process_time() - started:.0f} s CPU so far", flush=True)
-    print(report(pd.concat(frames), time.process_time() - started, args))
+    items = study_items(args.cases, args.runs, args.runs_long, not args.no_tuning)
+    runs = run_loop_study(items, args.seed, args.work, args.workers, args.chunk,
+                          say=lambda text: print(text, flush=True))
+    runs.to_csv(OUT / "runs.csv", index=False)
+    print(report(runs, time.process_time() - started, args))  # the main process's CPU: the tuning
 
 
 if __name__ == "__main__":

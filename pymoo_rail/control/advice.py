@@ -266,7 +266,8 @@ def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_ban
     """
     if state.elapsed_s >= policy.planned_time_s:
         return board
-    model = policy.model_ahead(state.position_m, state.speed_ms, state.restriction, state.mass_t)
+    model = policy.model_ahead(state.position_m, state.speed_ms, state.restriction, state.mass_t,
+                               state.adhesion_factor)
     length = float(model.position_m[-1])
     remaining = policy.planned_time_s - state.elapsed_s
     now = current_advice(board, state.position_m)

@@ -34,7 +34,7 @@ import numpy as np
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.control import kernel as ck
 from pymoo_rail.control.controllers import PID, Controller, check_controller
-from pymoo_rail.control.disturbances import Disturbance, disturbed_tracker
+from pymoo_rail.control.disturbances import Disturbance, adhesion_limited, disturbed_tracker
 from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction, model_from, restricted_model, run_trace
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S
 from pymoo_rail.model import Case
@@ -103,7 +103,8 @@ class LoopState:
     """What a controller knows when it decides: the measured state and the line as announced.
 
     ``event`` is ``"departure"``, ``"period"`` or ``"announcement"``; ``mass_t`` is the train's
-    measured mass (weighed at departure).
+    measured mass (weighed at departure), ``adhesion_factor`` the rail's adhesion as the ATP knows it
+    (its braking curves, and so the real train's braking envelope, use it).
     """
 
     position_m: float
@@ -112,6 +113,7 @@ class LoopState:
     restriction: SpeedRestriction | None
     mass_t: float
     event: str
+    adhesion_factor: float = 1.0
 
 
 class LoopController(Protocol):
@@ -179,7 +181,8 @@ class Recovery:
         if late_s <= 0.0:
             return plan
         sim = Simulator(replace(self.case, train=replace(self.case.train, mass_t=state.mass_t)))
-        model = restricted_model(sim.model, state.restriction, float(self.case.train.length_m))
+        model = restricted_model(adhesion_limited(sim.model, state.adhesion_factor), state.restriction,
+                                 float(self.case.train.length_m))
         node = min(int(round(state.position_m / sim.grid.dx_m)), model.position_m.shape[0] - 2)
         ahead = model_from(model, node, min(state.speed_ms, float(model.envelope_ms[node])))
         length = float(model.position_m[-1])
@@ -224,10 +227,11 @@ def plan_for(policy: OptimalPolicy, state: LoopState) -> Trajectory:
     The planner's train may be less able than the real one (a resistance error): a state above its
     braking envelope is taken at the envelope.
     """
-    speed = min(state.speed_ms, policy.envelope_ms(state.position_m, state.restriction, state.mass_t))
+    train = (state.restriction, state.mass_t, state.adhesion_factor)
+    speed = min(state.speed_ms, policy.envelope_ms(state.position_m, *train))
     if state.elapsed_s >= policy.planned_time_s:
-        return policy.fastest(state.position_m, speed, state.elapsed_s, state.restriction, state.mass_t)
-    return policy.replan(state.position_m, speed, state.elapsed_s, state.restriction, state.mass_t)
+        return policy.fastest(state.position_m, speed, state.elapsed_s, *train)
+    return policy.replan(state.position_m, speed, state.elapsed_s, *train)
 
 
 def reference_command(model: KernelModel, reference: Trajectory) -> float:
@@ -324,7 +328,8 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
     while True:
         if pending and d.announce_m <= float(model.position_m[node]):  # announced before departure
             known, pending = d.restriction, False
-        state = LoopState(float(model.position_m[node]), v, t, known, case.train.mass_t * d.mass_factor, event)
+        state = LoopState(float(model.position_m[node]), v, t, known, case.train.mass_t * d.mass_factor, event,
+                          d.adhesion_factor)
         decisions.append(state.position_m)
         ahead = model_from(model, node, v)
         x_end = float(d.announce_m) if pending and d.announce_m > state.position_m else math.inf

@@ -20,7 +20,7 @@ from pymoo_rail.control.controllers import Controller
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S, Tracker
 from pymoo_rail.model import Case
 from pymoo_rail.sim import Trajectory
-from pymoo_rail.sim.physics import braking_envelope
+from pymoo_rail.sim.physics import KernelModel, braking_envelope
 
 # Ranges of the study (issue text: mass +-15 %); the others are reconstructed, typical values.
 DEFAULT_RANGES = {"mass_factor": (0.85, 1.15), "adhesion_factor": (0.8, 1.0), "speed_noise_kmh": (0.0, 0.5),
@@ -80,12 +80,21 @@ def disturbed_tracker(case: Case, controller: Controller, disturbance: Disturban
     """A tracker of the disturbed train: its mass, and its traction and braking force caps scaled by adhesion."""
     tracker = Tracker(disturbance.case(case), controller, control_period_s, dx_m)
     if disturbance.adhesion_factor != 1.0:
-        m = tracker.simulator.model
-        f = disturbance.adhesion_factor
-        m = m._replace(traction_max_n=min(m.traction_max_n, f * _peak_force(m, traction=True)),
-                       brake_max_n=min(m.brake_max_n, f * _peak_force(m, traction=False)))
-        tracker.simulator.model = m._replace(envelope_ms=braking_envelope(m))
+        tracker.simulator.model = adhesion_limited(tracker.simulator.model, disturbance.adhesion_factor)
     return tracker
+
+
+def adhesion_limited(model: KernelModel, adhesion_factor: float) -> KernelModel:
+    """The kernels' model with traction and braking force caps at ``adhesion_factor`` of their curves' peaks.
+
+    The braking envelope is rebuilt with the reduced brakes, as an ATP does with a known adhesion.
+    """
+    f = float(adhesion_factor)
+    if f == 1.0:
+        return model
+    m = model._replace(traction_max_n=min(model.traction_max_n, f * _peak_force(model, traction=True)),
+                       brake_max_n=min(model.brake_max_n, f * _peak_force(model, traction=False)))
+    return m._replace(envelope_ms=braking_envelope(m))
 
 
 def _peak_force(model, traction: bool) -> float:

@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
+from pymoo_rail.control.disturbances import adhesion_limited
 from pymoo_rail.model import Case
 from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.optimal import OptimalSolver, dp
@@ -221,11 +222,10 @@ class OptimalPolicy:
         self.n_sweeps = 0
         self.last_program: np.ndarray | None = None
         self._lines: dict[tuple, _Line] = {}
-        self._solvers: dict[float, OptimalSolver] = {}
         model = self.solver.simulator.model
         self.dx_m = float(self.solver.dx_m)
         self.aux_w = float(model.aux_power_w)
-        self._lines[(self.case.train.mass_t, None)] = _Line(model, self.solver.transition_tables(),
+        self._lines[(self.case.train.mass_t, 1.0, None)] = _Line(model, self.solver.transition_tables(),
                                                             self._terminal(model))
 
     def _terminal(self, model: KernelModel) -> np.ndarray:
@@ -233,7 +233,7 @@ class OptimalPolicy:
 
     def _forget_lines(self) -> None:
         """Keep the case's own line and the most recently used others (each holds tables and sweeps)."""
-        nominal = (self.case.train.mass_t, None)
+        nominal = (self.case.train.mass_t, 1.0, None)
         others = [key for key in self._lines if key != nominal]
         for key in others[: max(len(others) - (MAX_LINES_KEPT - 1), 0)]:
             del self._lines[key]
@@ -260,22 +260,28 @@ class OptimalPolicy:
                                                    "keep the limits ahead")
         return node, min(v, top), t
 
-    def _line(self, restriction: SpeedRestriction | None, mass_t: float | None) -> _Line:
+    def _line(self, restriction: SpeedRestriction | None, mass_t: float | None,
+              adhesion_factor: float | None = None) -> _Line:
         if restriction is not None:
             if not isinstance(restriction, SpeedRestriction):
                 raise FieldError("restriction", restriction, "must be a SpeedRestriction (start_m, end_m, limit_kmh)")
             restriction.check_on(self.case)
         mass = self.case.train.mass_t if mass_t is None else check_number("mass_t", mass_t, positive=True,
                                                                           error=FieldError)
-        key = (mass, restriction)
+        adhesion = 1.0 if adhesion_factor is None else check_number("adhesion_factor", adhesion_factor,
+                                                                    positive=True, error=FieldError)
+        if adhesion > 1.0:
+            raise FieldError("adhesion_factor", adhesion_factor, "must be at most 1 (a share of the nominal forces)")
+        key = (mass, adhesion, restriction)
         if key in self._lines:
             self._lines[key] = self._lines.pop(key)  # most recently used last
             return self._lines[key]
-        base_key = (mass, None)
-        if base_key not in self._lines:  # a measured mass changes every cell: new model and tables
+        base_key = (mass, adhesion, None)
+        if base_key not in self._lines:  # a measured mass or adhesion changes every cell: new model and tables
             case = replace(self.case, train=replace(self.case.train, mass_t=mass))
             solver = OptimalSolver(case, self.dx_m, self.n_speeds, self.max_targets, top_bias=self.bias,
                                    tie_j=self.tie_j, certify=False)
+            solver.simulator.model = adhesion_limited(solver.simulator.model, adhesion)  # before any table
             self._lines[base_key] = _Line(solver.simulator.model, solver.transition_tables(),
                                           self._terminal(solver.simulator.model))
         base = self._lines[base_key]
@@ -290,16 +296,16 @@ class OptimalPolicy:
         return line
 
     def envelope_ms(self, position_m: float, restriction: SpeedRestriction | None = None,
-                    mass_t: float | None = None) -> float:
+                    mass_t: float | None = None, adhesion_factor: float | None = None) -> float:
         """The planner's braking envelope at the grid node nearest ``position_m`` (m/s): the highest speed it plans from."""
-        model = self._line(restriction, mass_t).model
+        model = self._line(restriction, mass_t, adhesion_factor).model
         node = min(max(int(round(float(position_m) / self.dx_m)), 0), model.position_m.shape[0] - 1)
         return float(model.envelope_ms[node])
 
     def model_ahead(self, position_m: float, speed_ms: float, restriction: SpeedRestriction | None = None,
-                    mass_t: float | None = None) -> KernelModel:
+                    mass_t: float | None = None, adhesion_factor: float | None = None) -> KernelModel:
         """The planner's model of the line ahead of ``position_m`` (nearest node) with the train at ``speed_ms``."""
-        model = self._line(restriction, mass_t).model
+        model = self._line(restriction, mass_t, adhesion_factor).model
         node = min(max(int(round(float(position_m) / self.dx_m)), 0), model.position_m.shape[0] - 2)
         return model_from(model, node, min(float(speed_ms), float(model.envelope_ms[node])))
 
@@ -491,12 +497,13 @@ class OptimalPolicy:
         return moved(lo) if abs(times[0] - remaining_s) <= abs(times[1] - remaining_s) else moved(hi)
 
     def fastest(self, position_m: float, speed_ms: float, elapsed_s: float,
-                restriction: SpeedRestriction | None = None, mass_t: float | None = None) -> Trajectory:
+                restriction: SpeedRestriction | None = None, mass_t: float | None = None,
+               adhesion_factor: float | None = None) -> Trajectory:
         """The earliest arrival from a state: maximum traction, held at the limits, latest braking.
 
         Unlike :meth:`replan`, ``elapsed_s`` may be past the planned arrival.
         """
-        line = self._line(restriction, mass_t)
+        line = self._line(restriction, mass_t, adhesion_factor)
         node, v, elapsed = self._check_state(line.model, position_m, speed_ms, elapsed_s, before_plan=False)
         model = model_from(line.model, node, v)
         self.last_program = flat_out_program(float(model.position_m[-1]))
@@ -516,7 +523,8 @@ class OptimalPolicy:
         return replace(tr, running_time_s=arrival, summary=summary)
 
     def replan(self, position_m: float, speed_ms: float, elapsed_s: float,
-               restriction: SpeedRestriction | None = None, mass_t: float | None = None) -> Trajectory:
+               restriction: SpeedRestriction | None = None, mass_t: float | None = None,
+               adhesion_factor: float | None = None) -> Trajectory:
         """The optimal rest of the run from a state, arriving at the planned time.
 
         Parameters
@@ -532,6 +540,9 @@ class OptimalPolicy:
             A temporary speed restriction on the line (known from now on).
         mass_t : float, optional
             The measured train mass (t), if it differs from the case's.
+        adhesion_factor : float, optional
+            The rail's adhesion as a share (<= 1) of the nominal traction and braking force peaks,
+            as the ATP knows it (its braking curves use it): the planner's train gets the same caps.
 
         Returns
         -------
@@ -540,8 +551,9 @@ class OptimalPolicy:
             clock continuing from ``elapsed_s`` (``running_time_s`` is the arrival time on that
             clock, ``energy`` the energy from here). ``summary`` adds ``lambda_w`` (price of time
             of the run), ``lateness_s`` (arrival minus plan), ``on_time`` (1.0 when within
-            ``ARRIVAL_TOL_S`` of the plan, 0.0 when even the fastest run is late: the run is then
-            the fastest one; or, when even the cheapest run of the lattice arrives early, that run),
+            ``ARRIVAL_TOL_S`` of the plan, 0.0 when even the fastest run is more than
+            ``ON_TIME_TOL_S - ARRIVAL_TOL_S`` late: the run is then the fastest one; a train less
+            late than that is planned ``ARRIVAL_TOL_S`` behind the fastest run; or, when even the cheapest run of the lattice arrives early, that run),
             ``energy_bound_kwh`` (estimated bound above the optimum at the run's time: the duality
             gap to the cost-to-go of every price computed plus the plan's grid share) and
             ``replan_cpu_s``.
@@ -553,23 +565,26 @@ class OptimalPolicy:
             past the plan, a restriction beyond the line, a mass that is not a positive number.
         """
         started = _time.process_time()
-        line = self._line(restriction, mass_t)
+        line = self._line(restriction, mass_t, adhesion_factor)
         node, v, elapsed = self._check_state(line.model, position_m, speed_ms, elapsed_s)
         remaining = self.planned_time_s - elapsed
         model = model_from(line.model, node, v)
         fastest = flat_out_program(float(model.position_m[-1]))
         t_min = self._times(model, fastest[None])[0]
-        if t_min >= remaining:  # not even the fastest run is on time: the earliest arrival
+        if t_min > remaining + ON_TIME_TOL_S - ARRIVAL_TOL_S:  # not on time even flat out: the earliest arrival
             self.last_program = fastest
             tr = run_trace(model, fastest, elapsed)
             return self._finish(tr, elapsed, math.inf, math.nan, on_time=t_min <= remaining + ON_TIME_TOL_S,
                                 cpu_s=_time.process_time() - started)
-        k = self._choose_price(line, node, v, remaining)
-        program, price_w = self._on_time_program(line, k, node, v, model, remaining)
+        # a train a little behind a plan that ends near its minimum time (metro-a's last coast) is on
+        # time within the tolerance just after the flat-out run, for far less energy than flat out
+        target = max(remaining, t_min + ARRIVAL_TOL_S)
+        k = self._choose_price(line, node, v, target)
+        program, price_w = self._on_time_program(line, k, node, v, model, target)
         self.last_program = program
         tr = run_trace(model, program, elapsed)
         # weak duality: E*(T) >= V_lambda(state) - lambda T for every price swept so far
-        lower = max(self._cost_to_go(line, j, node, v) - self._price(j) * remaining
+        lower = max(self._cost_to_go(line, j, node, v) - self._price(j) * target
                     for j, (first, _) in list(line.values.items()) if first <= node)
         on_time = abs(tr.time_s[-1] - self.planned_time_s) <= ON_TIME_TOL_S
         return self._finish(tr, elapsed, price_w, lower, on_time, _time.process_time() - started)

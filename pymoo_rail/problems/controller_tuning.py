@@ -114,3 +114,18 @@ class ControllerTuningProblem(Problem):
 
     def _evaluate(self, x, out, *args, **kwargs):
         out["F"] = np.array([[self.cost(xi)] for xi in np.atleast_2d(x)])
+
+
+def tune_controller(case: Case, family: str, reference: Trajectory, n_train: int = 4, pop_size: int = 10,
+                    n_gen: int = 10, seed: int = 1):
+    """Gains of ``family`` tuned on ``reference`` by pymoo's DE (mean rms tracking error over disturbed trains).
+
+    The same training set and budget for every family (:class:`ControllerTuningProblem`), so a
+    study compares the families fairly. Returns the :class:`PID` or :class:`FuzzyPID` of the best gains.
+    """
+    from pymoo.algorithms.soo.nonconvex.de import DE
+    from pymoo.optimize import minimize
+
+    problem = ControllerTuningProblem(case, family, reference=reference, n_train=n_train)
+    result = minimize(problem, DE(pop_size=pop_size), ("n_gen", n_gen), seed=seed)
+    return controller_from_gains(family, np.asarray(result.X, dtype=float))

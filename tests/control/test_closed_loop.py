@@ -108,6 +108,17 @@ def test_bad_decision_period(metro, policy):
         closed_loop(metro, CurveTracking(policy.plan, PID(), decide_every_s=0.0))
 
 
+def test_a_train_just_behind_a_tight_plan_is_not_driven_flat_out(metro):
+    """metro-a at 75 s: the plan's last coast ends 0.05 s behind 75 s, and flat out saves little time."""
+    from pymoo_rail.control.closed_loop import OptimalControls
+
+    tight = OptimalPolicy(metro, 75.0)
+    run = closed_loop(metro, OptimalControls(tight, 10.0), planned_time_s=75.0)
+    # re-planning on the plan changes nothing; flat out from 879 m cost 0.40 kWh (2.3 %) more
+    assert run.energy.net_kwh == pytest.approx(tight.plan.energy.net_kwh, rel=1e-3)
+    assert abs(run.summary["lateness_s"]) <= 0.5
+
+
 def test_the_optimal_controls_applied_directly_arrive_on_time(metro, policy):
     from pymoo_rail.control.closed_loop import OptimalControls
 
@@ -118,3 +129,18 @@ def test_the_optimal_controls_applied_directly_arrive_on_time(metro, policy):
     heavy_late = LoopDisturbance(departure_delay_s=3.0, mass_factor=1.1, resistance_factor=1.1)
     run = closed_loop(metro, OptimalControls(policy, 5.0), heavy_late, planned_time_s=PLANNED_S)
     assert abs(run.summary["lateness_s"]) <= 1.0 and run.summary["reached"] == 1.0
+
+
+@pytest.mark.slow
+def test_a_long_line_with_weak_adhesion_arrives_on_time():
+    """48 km, a 10 % heavier train on 0.895 adhesion: planned on the nominal brakes, it arrived 4.2 s late."""
+    from pymoo_rail.control.closed_loop import OptimalControls
+    from pymoo_rail.control.study import draw_loop_disturbances, study_planned_time
+
+    case = load_case("wuguang-crh3")
+    planned = study_planned_time(case)  # 8 % above the minimum running time
+    world = draw_loop_disturbances(case, 2, 1, planned)[1]
+    assert world.adhesion_factor < 0.9 and world.mass_factor > 1.09 and world.departure_delay_s == 0.0
+    run = closed_loop(case, OptimalControls(OptimalPolicy(case, planned), 10.0), world, planned_time_s=planned)
+    assert run.summary["reached"] == 1.0
+    assert abs(run.summary["lateness_s"]) <= 2.0

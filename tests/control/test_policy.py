@@ -122,6 +122,17 @@ def test_a_measured_mass_replans_with_the_heavier_train(metro, policy):
     assert heavy.energy.net_kwh > nominal.energy.net_kwh
 
 
+def test_a_known_low_adhesion_brakes_earlier_and_is_still_on_time(metro, policy):
+    plan = policy.plan
+    i = 100
+    low = policy.replan(plan.position_m[i], plan.speed_ms[i], plan.time_s[i], adhesion_factor=0.85)
+    nominal = policy.replan(plan.position_m[i], plan.speed_ms[i], plan.time_s[i])
+    assert abs(low.running_time_s - PLANNED_S) <= 0.3
+    # weaker brakes: the ATP's envelope, and so the planner's, is lower before the platform
+    assert policy.envelope_ms(900.0, adhesion_factor=0.85) < policy.envelope_ms(900.0)
+    assert np.max(low.accel_ms2) < np.max(nominal.accel_ms2) + 1e-9
+
+
 @pytest.mark.parametrize("kwargs, field", [
     ({"position_m": -1.0}, "position_m"), ({"position_m": 1000.5}, "position_m"),
     ({"position_m": 1000.0}, "position_m"), ({"position_m": math.nan}, "position_m"),
@@ -129,6 +140,7 @@ def test_a_measured_mass_replans_with_the_heavier_train(metro, policy):
     ({"elapsed_s": PLANNED_S + 1.0}, "elapsed_s"), ({"elapsed_s": -1.0}, "elapsed_s"),
     ({"restriction": SpeedRestriction(900.0, 1200.0, 40.0)}, "restriction.end_m"),
     ({"restriction": (100, 200, 40)}, "restriction"), ({"mass_t": 0.0}, "mass_t"),
+    ({"adhesion_factor": 0.0}, "adhesion_factor"), ({"adhesion_factor": 1.2}, "adhesion_factor"),
 ])
 def test_bad_input_names_the_field_and_the_value(policy, kwargs, field):
     state = {"position_m": 300.0, "speed_ms": 15.0, "elapsed_s": 20.0, **kwargs}
@@ -163,4 +175,4 @@ def test_line_variants_are_kept_within_bounds(metro, policy):
     for k in range(MAX_LINES_KEPT + 2):
         policy.replan(300.0, 15.0, 25.0, mass_t=metro.train.mass_t * (1.0 + 0.01 * (k + 1)))
     assert len(policy._lines) <= MAX_LINES_KEPT
-    assert (metro.train.mass_t, None) in policy._lines  # the case's own line stays
+    assert (metro.train.mass_t, 1.0, None) in policy._lines  # the case's own line stays

@@ -58,3 +58,9 @@ def test_a_world_too_late_for_the_plan_is_told_apart(metro):
 def test_unknown_controller_name(metro):
     with pytest.raises(FieldError, match="'controller' = 'magic'"):
         make_loop_controller("magic", metro, None)
+
+
+def test_tuned_trackers_need_their_gains(metro):
+    policy = OptimalPolicy(metro, 80.0)
+    with pytest.raises(FieldError, match="'controller' = 'tracking_tuned_pid'"):
+        make_loop_controller("tracking_tuned_pid", metro, policy)

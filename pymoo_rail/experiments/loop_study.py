@@ -1,0 +1,171 @@
+"""The closed-loop study run at full size: one record per world in a result store, resumable, on a process pool.
+
+:func:`run_loop_study` hands the worlds of :mod:`pymoo_rail.control.study` out in chunks (one
+case's policy is built once per chunk) and stores each world's rows (every controller, the exact
+optima) as one checksummed record of a :class:`~pymoo_rail.experiments.store.ResultStore`: written
+atomically, computed by the process holding its claim, never computed again, so a study stopped
+at any time goes on where it was. :func:`tuned_trackers` tunes the PID and fuzzy PID on a case's
+plan (:func:`pymoo_rail.problems.controller_tuning.tune_controller`) for the study's tuned trackers.
+"""
+
+from __future__ import annotations
+
+import json
+import time as _time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Callable, Mapping, Sequence
+
+import pandas as pd
+
+from pymoo_rail.control.controllers import Controller
+from pymoo_rail.control.policy import OptimalPolicy
+from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, draw_loop_disturbances, world_rows
+from pymoo_rail.experiments.stats import signed_rank_vs
+from pymoo_rail.experiments.store import ResultStore, record_checksum
+from pymoo_rail.model import Case
+from pymoo_rail.model.errors import FieldError
+from pymoo_rail.problems.controller_tuning import tune_controller
+from pymoo_rail.sim import Trajectory
+
+# One record of the result store holds the rows of one world of one case
+LOOP_RECORD_FORMAT = "pymoo-rail/loop-world/1"
+
+
+def tuned_trackers(case: Case, plan: Trajectory, seed: int = 1) -> dict[str, Controller]:
+    """The PID and fuzzy PID tuned on ``plan`` with the same training set and budget (keys ``pid``, ``fuzzy_pid``)."""
+    return {family: tune_controller(case, family, plan, seed=seed) for family in ("pid", "fuzzy_pid")}
+
+
+@dataclass(frozen=True)
+class LoopStudyCase:
+    """One case of a closed-loop study: its planned time, worlds and the tuned trackers (if any)."""
+
+    case: Case
+    planned_time_s: float
+    n_runs: int
+    tuned: Mapping[str, Controller] = field(default_factory=dict)
+
+
+def world_run_id(case_name: str, seed: int, run: int) -> str:
+    """The result store's id of one world of a case."""
+    return f"{case_name}-seed{seed}-world{run:04d}"
+
+
+def _loop_chunk(item: LoopStudyCase, runs: list[int], seed: int, directory: str,
+                controllers: tuple[str, ...]) -> int:
+    """Compute and store the worlds ``runs`` of one case (skipping those stored or claimed); returns how many."""
+    store = ResultStore(directory)
+    planned = item.planned_time_s
+    policy = None
+    worlds = draw_loop_disturbances(item.case, max(runs) + 1, seed, planned)
+    done = 0
+    for run in runs:
+        run_id = world_run_id(item.case.name, seed, run)
+        lock = store.claim(run_id)
+        if lock is None:
+            continue
+        try:
+            if store.path(run_id).is_file():
+                continue
+            policy = OptimalPolicy(item.case, planned) if policy is None else policy
+            started = _time.process_time()
+            rows = world_rows(item.case, run, worlds[run], policy, planned, controllers, True, item.tuned)
+            world_cpu_s = _time.process_time() - started  # every controller and the exact optima
+            rows = [dict(row, world_cpu_s=world_cpu_s) for row in rows]
+            store.write({"format": LOOP_RECORD_FORMAT, "run_id": run_id, "case": item.case.name, "seed": seed,
+                         "planned_time_s": planned, "controllers": list(controllers), "rows": rows})
+            done += 1
+        finally:
+            lock.release()
+    return done
+
+
+def load_loop_rows(directory: str | Path) -> pd.DataFrame:
+    """Every world stored by :func:`run_loop_study` in ``directory``, one row per world and controller.
+
+    A record whose checksum does not match its content is a :class:`FieldError` naming the file.
+    """
+    store = ResultStore(directory)
+    rows = []
+    for path in sorted(store.runs_dir.glob("*.json")) if store.runs_dir.is_dir() else []:
+        record = json.loads(path.read_text(encoding="utf-8"))
+        checksum = record.pop("checksum", None)
+        if record.get("format") != LOOP_RECORD_FORMAT or checksum != record_checksum(record):
+            raise FieldError("record", str(path), "is not a checked closed-loop record (altered or damaged): "
+                                                  "delete it and run the study again")
+        rows += record["rows"]
+    return pd.DataFrame(rows)
+
+
+def run_loop_study(items: Sequence[LoopStudyCase], seed: int, directory: str | Path, workers: int = 1,
+                   chunk: int = 5, controllers: Sequence[str] | None = None,
+                   say: Callable[[str], None] = print) -> pd.DataFrame:
+    """The closed-loop study of several cases, resumable: one record per world in a result store.
+
+    Worlds already stored in ``directory`` are not computed again, so a study stopped at any time
+    goes on where it was by running it again. Work is handed out in chunks of ``chunk`` worlds of
+    one case (a chunk builds its case's policy once), chunk by chunk across the cases, so that a
+    study stopped early has about as many worlds of every case; ``workers`` processes of a pool.
+    Returns :func:`load_loop_rows` of the directory.
+    """
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise FieldError("workers", workers, "must be a positive integer")
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or chunk < 1:
+        raise FieldError("chunk", chunk, "must be a positive integer")
+    store = ResultStore(directory)
+    store.prepare()
+    done = store.done_ids()
+    tasks = []
+    for first in range(0, max(item.n_runs for item in items), chunk):
+        for item in items:
+            names = tuple(controllers or STUDY_CONTROLLERS + tuple(
+                n for n in TUNED_CONTROLLERS if n.removeprefix("tracking_tuned_") in item.tuned))
+            runs = [r for r in range(first, min(first + chunk, item.n_runs))
+                    if world_run_id(item.case.name, seed, r) not in done]
+            if runs:
+                tasks.append((item, runs, seed, str(directory), names))
+    say(f"{len(done)} worlds stored, {sum(len(t[1]) for t in tasks)} to compute in {len(tasks)} chunks")
+    if workers == 1:
+        for task in tasks:
+            _report_chunk(task, _loop_chunk(*task), say)
+    else:
+        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+            futures = [(task, pool.submit(_loop_chunk, *task)) for task in tasks]
+            for task, future in futures:
+                _report_chunk(task, future.result(), say)
+    return load_loop_rows(directory)
+
+
+def _report_chunk(task: tuple, n_done: int, say: Callable[[str], None]) -> None:
+    item, runs = task[0], task[1]
+    say(f"{item.case.name}: worlds {runs[0]}-{runs[-1]} stored ({n_done} computed here)")
+
+
+def loop_tests(runs: pd.DataFrame, tracking: Sequence[str]) -> pd.DataFrame:
+    """Each controller against the best curve tracking of its case (lowest median ``gap_pct``), world by world.
+
+    Paired Wilcoxon signed-rank tests (every controller drove the same worlds) of ``gap_pct``,
+    ``cost_kwh`` and the absolute lateness; verdict ``+`` significantly lower (better) at p < 0.05,
+    ``-`` higher, ``=`` no significant difference.
+    """
+    rows = []
+    for case, g in runs.groupby("case", sort=False):
+        medians = g.groupby("controller")["gap_pct"].median()
+        best = min((n for n in tracking if n in medians.index), key=lambda n: medians[n])
+        base = g[g["controller"] == best].set_index("run")
+        for name in dict.fromkeys(g["controller"]):
+            if name == best:
+                continue
+            mine = g[g["controller"] == name].set_index("run")
+            for measure in ("gap_pct", "cost_kwh", "lateness_abs_s"):
+                a, b = (frame["lateness_s"].abs() if measure == "lateness_abs_s" else frame[measure]
+                        for frame in (mine, base))
+                b = b.reindex(a.index)
+                p, verdict = signed_rank_vs((a - b).to_numpy(), 0.0)
+                rows.append({"case": case, "controller": name, "against": best, "measure": measure,
+                             "median": float(a.median()), "median_against": float(b.median()), "p_value": p,
+                             "verdict": verdict})
+    return pd.DataFrame(rows)

@@ -1,0 +1,58 @@
+"""The closed-loop study at full size: one checked record per world, resumable (``pymoo_rail.experiments.loop_study``)."""
+
+import numpy as np
+import pytest
+
+from pymoo_rail.cases import load_case
+from pymoo_rail.control.study import loop_runs
+from pymoo_rail.model.errors import FieldError
+
+
+@pytest.fixture(scope="module")
+def metro():
+    return load_case("metro-a")
+
+
+def test_the_study_is_stored_world_by_world_and_resumes(metro, tmp_path):
+    from pymoo_rail.control import PID
+    from pymoo_rail.experiments.loop_study import LoopStudyCase, load_loop_rows, run_loop_study
+
+    item = LoopStudyCase(metro, 80.0, 2, tuned={"pid": PID(kp=0.3, ki=0.02, kd=0.0)})
+    names = ("tracking_pid", "tracking_tuned_pid", "optimal_controls")
+    said = []
+    rows = run_loop_study([item], 5, tmp_path, chunk=1, controllers=names, say=said.append)
+    assert said[0] == "0 worlds stored, 2 to compute in 2 chunks"
+    assert sorted(set(rows["run"])) == [0, 1] and len(rows) == 6
+    tuned = rows[rows["controller"] == "tracking_tuned_pid"]
+    assert (tuned["net_kwh"].to_numpy() != rows[rows["controller"] == "tracking_pid"]["net_kwh"].to_numpy()).all()
+    # the same worlds as the study's own runs, so a resumed study matches one run in one go
+    direct = loop_runs(metro, 2, seed=5, controllers=names, planned_time_s=80.0, tuned=item.tuned)
+    np.testing.assert_allclose(rows["net_kwh"].to_numpy(), direct["net_kwh"].to_numpy())
+    again = run_loop_study([item], 5, tmp_path, chunk=1, controllers=names, say=said.append)
+    assert said[-1] == "2 worlds stored, 0 to compute in 0 chunks"
+    assert again.equals(rows)
+    record = tmp_path / "runs" / "metro-a-seed5-world0000.json"
+    record.write_text(record.read_text().replace('"run": 0', '"run": 7'))
+    with pytest.raises(FieldError, match="'record' = .*altered or damaged"):
+        load_loop_rows(tmp_path)
+
+
+def test_loop_tests_pair_the_worlds():
+    import pandas as pd
+
+    from pymoo_rail.experiments.loop_study import loop_tests
+
+    rng = np.random.default_rng(0)
+    base = rng.uniform(1.0, 20.0, 12)  # worlds differ far more than the controllers do
+    rows = []
+    for name, shift in (("tracking_a", 0.0), ("tracking_b", 0.5), ("better", -0.1), ("worse", 0.1)):
+        for run, b in enumerate(base):
+            rows.append({"case": "c", "run": run, "controller": name, "gap_pct": b + shift, "cost_kwh": b + shift,
+                         "lateness_s": 0.0})
+    tests = loop_tests(pd.DataFrame(rows), ("tracking_a", "tracking_b"))
+    gap = tests[tests["measure"] == "gap_pct"].set_index("controller")
+    assert set(gap["against"]) == {"tracking_a"}
+    # unpaired, +-0.1 would be lost in the spread of the worlds; paired, it is significant
+    assert gap.loc["better", "verdict"] == "+" and gap.loc["worse", "verdict"] == "-"
+    assert gap.loc["tracking_b", "verdict"] == "-"
+    assert (tests[tests["measure"] == "lateness_abs_s"]["verdict"] == "=").all()
