@@ -29,7 +29,7 @@ from pymoo_rail.model import Case
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.optimal.reference import FRONT_VERSION, NoExactFrontError, case_hash, default_window
 from pymoo_rail.suite import problems as named
-from pymoo_rail.suite.identity import as_text, checksum_of
+from pymoo_rail.suite.identity import HV_MARGIN, as_text, checksum_of
 from pymoo_rail.suite.trips import TripProblem, trip_problem
 
 FAMILY_VERSION = "1"
@@ -38,8 +38,6 @@ N_VAR_RANGE = (2, 1000)
 """Smallest and largest ``n_var`` of a family instance (the checks and the benchmark cover 10-1000)."""
 DEFAULT_N_VAR = 30
 DEFAULT_SEED = 1
-HV_MARGIN = 0.1
-"""The hypervolume reference point lies this share of the front's range beyond its nadir point."""
 BI_OBJECTIVES = ("energy", "running_time")
 TRIP_KINDS = ("metro", "suburban")
 """Kinds of line of the whole-trip families (many stops: the short lines)."""
@@ -144,7 +142,8 @@ class FamilyProblem(SpeedProfileProblem):
                                     "no certified front: take another seed") from err
 
     def hv_reference_point(self) -> np.ndarray:
-        """The fixed hypervolume reference point: the certified front's nadir plus :data:`HV_MARGIN` of its range.
+        """The fixed hypervolume reference point: the certified front's nadir plus
+        :data:`~pymoo_rail.suite.identity.HV_MARGIN` of its range.
 
         Taken from the case's bi-objective front in the planner's window (energy kWh, running time s),
         restricted to this problem's objectives: the single-objective form's point is the energy of

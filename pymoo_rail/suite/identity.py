@@ -1,4 +1,4 @@
-"""Checksums of instance definitions: canonical JSON, floats as text with a fixed number of digits."""
+"""What fixes an instance's identity: checksums of canonical definitions, and the HV reference margin."""
 
 from __future__ import annotations
 
@@ -10,6 +10,9 @@ import numpy as np
 DIGITS = 12
 """Significant digits of the floats of a definition: the last bits of a simulated number (a window's
 end from the flat-out run, a front's vertex) may differ between machines; 12 digits do not."""
+
+HV_MARGIN = 0.1
+"""A family instance's hypervolume reference point lies this share of the front's range beyond its nadir."""
 
 
 def as_text(values) -> list[str]:

@@ -21,7 +21,7 @@ from pymoo_rail.cases import generate_case
 from pymoo_rail.journeys import RunningTimeAllocationProblem, allocate_on_fronts, front_energy, strategy_front
 from pymoo_rail.model import Case
 from pymoo_rail.optimal.reference import case_hash
-from pymoo_rail.suite.identity import as_text
+from pymoo_rail.suite.identity import HV_MARGIN, as_text
 
 POOL_SIZE = 8
 """Distinct lines a trip's sections are drawn from (their curves are computed once each)."""
@@ -69,9 +69,10 @@ class TripProblem(RunningTimeAllocationProblem):
 
     def hv_reference_point(self) -> np.ndarray:
         """Energy of every section at its shortest time (the most any split in the box costs) plus
-        10 % of its distance from the optimum: the fixed reference of the HV gap."""
+        :data:`~pymoo_rail.suite.identity.HV_MARGIN` of its distance from the optimum: the fixed
+        reference of the HV gap."""
         fastest = float(sum(front_energy(f, f["running_time_s"].iloc[0]) for f in self.fronts))
-        return np.array([fastest + 0.1 * (fastest - self.optimum[1])])
+        return np.array([fastest + HV_MARGIN * (fastest - self.optimum[1])])
 
     def definition(self) -> dict:
         """What the checksum covers: the pool's content, the sections, the curves, the budget, the bounds."""
