@@ -24,39 +24,14 @@ DEFAULT = ["optimize", "yizhuang", "--algorithm", "nsga2", "-q"]
 
 
 def child(cli_args: list[str], top: int, signatures: bool) -> None:
+    """Run the CLI under the compile profile (in the child with an empty cache) and print the profile."""
     from pymoo_rail import cli
     from pymoo_rail.sim.jit import compile_profile
 
     with tempfile.TemporaryDirectory() as out, compile_profile() as profile:
         code = cli.main([*cli_args, "--out", out] if cli_args[0] != "warmup" else cli_args)
     usage = resource.getrusage(resource.RUSAGE_SELF)
-    rows = profile.table()
-    stages: dict[str, float] = {}
-    for _, _, per in rows:
-        for stage, s in per.items():
-            stages[stage] = stages.get(stage, 0.0) + s
-    total = sum(stages.values())
-    print(f"exit {code}; process CPU {usage.ru_utime + usage.ru_stime:.1f} s; compile (CPU) {total:.1f} s")
-    modules: dict[str, float] = {}
-    for qualname, s, _ in rows:
-        module = qualname.split(".<locals>")[0].rsplit(".", 1)[0]
-        modules[module] = modules.get(module, 0.0) + s
-    print("\nby module:")
-    for module, s in sorted(modules.items(), key=lambda kv: -kv[1])[:10]:
-        print(f"  {s:7.1f} s  {module}")
-    print("\nby stage:")
-    for stage, s in sorted(stages.items(), key=lambda kv: -kv[1])[:12]:
-        print(f"  {s:7.1f} s  {stage}")
-    print(f"\nby function (top {top}): total s, signatures, stages >= 0.2 s")
-    for qualname, s, per in rows[:top]:
-        parts = ", ".join(f"{k} {v:.1f}" for k, v in sorted(per.items(), key=lambda kv: -kv[1]) if v >= 0.2)
-        print(f"  {s:7.1f}  x{profile.compiles.get(qualname, 0)}  {qualname}: {parts}")
-    if signatures:
-        print("\nfunctions compiled for more than one signature (the arguments where they differ):")
-        for qualname, sigs in profile.signatures.items():
-            if len(sigs) > 1:
-                start = max(0, len(os.path.commonprefix(sigs)) - 30)
-                print(f"  {qualname}: " + " | ".join(sig[start:][:120] for sig in sigs))
+    print(f"exit {code}; process CPU {usage.ru_utime + usage.ru_stime:.1f} s; {profile.summary(top, signatures)}")
 
 
 def main() -> None:

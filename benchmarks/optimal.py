@@ -26,7 +26,11 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.constants import J_PER_KWH, KMH_PER_MS
+from pymoo_rail.cases import load_case
 from pymoo_rail.experiments.report import markdown
+from pymoo_rail.optimal import optimal_profile
+from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
+from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs
 
 REPORT = Path(__file__).resolve().parent / "reports" / "optimal.md"
 
@@ -129,25 +133,30 @@ def direct_search(case, quick: bool):
     return pd.DataFrame(rows)
 
 
-def main() -> None:
+def draw(case, front, planned, out: Path) -> None:
+    """The front beside the speed-code run and Liu's (2019) results, and the optimal profile at 150 s."""
+    codes = Simulator(case).run(speed_code_programs(gradient_limit_partition(case.line), np.full(8, 60 / KMH_PER_MS))[0])
+    seeds = pd.DataFrame({"running_time_s": [150.0, 149.89, 149.6], "energy_kwh": [19.68, 19.55, 20.43]})
+    columns = ["running_time_s", "energy_kwh"]
+    fig = plot_fronts({"60 km/h speed codes (simulator)": np.array([[codes.running_time_s, codes.energy.net_kwh]]),
+                       "seed 000 results (own MATLAB model)": seeds[columns].to_numpy()},
+                      objectives=("running_time", "energy"), reference=front[columns], reference_label="optimum (DP)",
+                      title="yizhuang: minimum net energy against running time")
+    save_figure(fig, out / "optimal_front.png")
+    codes_label = f"60 km/h speed codes: {codes.running_time_s:.1f} s, {codes.energy.net_kwh:.2f} kWh"
+    save_figure(plot_speed_profile(planned, case, others=[codes], other_labels=[codes_label],
+                                   title=f"yizhuang: optimal profile at 150 s ({planned.running_time_s:.1f} s, "
+                                         f"{planned.energy.net_kwh:.2f} kWh)"), out / "optimal_profile.png")
+
+
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true")
-    args = parser.parse_args()
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from pymoo_rail.cases import load_case
-    from pymoo_rail.optimal import optimal_profile
-    from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
-    from pymoo_rail.sim import Simulator, gradient_limit_partition, speed_code_programs
-
+    args = parser.parse_args(argv)
     case = load_case("yizhuang")
-    cores = os.cpu_count()
-    load = os.getloadavg()[0]
     out = [f"# Exact solver benchmark (`benchmarks/optimal.py{' --quick' if args.quick else ''}`)", "",
-           f"{cores} cores, load average {load:.1f} at the start (the machine is shared: times are wall clock).", ""]
-
+           f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start (the machine is shared: "
+           "times are wall clock).", ""]
 
     def emit(text: str) -> None:
         """Print one report section now and keep it for the report file."""
@@ -155,47 +164,21 @@ def main() -> None:
         out.extend([text, ""])
 
     front, elapsed, warm_up, fastest = timing(case)
-    text = (f"## 1. `optimal_front(yizhuang)`, 10 running times from {fastest:.2f} s to {1.5 * fastest:.2f} s\n\n"
-            f"{elapsed:.1f} s wall clock (default grid: 1 m x 200 speed nodes), after a {warm_up:.1f} s warm-up "
-            "that loads or compiles the Numba kernels.\n\n" + markdown(front))
-    emit(text)
-
+    emit(f"## 1. `optimal_front(yizhuang)`, 10 running times from {fastest:.2f} s to {1.5 * fastest:.2f} s\n\n"
+         f"{elapsed:.1f} s wall clock (default grid: 1 m x 200 speed nodes), after a {warm_up:.1f} s warm-up "
+         "that loads or compiles the Numba kernels.\n\n" + markdown(front))
     planned = optimal_profile(case, case.planned_time_s)
-    text = (f"Optimum at the planned 150 s: {planned.energy.net_kwh:.3f} kWh at {planned.running_time_s:.2f} s "
-            f"({_at(planned, 150.0):.3f} kWh at exactly 150 s); the flat-out run: "
-            f"{Simulator(case).flat_out().energy.net_kwh:.2f} kWh at {fastest:.2f} s.")
-    emit(text)
-
-    table = refinement(case, args.quick)
-    text = ("## 2. Grid refinement (energy moved to exactly the requested time along the slope lambda)\n\n"
-            + markdown(table))
-    emit(text)
-
-    table = level_track()
-    text = ("## 3. Level track (5 km, Davis resistance): Pontryagin's closed form against the DP\n\n"
-            + markdown(table))
-    emit(text)
-
-    table = direct_search(case, args.quick)
-    text = ("## 4. Direct search over traction-hold-coast-brake strategies on yizhuang\n\n"
-            + markdown(table))
-    emit(text)
-
+    emit(f"Optimum at the planned 150 s: {planned.energy.net_kwh:.3f} kWh at {planned.running_time_s:.2f} s "
+         f"({_at(planned, 150.0):.3f} kWh at exactly 150 s); the flat-out run: "
+         f"{Simulator(case).flat_out().energy.net_kwh:.2f} kWh at {fastest:.2f} s.")
+    emit("## 2. Grid refinement (energy moved to exactly the requested time along the slope lambda)\n\n"
+         + markdown(refinement(case, args.quick)))
+    emit("## 3. Level track (5 km, Davis resistance): Pontryagin's closed form against the DP\n\n"
+         + markdown(level_track()))
+    emit("## 4. Direct search over traction-hold-coast-brake strategies on yizhuang\n\n"
+         + markdown(direct_search(case, args.quick)))
     REPORT.parent.mkdir(parents=True, exist_ok=True)
-    bounds = gradient_limit_partition(case.line)
-    codes = Simulator(case).run(speed_code_programs(bounds, np.full(8, 60 / KMH_PER_MS))[0])
-    seeds = pd.DataFrame({"running_time_s": [150.0, 149.89, 149.6], "energy_kwh": [19.68, 19.55, 20.43]})
-    columns = ["running_time_s", "energy_kwh"]
-    fig = plot_fronts({"60 km/h speed codes (simulator)": np.array([[codes.running_time_s, codes.energy.net_kwh]]),
-                       "seed 000 results (own MATLAB model)": seeds[columns].to_numpy()},
-                      objectives=("running_time", "energy"), reference=front[columns], reference_label="optimum (DP)",
-                      title="yizhuang: minimum net energy against running time")
-    save_figure(fig, REPORT.parent / "optimal_front.png")
-    codes_label = f"60 km/h speed codes: {codes.running_time_s:.1f} s, {codes.energy.net_kwh:.2f} kWh"
-    save_figure(plot_speed_profile(planned, case, others=[codes], other_labels=[codes_label],
-                                   title=f"yizhuang: optimal profile at 150 s ({planned.running_time_s:.1f} s, "
-                                         f"{planned.energy.net_kwh:.2f} kWh)"),
-                REPORT.parent / "optimal_profile.png")
+    draw(case, front, planned, REPORT.parent)
     out += ["![front](optimal_front.png)", "", "![profile](optimal_profile.png)", ""]
     REPORT.write_text("\n".join(out))
     print(f"written {REPORT}")

@@ -46,11 +46,13 @@ from pymoo_rail.cases import load_case
 from pymoo_rail.cases.ttobench import TTOBenchWarning, case_between, read_track, read_train
 from pymoo_rail.experiments.reference_audit import (DERIVED, certificate_parts, check_members, coverage_summary,
                                                      coverage_table, members_summary, with_derived_columns)
-from pymoo_rail.experiments.report import committed_members, lower_priority, markdown, member_cases, write_report
+from pymoo_rail.experiments.report import (committed_members, fill_template, lower_priority, markdown, member_cases,
+                                          write_report)
 from pymoo_rail.model.grid import default_dx_m
 from pymoo_rail.optimal import min_running_time, optimal_profile
 
 REPORTS = Path(__file__).resolve().parent / "reports"
+TEMPLATES = Path(__file__).resolve().parent / "templates"
 TTOBENCH = Path(__file__).resolve().parents[1] / "tests" / "data" / "ttobench"
 PARTS_VARIANTS = ({"n_speeds": 100}, {"n_speeds": 400}, {"n_speeds": 800}, {"tie_j": 0.0})
 
@@ -66,10 +68,11 @@ def chosen_members(limit: int | None):
     return table if limit is None else table.groupby("case", sort=False).head(limit)
 
 
-def show(path: Path, lines: list[str]) -> None:
-    """Write a report (no newline after its last line, as committed) and print it."""
-    write_report(path, lines, newline=False)
-    print("\n".join(lines))
+def show(path: Path, values: dict) -> None:
+    """Fill the report's template (``benchmarks/templates/<name>``), write it and print it."""
+    text = fill_template(TEMPLATES / path.name, values)
+    write_report(path, [text], newline=False)
+    print(text)
 
 
 def members(args) -> int:
@@ -85,15 +88,8 @@ def members(args) -> int:
         table.drop(columns=list(DERIVED)).to_csv(csv_path, index=False, float_format="%.9g")
     s = members_summary(table)
     n_below = int(s["below_reference"].sum())
-    lines = ["# Committed optimiser results against the exact optimum at their own running time", "",
-             "Written by `python benchmarks/reference_check.py` (it reads the study CSVs of `benchmarks/reports`, "
-             "see its docstring for which members). Each member is compared with the optimum solved at its own "
-             "running time (`pymoo_rail.optimal.solved_energy_gap`, default grid) and with that solve's certificate "
-             "`energy_bound_kwh`. *margin* = gap + certificate: a negative margin is a member below the optimum by "
-             "more than the certificate, a defect of the reference.", "",
-             f"Members in range: {int(table['in_range'].sum())} of {len(table)}; below the reference beyond the "
-             f"certificate: **{n_below}**.", "", markdown(s), ""]
-    show(args.out / "reference_check.md", lines)
+    show(args.out / "reference_check.md", {"in_range": int(table["in_range"].sum()), "members": len(table),
+                                            "below": n_below, "table": markdown(s)})
     return n_below
 
 
@@ -104,17 +100,9 @@ def coverage(args) -> int:
     cpu = time.process_time() - start
     s, sentences = coverage_summary(result)
     misses = int(s["misses"].sum())
-    lines = ["# The default solver's certificate against other node placements and a finer grid", "",
-             "Written by `python benchmarks/reference_check.py --check coverage`: at every distinct running time of "
-             "the optimiser members `benchmarks/reference_check.py` reads, the default solver's optimum "
-             "(`ReferenceAtTime`, the run moved to the time along the front's slope) and its certificate against the "
-             "same optimum solved with the speed nodes uniform in v^2 and with twice the speed nodes (each at the "
-             "chord between its solves on either side of the time, the energy its runs reach there). A *miss* is "
-             "another solve lower than the default by more than the default's certificate; *worst margin* = "
-             "certificate - difference.", "",
-             f"Times compared: {int(np.isfinite(result['default_kwh']).sum())}; misses: **{misses}**; "
-             f"CPU {cpu:.0f} s.", "", *sentences, "", markdown(s), ""]
-    show(args.out / "certificate_coverage.md", lines)
+    show(args.out / "certificate_coverage.md", {"times": int(np.isfinite(result["default_kwh"]).sum()),
+                                                 "misses": misses, "cpu_s": f"{cpu:.0f}",
+                                                 "sentences": "\n".join(sentences), "table": markdown(s)})
     return misses
 
 
@@ -127,11 +115,7 @@ def parts(args) -> int:
     points = [("wuguang-crh3", load_case("wuguang-crh3"), 1050.53), ("Yizhuang section 1-2", section, 119.432943)]
     table = certificate_parts(points, PARTS_VARIANTS).set_index("case").T.reset_index().rename(
         columns={"index": "figure"})
-    lines = ["# The certificate's parts", "", "Written by `python benchmarks/reference_check.py --check parts`: the "
-             "default run (200 speed nodes, `tie_j` = 100 J) and its certificate with its parts, beside finer grids "
-             "and the run without the tie rule, all moved to the default run's time along the front's slope. The "
-             "certificate is the grid part plus the floor plus the largest of the other three.", "", markdown(table), ""]
-    show(args.out / "certificate.md", lines)
+    show(args.out / "certificate.md", {"table": markdown(table)})
     return 0
 
 

@@ -23,7 +23,7 @@ from pymoo_rail.experiments.runner import execute_run
 from pymoo_rail.experiments.spec import Budget, RunSpec
 from pymoo_rail.experiments.stats import rank_sum_tests, to_markdown
 from pymoo_rail.optimal import optimal_front
-from pymoo_rail.problems import reference
+from pymoo_rail.optimal import reference
 from pymoo_rail.optimal.reference import FRONT_VERSION, certified_gap
 from pymoo_rail.suite import get_problem, list_problems
 from pymoo_rail.suite.sanity import nsga2_against_random

@@ -10,6 +10,7 @@ image or before a study on a cluster whose workers share the cache directory.
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from contextlib import contextmanager
@@ -175,6 +176,36 @@ class CompileProfile(event.Listener):
             per.setdefault(qualname, {})[stage] = per.setdefault(qualname, {}).get(stage, 0.0) + s
         rows = [(q, sum(st.values()), st) for q, st in per.items()]
         return sorted(rows, key=lambda row: -row[1])
+
+    def summary(self, top: int = 25, signatures: bool = False) -> str:
+        """The profile as text: compile CPU by module, by stage, and per function (the ``top`` dearest).
+
+        Per function: total seconds, signatures compiled and the stages of at least 0.2 s. With
+        ``signatures``, also every function compiled more than once and where its argument types
+        differ (a specialisation that may be avoidable).
+        """
+        rows = self.table()
+        stages: dict[str, float] = {}
+        modules: dict[str, float] = {}
+        for qualname, s, per in rows:
+            module = qualname.split(".<locals>")[0].rsplit(".", 1)[0]
+            modules[module] = modules.get(module, 0.0) + s
+            for stage, t in per.items():
+                stages[stage] = stages.get(stage, 0.0) + t
+        lines = [f"compile (CPU) {sum(stages.values()):.1f} s", "", "by module:"]
+        lines += [f"  {s:7.1f} s  {m}" for m, s in sorted(modules.items(), key=lambda kv: -kv[1])[:10]]
+        lines += ["", "by stage:"] + [f"  {s:7.1f} s  {st}" for st, s in sorted(stages.items(), key=lambda kv: -kv[1])[:12]]
+        lines += ["", f"by function (top {top}): total s, signatures, stages >= 0.2 s"]
+        for qualname, s, per in rows[:top]:
+            parts = ", ".join(f"{k} {v:.1f}" for k, v in sorted(per.items(), key=lambda kv: -kv[1]) if v >= 0.2)
+            lines.append(f"  {s:7.1f}  x{self.compiles.get(qualname, 0)}  {qualname}: {parts}")
+        if signatures:
+            lines += ["", "functions compiled for more than one signature (the arguments where they differ):"]
+            for qualname, sigs in self.signatures.items():
+                if len(sigs) > 1:
+                    start = max(0, len(os.path.commonprefix(sigs)) - 30)
+                    lines.append(f"  {qualname}: " + " | ".join(sig[start:][:120] for sig in sigs))
+        return "\n".join(lines)
 
 
 @contextmanager

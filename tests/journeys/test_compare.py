@@ -59,3 +59,23 @@ def test_front_gaps_are_relative_to_the_reference_over_the_common_range(journey)
     np.testing.assert_allclose(gaps[["a mean %", "a min %", "a max %"]].to_numpy(), 10.0)
     np.testing.assert_allclose(gaps[["b mean %", "combined max %"]].to_numpy(), 0.0, atol=1e-12)
     assert gaps["label"].iloc[1] == journey.section_label(1)
+
+
+def test_plot_split_costs_draws_the_sweep_and_one_trip(journey):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from pymoo_rail.journeys import allocate_running_time, supplement_split
+    from pymoo_rail.plotting.journey import plot_split_costs
+
+    fronts = [STEEP] + [FLAT] * (journey.n_sections - 1)
+    sweep = split_sweep(journey, fronts, n_points=5)
+    total = 13 * 60.0 * 1.1
+    best = allocate_running_time(journey, total, fronts=fronts)
+    equal = supplement_split(journey, total, fronts=fronts)
+    fig = plot_split_costs(sweep, best, equal, "hand-made fronts")
+    first, second, third = fig.axes
+    np.testing.assert_allclose(first.lines[0].get_ydata(), sweep["optimal_kwh"])
+    np.testing.assert_allclose(second.lines[0].get_ydata(), sweep["equal_kwh"] - sweep["optimal_kwh"])
+    assert [p.get_height() for p in third.patches[:journey.n_sections]] == pytest.approx(best.table.supplement_s.tolist())
+    assert first.get_title() == "hand-made fronts" and f"{best.trip_time_s / 60:.0f}-min" in third.get_title()

@@ -62,6 +62,8 @@ def test_a_renamed_section_is_served_and_a_changed_one_under_its_name_is_compute
     # the stale rows of section 1 went when its new front came: one front per section in the file
     table = pd.read_csv(cache)
     assert table.groupby("section")[KEY_COLUMN].nunique().tolist() == [1, 1, 1]
+    # a finished run leaves the cache and nothing else (no fronts.csv.lock)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fronts.csv"]
 
 
 def test_a_front_of_another_strategy_version_is_not_served(tmp_path, monkeypatch):
