@@ -75,3 +75,27 @@ def test_the_single_form_optimum_lies_on_the_front_at_the_plan():
     _, below = front.below_certificate(out["running_time_s"][feasible], out["F"][feasible, 0])
     assert feasible.sum() > 20 and not below.any()
     assert single.hv_reference_point()[0] > optimum[0, 0]
+
+
+@pytest.mark.slow
+def test_a_front_is_computed_on_demand_once_then_read_from_the_disk_cache(tmp_path, monkeypatch):
+    """About 20 s of CPU: the exact solver on one metro line (seed 2 ships no front)."""
+    from pymoo_rail.optimal.reference import store
+
+    monkeypatch.setenv(ref.CACHE_ENV, str(tmp_path))
+    ref.forget_fronts()
+    small = get_problem("generated-metro-bi", n_var=20, seed=2)
+    assert ref.find_front(small.case) is None
+    pf = small.pareto_front()
+    path = ref.find_front(small.case)
+    assert path.parent == tmp_path / "fronts" and path.name.startswith("generated-metro-2-")
+    assert ref.CertifiedFront.read_csv(path).case_hash == ref.case_hash(small.case)
+    ref.forget_fronts()
+
+    def no_solver(*args, **kwargs):
+        raise AssertionError("the front was solved again instead of read from the cache")
+
+    monkeypatch.setattr(store, "compute_front", no_solver)
+    large = get_problem("generated-metro-bi", n_var=500, seed=2)
+    np.testing.assert_array_equal(large.pareto_front(), pf)
+    ref.forget_fronts()
