@@ -1,15 +1,10 @@
-"""ABC vs PSO vs DE on Sphere, Griewank and Rosenbrock (seed 000, section 3.5, tables 3-2 to 3-5).
+"""ABC vs PSO vs DE on Sphere, Griewank and Rosenbrock (Liu (2019), 3.5, tables 3-2 to 3-5), equal budgets.
 
-The seed's colony sizes and control parameters, equal budgets of ``30 (iterations + 1)``
-evaluations, one study of ``pymoo_rail.experiments.run_study`` per (dimension, iterations)
-setting in ``--work/d<D>-it<iterations>`` (one record per run, seeds 1000 + run). The report's text
-is ``benchmarks/templates/abc_functions.md``, the seed's values ``abc_functions_seed.csv`` beside it;
-``--report-only`` without records rebuilds the tables from the committed ``abc_functions.csv``.
+One study per (dimension, iterations) through ``run_study``; text ``benchmarks/templates/abc_functions.md``,
+the seed's values ``abc_functions_seed.csv``; without records, ``--report-only`` rebuilds the tables
+from the committed ``abc_functions.csv``.
 
-Usage::
-
-    nice -n 10 python benchmarks/abc_functions.py --runs 30
-    python benchmarks/abc_functions.py --report-only
+Usage: ``nice -n 10 python benchmarks/abc_functions.py [--runs 30] [--report-only]``
 """
 
 from __future__ import annotations
@@ -23,8 +18,7 @@ import pandas as pd
 from pymoo_rail.experiments import Study, algorithm, load_results, problem, run_study
 from pymoo_rail.experiments.report import (add_study_options, count_range, fill_template, lower_priority,
                                            markdown_rows, write_report)
-from pymoo_rail.plotting import save_figure
-from pymoo_rail.plotting.style import new_figure
+from pymoo_rail.plotting import plot_convergence, save_figure
 
 HERE = Path(__file__).resolve().parent
 POP, FIRST_SEED = 30, 1000
@@ -64,17 +58,16 @@ def study_directory(work: Path, dim: int, iterations: int) -> Path:
 
 
 def load_runs(work: Path, runs: int, settings=None, extra=EXTRA):
-    """Every stored run: ``(table, curves)``, one row per run and ``curves[(function, dim, iterations,
-    algorithm)]`` = list of (n_eval, best-so-far) arrays."""
-    rows, curves = [], {}
+    """Every stored run: ``(table, results)``, one row per run and the stored runs (with their best-so-far
+    histories) by ``(dim, iterations)``."""
+    rows, results = [], {}
     for (dim, iterations), study in build_studies(runs, settings, extra).items():
-        for r in load_results(study_directory(work, dim, iterations), study=study).itertuples():
-            rows.append(dict(function=r.problem, dim=dim, iterations=iterations, algorithm=r.algorithm,
-                             run=int(r.seed) - FIRST_SEED, seed=int(r.seed), best=float(r.f_best),
-                             n_eval=int(r.n_eval), n_gen=int(r.n_gen), time_s=round(float(r.wall_time_s), 4)))
-            curves.setdefault((r.problem, dim, iterations, r.algorithm), []).append(
-                np.column_stack([r.history["n_eval"], r.history["f0_min"]]))
-    return pd.DataFrame(rows, columns=FIELDS), curves
+        results[dim, iterations] = load_results(study_directory(work, dim, iterations), study=study)
+        rows += [dict(function=r.problem, dim=dim, iterations=iterations, algorithm=r.algorithm,
+                      run=int(r.seed) - FIRST_SEED, seed=int(r.seed), best=float(r.f_best), n_eval=int(r.n_eval),
+                      n_gen=int(r.n_gen), time_s=round(float(r.wall_time_s), 4))
+                 for r in results[dim, iterations].itertuples()]
+    return pd.DataFrame(rows, columns=FIELDS), results
 
 
 def function_table(df, seed, function: str) -> str:
@@ -107,43 +100,27 @@ def observations(df, seed) -> str:
     return "\n".join(lines)
 
 
-def median_curve(curves, function, dim, iterations, a):
-    """(iteration, median best-so-far) over the runs of a cell, None without runs."""
-    grid = np.linspace(POP, POP * (iterations + 1), 400)
-    ys = [np.interp(grid, c[:, 0], c[:, 1]) for c in curves.get((function, dim, iterations, a), [])]
-    return (grid / POP - 1, np.maximum(np.median(ys, axis=0), 1e-300)) if ys else None
+def convergence_figures(results: dict, out: Path) -> list[str]:
+    """Median and interquartile range of the best-so-far value over the runs (figs. 3-5 to 3-12), one
+    figure per dimension and budget, one panel per function; the file names."""
+    names = []
+    for (dim, iterations), runs in results.items():
+        if len(runs):
+            names.append(f"abc_functions_d{dim}-it{iterations}.png")
+            save_figure(plot_convergence(runs, "f0_min", log=True, ylabel=f"best-so-far f, D = {dim}"), out / names[-1],
+                        dpi=110)
+    return names
 
 
-def convergence_figures(curves, out: Path) -> list[str]:
-    """Algorithms per function and dimension (figs. 3-5 to 3-9) and ABC's dimensions on Sphere (3-10 to 3-12)."""
-    panels = {f"abc_functions_{f}.png": [(f"{f}, D = {d}", [(a, f, d, it, a) for a in ALGORITHMS]) for d, it in SETTINGS]
-              for f in FUNCTIONS}
-    panels["abc_functions_sphere_dims.png"] = [(f"{a} on Sphere [-100, 100]", [(f"D = {d}", "sphere", d, it, a)
-                                                                             for d, it in SETTINGS]) for a in ALGORITHMS[:3]]
-    for name, axes_spec in panels.items():
-        fig, axes = new_figure(1, len(axes_spec), figsize=(4 * len(axes_spec), 3.7))
-        for ax, (title, lines) in zip(axes[0], axes_spec):
-            for label, *cell in lines:
-                if (c := median_curve(curves, *cell)) is not None:
-                    ax.semilogy(*c, label=label)
-            ax.set(title=title, xlabel="iteration (evaluations / 30 - 1)")
-            ax.grid(True, which="both", alpha=0.3)
-            if ax.get_legend_handles_labels()[0]:
-                ax.legend()
-        axes[0, 0].set_ylabel("median best-so-far f")
-        save_figure(fig, out / name, dpi=110)
-    return list(panels)
-
-
-def report(out: Path, df, curves: dict) -> None:
-    """Report, per-run CSV and (with ``curves``) figures from :func:`load_runs`."""
+def report(out: Path, df, results: dict) -> None:
+    """Report, per-run CSV and (with the stored ``results``) figures from :func:`load_runs`."""
     exported = df.assign(best=df.best.map(lambda v: repr(float(v))))  # every digit of the best value
     exported.sort_values(["run", "function", "dim", "iterations", "algorithm"], kind="stable").to_csv(
         out / "abc_functions.csv", index=False)
     table = pd.read_csv(HERE / "templates" / "abc_functions_seed.csv")
     seed = {(r.function, r.dim, None if np.isnan(r.iterations) else int(r.iterations), r.algorithm):
             (r.min, r.mean, r.max, r.time_s) for r in table.itertuples()}
-    names = convergence_figures(curves, out) if curves else [f"abc_functions_{f}.png" for f in (*FUNCTIONS, "sphere_dims")]
+    names = convergence_figures(results, out) or [f"abc_functions_d{d}-it{it}.png" for d, it in SETTINGS + [EXTRA[0][1:]]]
     values = {"runs": count_range(df.groupby(["function", "dim", "iterations", "algorithm"]).size()),
               "function_tables": "\n".join(function_table(df, seed, f) for f in FUNCTIONS),
               "observations": observations(df, seed), "figures": "\n".join(f"![{n}]({n})" for n in names)}
@@ -161,10 +138,10 @@ def main() -> None:
             print(run_study(study, study_directory(args.work, dim, iterations),
                             workers=max(1, min(args.workers, 2)), seed_major=True), flush=True)
     args.out.mkdir(parents=True, exist_ok=True)
-    table, curves = load_runs(args.work, args.runs)
+    table, results = load_runs(args.work, args.runs)
     if table.empty:  # no records (they are not in git): the tables from the committed per-run CSV
         table = pd.read_csv(args.out / "abc_functions.csv")
-    report(args.out, table, curves)
+    report(args.out, table, results)
 
 
 if __name__ == "__main__":

@@ -1,19 +1,10 @@
-"""Golden-ratio NSGA-II vs NSGA-II on the CRH3 EMU run of Tang et al. (2020), section 4.2 (figs. 10-12,
-tables 4 and 5), at equal evaluation budgets, through the study runner, against the exact front.
+"""GR-NSGA-II vs NSGA-II on the CRH3 EMU run of Tang et al. (2020), 4.2, against the exact front.
 
-Two studies of ``pymoo_rail.experiments.run_study`` (one record per run, resumable, seed by seed):
-``encodings`` (three encodings, a few seeds, a smaller budget: it chooses the encoding) and ``main``
-(population 200, 60,000 evaluations, ``--seeds`` seeds, on speed codes and switching points). The
-exact front at 13 running times is cached in ``reports/emu_wuguang_optimal.csv`` by
-``pymoo_rail.optimal.reference.exact_points`` (``--no-exact`` leaves it out). Every member of every
-front is re-simulated and checked (``pymoo_rail.experiments.verify``). The report's text is
-``benchmarks/templates/emu_wuguang.md``; the hand-written discussion is ``reports/emu_wuguang_notes.md``.
+Two studies (``encodings``: the choice of encoding; ``main``: 60,000 evaluations, ``--seeds`` seeds),
+the cached exact front, and a check of every front member (``pymoo_rail.experiments.verify``). Text:
+``benchmarks/templates/emu_wuguang.md`` and the hand-written ``reports/emu_wuguang_notes.md``.
 
-Usage::
-
-    nice -n 10 python benchmarks/emu_wuguang.py                   # both studies, then the report
-    nice -n 10 python benchmarks/emu_wuguang.py --seeds 5 --budget 30000
-    python benchmarks/emu_wuguang.py --report-only                # re-analyse stored runs
+Usage: ``nice -n 10 python benchmarks/emu_wuguang.py [--seeds 10] [--budget 60000] [--report-only]``
 """
 
 from __future__ import annotations
@@ -28,13 +19,12 @@ import pandas as pd
 
 from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.cases import load_case
-from pymoo_rail.experiments import (Study, algorithm, choose_member, load_results, problem, run_study, stats,
-                                    tang2020_nsga2)
+from pymoo_rail.experiments import (Study, algorithm, build_problem, choose_member, load_results, problem, run_study,
+                                    stats, tang2020_nsga2)
 from pymoo_rail.experiments.metrics import gd_van_veldhuizen
 from pymoo_rail.experiments.report import fill_template, markdown_rows, mean_std, significant, write_report
-from pymoo_rail.experiments.verify import check_members, worst_checks
+from pymoo_rail.experiments.verify import check_members, check_rows, worst_checks
 from pymoo_rail.indicators.energy import energy_gap
-from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.optimal.reference import exact_points
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -77,14 +67,8 @@ def make_study(name: str, encodings, seeds, budget: int, pop_size: int = POP_SIZ
     return Study(name, problems, algorithms, seeds=list(seeds), budget={"n_eval": int(budget)}, baseline=NSGA2_LABEL)
 
 
-def build_problems() -> dict:
-    case = load_case(CASE)
-    return {e: SpeedProfileProblem(case, objectives=OBJECTIVES, time_tolerance_s=case.time_margin_s, **kw)
-            for e, kw in ENCODINGS.items()}
-
-
 def exact_front(path: Path, profile_path: Path):
-    """The exact front at :data:`EXACT_TIMES_S` cached in ``path``; the optimal run at the planned time in ``profile_path``."""
+    """The exact front at :data:`EXACT_TIMES_S` cached in ``path``; the optimum at the planned time in ``profile_path``."""
     case = load_case(CASE)
 
     def keep_profile(t, traj):
@@ -151,21 +135,14 @@ def pair(rows, enc: str, key: str):
 
 
 def rank_sum(rows, enc: str, key: str, lower_better: bool):
-    """(p, verdict, difference) of GR-NSGA-II against NSGA-II: relative, or in points for ``*_pct``."""
-    sides = pair(rows, enc, key) or ([], [])
-    base, gr = (np.asarray([v for v in side if np.isfinite(v)], dtype=float) for side in sides)
+    """(p, verdict, difference of the means) of GR-NSGA-II against NSGA-II: in %, or in points for ``*_pct``."""
+    base, gr = (np.asarray([v for v in side if np.isfinite(v)], dtype=float) for side in pair(rows, enc, key) or ([], []))
     if len(gr) < 2 or len(base) < 2:
-        return np.nan, "", np.nan
+        return np.nan, "", ""
     _, p, verdict = stats.rank_sum(gr, base, lower_better=lower_better)
     if key.endswith("_pct"):
-        return p, verdict, gr.mean() - base.mean()
-    return p, verdict, (gr.mean() - base.mean()) / abs(base.mean()) if base.mean() != 0 else np.nan
-
-
-def difference(key: str, value: float) -> str:
-    if not np.isfinite(value):
-        return ""
-    return f"{value:+.3f} points" if key.endswith("_pct") else f"{100 * value:+.3f} %"
+        return p, verdict, f"{gr.mean() - base.mean():+.3f} points"
+    return p, verdict, f"{100 * ((gr.mean() - base.mean()) / abs(base.mean())):+.3f} %" if base.mean() != 0 else ""
 
 
 def median_run(rows, enc: str, alg: str) -> dict:
@@ -215,7 +192,7 @@ def tests_table(rows, enc: str) -> str:
     for key, lower in TESTED:
         if (p := pair(rows, enc, key)) is not None:
             pval, verdict, rel = rank_sum(rows, enc, key, lower)
-            cells.append([key, "lower" if lower else "higher", mean_std(p[0]), mean_std(p[1]), difference(key, rel),
+            cells.append([key, "lower" if lower else "higher", mean_std(p[0]), mean_std(p[1]), rel,
                           significant(pval, 3), verdict])
     return f"**{enc}**\n\n" + markdown_rows(["indicator", "better", NSGA2_LABEL, GR_LABEL, "GR vs NSGA-II (means)", "p",
                                              "verdict"], cells)
@@ -250,20 +227,6 @@ def exact_table(ex) -> str:
                            f"{r.solve_s:.0f}"] for r in ex.itertuples()])
 
 
-def verification_table(ver: dict) -> str:
-    """Section 6: the worst value of each check over every member."""
-    checks = [("neutral traction work (J)", "neutral_traction_j_max", "0", "neutral"),
-              ("largest force in a neutral section (N)", "neutral_force_n_max", "<= 0", "force"),
-              ("kernel limit excess (m/s)", "limit_excess_ms_max", "<= 0", "limit"),
-              ("independent limit excess over the train length (m/s)", "independent_excess_ms_max", "<= 0", "independent"),
-              ("stop error (m)", "stop_error_m_max", "<= 0.25", "stop"),
-              ("stored vs re-simulated energy (kWh)", "energy_mismatch_kwh", "0", "energy"),
-              ("stored vs re-simulated running time (s)", "time_mismatch_s", "0", "time")]
-    cells = [[name, significant(ver[key]), required, ver[f"{ok}_ok"]] for name, key, required, ok in checks]
-    cells.append(["neutral-section genes at their fixed value (10 km/h, coast)", "", "all members", ver["fixed_ok"]])
-    return markdown_rows(["check", "worst value over all members", "required", "result"], cells)
-
-
 def verdict_text(rows) -> str:
     """The measured verdict per encoding, from the rank-sum tests."""
     lines = []
@@ -276,7 +239,7 @@ def verdict_text(rows) -> str:
                 p, verdict, rel = rank_sum(rows, enc, key, lower)
                 word = {"+": "better (significant)", "-": "worse (significant)",
                         "=": "not significantly different"}.get(verdict, "untested")
-                parts.append(f"{name}: GR-NSGA-II {word}, means differ by {difference(key, rel)} (p = {significant(p, 3)})")
+                parts.append(f"{name}: GR-NSGA-II {word}, means differ by {rel} (p = {significant(p, 3)})")
         lines.append(f"- Measured on {enc}: " + "; ".join(parts) + ".")
     return "\n".join(lines)
 
@@ -301,7 +264,8 @@ def front_figures(results, chosen: dict, planned: float, exact, out: Path) -> No
         ax.axhline(planned, color="0.5", lw=0.8, ls=":")
     save_figure(fig, out / "emu_wuguang_fronts.png")
     fronts = {f"{alg}, {enc} (seed {c['seed']})": c["front"] for (enc, alg), c in chosen.items()}
-    for name, title in (("overlay", "median-HV run of each algorithm and encoding"), ("zoom", "near the planned time (1050 s)")):
+    for name, title in (("overlay", "median-HV run of each algorithm and encoding"),
+                        ("zoom", "near the planned time (1050 s)")):
         fig = plot_fronts(fronts, OBJECTIVES, reference=exact_F, reference_label=exact_label, title=title)
         near = np.vstack([F[np.abs(F[:, 1] - planned) <= 15] for F in fronts.values()])
         if name == "zoom" and len(near):  # the seed's fig. 12 only covers the neighbourhood of the planned time
@@ -355,10 +319,8 @@ def report_values(rows, enc_rows, chosen, problems, exact, args) -> dict:
         "n_fixed": int(main.encoding.fixed().sum()),
         "other_encodings": ", ".join(f"**{e}** ({problems[e].n_var} variables, {int(problems[e].encoding.fixed().sum())} "
                                      "fixed)" for e in encodings if e != MAIN_ENCODING),
-        "budget": f"{args.budget:,} evaluations per run for both algorithms (`(\"n_eval\", {args.budget})`{budget}); "
-                  f"population {args.pop_size}; seeds {', '.join(map(str, seeds))} ({len(seeds)} runs per algorithm "
-                  "and encoding, the same seeds for both). Evaluations actually used are in table 4 (pymoo stops "
-                  "after the generation that reaches the budget).",
+        "budget": f"{args.budget:,}", "budget_raw": args.budget, "budget_note": budget, "seeds": ", ".join(map(str, seeds)),
+        "n_seeds": len(seeds),
         "pop_size": args.pop_size, "local_size": args.local_size, "workers": args.workers,
         "exact_times": ", ".join(f"{t:g}" for t in exact["requested_time_s"]) + " s, cached in `emu_wuguang_optimal.csv` "
                        "(section 5)." if exact is not None else "(not computed).",
@@ -367,7 +329,9 @@ def report_values(rows, enc_rows, chosen, problems, exact, args) -> dict:
         "tests": "\n\n".join(tests_table(rows, e) for e in encodings), "table5": table5(encodings, chosen, rows, exact),
         "n_speeds": int(exact["n_speeds"].iloc[0]) if exact is not None else EXACT_N_SPEEDS,
         "exact_table": exact_table(exact), "n_members": ver["n_members"], "n_runs": ver["n_runs"],
-        "train_length_m": f"{case.train.length_m:g}", "verification_table": verification_table(ver),
+        "train_length_m": f"{case.train.length_m:g}",
+        "verification_table": markdown_rows(["check", "worst value over all members", "required", "result"],
+                                            check_rows(ver, significant)),
         "all_ok": "yes" if ver["all_ok"] else "NO",
         "verdict": (verdict_text(rows) + "\n\n" + discussion.strip()).strip()}, ver
 
@@ -404,7 +368,7 @@ def main(argv=None) -> int:
     args.work.mkdir(parents=True, exist_ok=True)
     exact = None if args.no_exact else exact_front(args.out / "emu_wuguang_optimal.csv", args.work / "optimal_profile.csv")
     exact_profile = None if args.no_exact else pd.read_csv(args.work / "optimal_profile.csv")
-    problems = build_problems()
+    problems = {p.display: build_problem(p) for p in make_study("all", ENCODINGS, [1], 1).problems}
     main_results, rows = analyse(results["main"], problems, exact)
     enc_rows = analyse(results["encodings"], problems, exact)[1] if len(results.get("encodings", ())) else []
     chosen = punctual_choices(main_results, rows, problems)
@@ -416,7 +380,8 @@ def main(argv=None) -> int:
     values, ver = report_values(rows, enc_rows, chosen, problems, exact, args)
     write_report(args.out / "emu_wuguang.md", [fill_template(TEMPLATE, values)], newline=False)
     print(values["verdict"])
-    print(f"verification of {ver['n_members']} members in {ver['n_runs']} runs:", "all pass" if ver["all_ok"] else "FAILURES")
+    print(f"verification of {ver['n_members']} members in {ver['n_runs']} runs:",
+          "all pass" if ver["all_ok"] else "FAILURES")
     return 0 if ver["all_ok"] else 1
 
 

@@ -57,8 +57,9 @@ FIGURES = (
     Figures("moabc_zdt", ("moabc_zdt_fronts.png", "moabc_zdt_igd.png"), "out/moabc_zdt",
             from_committed=("moabc_zdt_igd.png",)),
     Figures("grnsga2_zdt", tuple(f"grnsga2_zdt{k}_fronts.png" for k in (1, 2, 3, 4)), "out/grnsga2_zdt"),
-    Figures("abc_functions", tuple(f"abc_functions_{f}.png" for f in ("sphere", "griewank", "rosenbrock",
-                                                                         "sphere_dims")), "out/abc_functions"),
+    Figures("abc_functions", tuple(f"abc_functions_d{d}-it{it}.png" for d, it in ((10, 500), (20, 1000), (30, 1000),
+                                                                                 (30, 3000), (50, 5000))),
+            "out/abc_functions"),
     Figures("emu_wuguang", tuple(f"emu_wuguang_{f}.png" for f in ("fronts", "fronts_overlay", "fronts_zoom",
                                                                    "box_hv", "profile")), "out/emu_wuguang"),
     Figures("yizhuang_seed000", ("yizhuang_seed000_front.png", "yizhuang_seed000_convergence.png") + PROFILES,
@@ -69,8 +70,7 @@ FIGURES = (
     Figures("closed_loop_study", ("closed_loop_study.png",), "out/closed_loop_study"),
     Figures("journeys", ("journeys.png",)),
     Figures("optimal", ("optimal_front.png", "optimal_profile.png")),
-    Figures("tracking_metro_a", ("tracking_metro_a.png",)),
-    Figures("tracking_yizhuang", ("tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png")),
+    Figures("tracking", ("tracking_metro_a.png", "tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png")),
 )
 
 

@@ -1,15 +1,9 @@
-"""Golden-ratio NSGA-II vs NSGA-II on ZDT1-4 at equal evaluation budgets (seed 003, 4.1).
+"""Golden-ratio NSGA-II vs NSGA-II (and two ablations) on ZDT1-4 at equal budgets (Tang et al. (2020), 4.1).
 
-Four algorithms (NSGA-II with the seed's settings, GR-NSGA-II, and two ablations), population
-200, 60,000 evaluations each, through ``pymoo_rail.experiments.run_study`` (study
-``grnsga2-zdt``, seed by seed, one record per run in ``--work``). The report's text is
-``benchmarks/templates/grnsga2_zdt.md``; its numbers come from the stored fronts, or from the
-committed ``grnsga2_zdt_runs.csv`` when there are no records (``--report-only``).
+Study ``grnsga2-zdt`` of ``run_study``; text ``benchmarks/templates/grnsga2_zdt.md``; without records,
+``--report-only`` rebuilds the report from the committed ``grnsga2_zdt_runs.csv``.
 
-Usage::
-
-    nice -n 10 python benchmarks/grnsga2_zdt.py --runs 30
-    python benchmarks/grnsga2_zdt.py --report-only
+Usage: ``nice -n 10 python benchmarks/grnsga2_zdt.py [--runs 30] [--report-only]``
 """
 
 from __future__ import annotations

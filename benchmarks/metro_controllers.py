@@ -1,25 +1,8 @@
-"""A fair PID vs adaptive fuzzy PID study on metro-a (Meng et al. 2017, sections 3.4-3.5, fig. 9).
+"""PID vs adaptive fuzzy PID on metro-a, tuned fairly (Meng et al. 2017, 3.4-3.5, fig. 9): both families
+tuned by DE with the same budget (study ``metro-controllers``), then compared on held-out disturbed
+trains with a rank-sum test. Text: ``benchmarks/templates/metro_controllers.md``.
 
-1. Tuning, through ``pymoo_rail.experiments.run_study`` (study ``metro-controllers``): the gains of
-   each family (PID: kp, ki, kd; fuzzy PID: the same plus its increment scales dkp, dki, dkd) are
-   tuned by pymoo's DE with the same budget (population 20, ``--budget`` evaluations, default 400)
-   and the same objective, the mean rms tracking error over a training set of 8 disturbed trains
-   (``draw_disturbances(8, seed=0)``: mass x 0.85-1.15, adhesion x 0.8-1.0 on the traction and
-   braking forces, speed-measurement noise of standard deviation 0-0.5 km/h at each 0.2 s control
-   instant, first-order traction/brake lag of 0-0.6 s), ``--tuning-seeds`` DE seeds per family.
-2. Held-out comparison: the best-tuned controller of each family (lowest training cost), and the
-   untuned defaults both share, track the table-3 reference (``table3_reference``) on ``--test``
-   held-out disturbed trains (``draw_disturbances(n, seed=1000)``, default 20): tracking error,
-   jerk, energy, stop error, punctuality (|T - 70 s|); Wilcoxon rank-sum
-   (``pymoo_rail.experiments.stats.rank_sum``) tuned fuzzy PID against tuned PID.
-3. Fig. 9: time-speed of the reference, PID and fuzzy PID on the first held-out train.
-
-Usage::
-
-    nice -n 10 python benchmarks/metro_controllers.py [--budget 400] [--tuning-seeds 3] [--test 20]
-
-Writes ``benchmarks/reports/metro_controllers.md``, ``metro_controllers.csv`` and
-``metro_controllers_fig9.png``.
+Usage: ``nice -n 10 python benchmarks/metro_controllers.py [--budget 400] [--tuning-seeds 3] [--test 20]``
 """
 
 from __future__ import annotations
@@ -27,152 +10,120 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import pandas as pd
 
-from pymoo_rail.experiments.report import add_study_options, lower_priority
+from pymoo_rail.cases import load_case
+from pymoo_rail.control import PID, FuzzyPID, draw_disturbances, track_disturbed
+from pymoo_rail.experiments import Study, algorithm, load_results, problem, run_study
+from pymoo_rail.experiments.report import add_study_options, fill_template, lower_priority, write_report
+from pymoo_rail.experiments.stats import rank_sum
+from pymoo_rail.plotting import save_figure
+from pymoo_rail.plotting.style import new_figure
+from pymoo_rail.problems.controller_tuning import controller_from_gains, table3_reference
+from pymoo_rail.sim import Simulator  # the flat-out run: limits held over the whole train
 
 ROOT = Path(__file__).resolve().parents[1]
-
-REPORTS = ROOT / "benchmarks" / "reports"
 METRICS = {"control_error_rms_kmh": "tracking error rms km/h", "jerk_ms2": "jerk (sum of abs da) m/s^2",
            "energy_kwh": "energy kWh", "stop_error_m": "stop error m", "punctuality_s": "punctuality abs(T - 70 s) s"}
+PAIRS = (("fuzzy PID (tuned)", "PID (tuned)"), ("fuzzy PID (defaults)", "PID (defaults)"))
 
 
-def build_study(budget: int, seeds: int):
-    from pymoo_rail.experiments import Study, algorithm, problem
-
+def build_study(budget: int, seeds: int) -> Study:
+    """DE (population 20) tuning both families with ``budget`` evaluations, ``seeds`` seeds each."""
     return Study("metro-controllers",
                  problems=[problem("controller_tuning", label="PID", case="metro-a", family="pid"),
                            problem("controller_tuning", label="fuzzy PID", case="metro-a", family="fuzzy_pid")],
                  algorithms=[algorithm("de", label="DE", pop_size=20)], seeds=seeds, budget={"n_eval": budget})
 
 
-def held_out(case, reference, controllers: dict, n_test: int) -> list[dict]:
-    from pymoo_rail.control import draw_disturbances, track_disturbed
-
+def held_out(case, reference, controllers: dict, n_test: int) -> pd.DataFrame:
+    """Every controller on each of ``n_test`` held-out disturbed trains: one row per train and controller."""
     rows = []
     for k, d in enumerate(draw_disturbances(n_test, seed=1000)):
         for name, c in controllers.items():
             tr = track_disturbed(case, reference, c, d)
             rows.append({"scenario": k, "controller": name, "mass_factor": d.mass_factor,
                          "adhesion_factor": d.adhesion_factor, "speed_noise_kmh": d.speed_noise_kmh,
-                         "traction_lag_s": d.traction_lag_s,
-                         "control_error_rms_kmh": tr.summary["control_error_rms_kmh"], "jerk_ms2": tr.jerk_ms2,
-                         "energy_kwh": tr.energy.net_kwh, "stop_error_m": tr.stop_error_m,
+                         "traction_lag_s": d.traction_lag_s, "control_error_rms_kmh": tr.summary["control_error_rms_kmh"],
+                         "jerk_ms2": tr.jerk_ms2, "energy_kwh": tr.energy.net_kwh, "stop_error_m": tr.stop_error_m,
                          "punctuality_s": abs(tr.running_time_s - case.planned_time_s),
                          "running_time_s": tr.running_time_s})
-    return rows
+    return pd.DataFrame(rows)
 
 
-def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--budget", type=int, default=400, help="DE evaluations per tuning run")
-    parser.add_argument("--tuning-seeds", type=int, default=3)
-    parser.add_argument("--test", type=int, default=20, help="held-out disturbed trains")
-    add_study_options(parser, ROOT / "out" / "metro_controllers", REPORTS)
-    args = parser.parse_args(argv)
-    lower_priority()
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from pymoo_rail.plotting import save_figure
-    import pandas as pd
-
-    from pymoo_rail.cases import load_case
-    from pymoo_rail.sim import Simulator
-    from pymoo_rail.control import PID, FuzzyPID, draw_disturbances, track_disturbed
-    from pymoo_rail.problems.controller_tuning import controller_from_gains, table3_reference
-    from pymoo_rail.experiments import load_results, run_study
-    from pymoo_rail.experiments.stats import rank_sum
-
-    study = build_study(args.budget, args.tuning_seeds)
-    if not args.report_only:
-        print(run_study(study, args.work, workers=1), flush=True)
-    results = load_results(args.work, study=study)
-    case = load_case("metro-a")
-    reference = table3_reference(case)
-    fastest_s = Simulator(case).flat_out().running_time_s  # limits held over the whole train
-
-    L = ["# PID vs adaptive fuzzy PID on metro-a, tuned fairly (Meng et al. 2017, 3.4-3.5, fig. 9)", "",
-         "Generated by `benchmarks/metro_controllers.py`; tuning runs stored by "
-         "`pymoo_rail.experiments.run_study` (study `metro-controllers`).", "",
-         f"Reference curve: `table3_reference(metro-a)`, the braking-onset run fitted to table 3: "
-         f"{reference.running_time_s:.2f} s (table 3: 68.87 s), stop at {reference.position_m[-1]:.2f} m "
-         f"(1000.18 m), peak {reference.speed_kmh.max():.2f} km/h (75.89 km/h), "
-         f"{reference.energy.net_kwh:.2f} kWh. The 65 km/h departure zone binds over the whole train up to "
-         f"280 m and the flat-out run takes {fastest_s:.1f} s, so a 68.87 s run cannot peak at 75.89 km/h here.", "",
-         "## Tuning (same budget, same objective, same training set)", "",
-         "| family | DE seed | evaluations | training cost (mean rms error km/h) | gains | CPU s |",
-         "|---|---:|---:|---:|---|---:|"]
-    best = {}
+def tuned(results) -> tuple[str, dict]:
+    """The tuning table rows and the best gains of each family (lowest training cost)."""
+    rows, best = [], {}
     for _, r in results.iterrows():
-        family = "pid" if r["problem"] == "PID" else "fuzzy_pid"
-        f = float(r["F"][0, 0])
-        x = r["X"][0]
-        L.append(f"| {r['problem']} | {r['seed']} | {r['n_eval']} | {f:.4f} | "
-                 f"{', '.join(f'{v:.4g}' for v in x)} | {r['cpu_time_s']:.1f} |")
+        family, f, x = "pid" if r["problem"] == "PID" else "fuzzy_pid", float(r["F"][0, 0]), r["X"][0]
+        rows.append(f"| {r['problem']} | {r['seed']} | {r['n_eval']} | {f:.4f} | {', '.join(f'{v:.4g}' for v in x)} | "
+                    f"{r['cpu_time_s']:.1f} |")
         if family not in best or f < best[family][0]:
             best[family] = (f, x)
-    controllers = {"PID (defaults)": PID(), "fuzzy PID (defaults)": FuzzyPID(),
-                   "PID (tuned)": controller_from_gains("pid", best["pid"][1]),
-                   "fuzzy PID (tuned)": controller_from_gains("fuzzy_pid", best["fuzzy_pid"][1])}
-    L += ["", "Gains: PID kp, ki, kd; fuzzy PID kp, ki, kd, dkp, dki, dkd (units of `pymoo_rail.control.PID`). "
-          "Defaults: PID(0.5, 0.05, 0), FuzzyPID(0.5, 0.05, 0, dkp 0.3, dki 0.03, dkd 0.05).", ""]
+    return "\n".join(rows), {family: x for family, (_, x) in best.items()}
 
-    args.out.mkdir(parents=True, exist_ok=True)
-    rows = held_out(case, reference, controllers, args.test)
-    frame = pd.DataFrame(rows)
-    frame.to_csv(args.out / "metro_controllers.csv", index=False)
-    L += [f"## Held-out comparison ({args.test} disturbed trains, `draw_disturbances({args.test}, seed=1000)`)", "",
-          "Median (and mean) per controller:", "",
-          "| controller | " + " | ".join(METRICS.values()) + " |", "|---|" + "---:|" * len(METRICS)]
-    for name in controllers:
-        sub = frame[frame["controller"] == name]
-        L.append(f"| {name} | " + " | ".join(f"{sub[m].median():.3f} ({sub[m].mean():.3f})" for m in METRICS) + " |")
-    L += ["", "Wilcoxon rank-sum, tuned fuzzy PID against tuned PID ('+' fuzzy significantly better, '-' worse, "
-          "'=' no significant difference at 0.05), and the same for the defaults:", "",
-          "| metric | tuned: U | p | verdict | defaults: U | p | verdict |", "|---|---:|---:|---|---:|---:|---|"]
-    for m, label in METRICS.items():
-        cells = []
-        for a, b in (("fuzzy PID (tuned)", "PID (tuned)"), ("fuzzy PID (defaults)", "PID (defaults)")):
-            u, p, v = rank_sum(frame[frame["controller"] == a][m], frame[frame["controller"] == b][m])
-            cells += [f"{u:.0f}", f"{p:.3g}", v]
-        L.append(f"| {label} | " + " | ".join(cells) + " |")
-    verdicts = [rank_sum(frame[frame["controller"] == "fuzzy PID (tuned)"][m],
-                         frame[frame["controller"] == "PID (tuned)"][m])[2] for m in METRICS]
-    better = [label for (m, label), v in zip(METRICS.items(), verdicts) if v == "+"]
-    worse = [label for (m, label), v in zip(METRICS.items(), verdicts) if v == "-"]
-    L += ["", f"Verdict over {args.test} held-out trains: tuned fuzzy PID is significantly better on "
-          f"{', '.join(better) if better else 'no metric'} and significantly worse on "
-          f"{', '.join(worse) if worse else 'no metric'} than tuned PID with the same tuning budget. "
-          "The paper's claim (fuzzy PID follows the curve better and more smoothly) is a comparison "
-          "against an untuned PID on one run; gains at a bound of the search box (see the tuning "
-          "table) mean a wider box could still move both. The table-3 run is close to the flat-out run "
-          f"({reference.running_time_s:.1f} s against a {fastest_s:.1f} s minimum): the controlled part is mostly the "
-          "climb to 80 km/h and the hold at the limit, which leaves the controllers little to differ on; "
-          "a slower reference (e.g. the kinematic optimum's phases, 77.6 s) would test them harder.", ""]
-    L += ["", "The stop error is 0 for every controller by construction: the tracking kernel hands the "
-          "stop over to the braking envelope (the ATP's curve, rebuilt with the reduced adhesion), as "
-          "the simulator does; what differs is the speed on the way.", ""]
 
-    # fig. 9
-    d0 = draw_disturbances(args.test, seed=1000)[0]
-    fig, ax = plt.subplots(figsize=(8, 4))
+def fig9(case, reference, controllers: dict, n_test: int, path: Path) -> None:
+    """Time-speed of the reference and both tuned controllers on the first held-out train."""
+    d0 = draw_disturbances(n_test, seed=1000)[0]
+    fig, axes = new_figure(1, 1, figsize=(8, 4))
+    ax = axes[0, 0]
     ax.plot(reference.time_s, reference.speed_kmh, "k--", lw=1.2, label="reference (table 3 run)")
     for name in ("PID (tuned)", "fuzzy PID (tuned)"):
         tr = track_disturbed(case, reference, controllers[name], d0)
         ax.plot(tr.time_s, tr.speed_kmh, label=name)
-    ax.set_xlabel("time s")
-    ax.set_ylabel("speed km/h")
+    ax.set(xlabel="time s", ylabel="speed km/h")
     ax.set_title(f"fig. 9 analogue: held-out train 0 (mass x{d0.mass_factor:.2f}, adhesion x{d0.adhesion_factor:.2f}, "
                  f"noise {d0.speed_noise_kmh:.2f} km/h, lag {d0.traction_lag_s:.2f} s)", fontsize="small")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    fig.tight_layout()
-    save_figure(fig, args.out / "metro_controllers_fig9.png", dpi=120)
-    L += ["![fig. 9 analogue](metro_controllers_fig9.png)", ""]
-    (args.out / "metro_controllers.md").write_text("\n".join(L) + "\n")
+    save_figure(fig, path, dpi=120)
+
+
+def comparison_values(frame: pd.DataFrame, controllers: dict) -> dict:
+    """The held-out table (median and mean), the rank-sum tests and the verdict's lists."""
+    def sample(name, m):
+        return frame[frame["controller"] == name][m]
+
+    tests = {m: [rank_sum(sample(a, m), sample(b, m)) for a, b in PAIRS] for m in METRICS}
+    verdict = {word: [METRICS[m] for m in METRICS if tests[m][0][2] == sign] for word, sign in (("better", "+"),
+                                                                                                ("worse", "-"))}
+    return {"held_out_rows": "\n".join(f"| {name} | " + " | ".join(f"{sample(name, m).median():.3f} "
+                                                                  f"({sample(name, m).mean():.3f})" for m in METRICS) + " |"
+                                       for name in controllers),
+            "test_rows": "\n".join(f"| {label} | " + " | ".join(f"{u:.0f} | {p:.3g} | {v}" for u, p, v in tests[m]) + " |"
+                                   for m, label in METRICS.items()),
+            **{word: ", ".join(names) if names else "no metric" for word, names in verdict.items()}}
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--budget", type=int, default=400, help="DE evaluations per tuning run")
+    parser.add_argument("--tuning-seeds", type=int, default=3)
+    parser.add_argument("--test", type=int, default=20, help="held-out disturbed trains")
+    add_study_options(parser, ROOT / "out" / "metro_controllers", ROOT / "benchmarks" / "reports")
+    args = parser.parse_args(argv)
+    lower_priority()
+    study = build_study(args.budget, args.tuning_seeds)
+    if not args.report_only:
+        print(run_study(study, args.work, workers=1), flush=True)
+    case = load_case("metro-a")
+    reference = table3_reference(case)
+    tuning_rows, best = tuned(load_results(args.work, study=study))
+    controllers = {"PID (defaults)": PID(), "fuzzy PID (defaults)": FuzzyPID(),
+                   "PID (tuned)": controller_from_gains("pid", best["pid"]),
+                   "fuzzy PID (tuned)": controller_from_gains("fuzzy_pid", best["fuzzy_pid"])}
+    args.out.mkdir(parents=True, exist_ok=True)
+    frame = held_out(case, reference, controllers, args.test)
+    frame.to_csv(args.out / "metro_controllers.csv", index=False)
+    fig9(case, reference, controllers, args.test, args.out / "metro_controllers_fig9.png")
+    values = {"ref_time_s": f"{reference.running_time_s:.2f}", "ref_stop_m": f"{reference.position_m[-1]:.2f}",
+              "ref_peak_kmh": f"{reference.speed_kmh.max():.2f}", "ref_kwh": f"{reference.energy.net_kwh:.2f}",
+              "ref_time_1": f"{reference.running_time_s:.1f}", "tuning_rows": tuning_rows, "n_test": args.test,
+              "fastest_s": f"{Simulator(case).flat_out().running_time_s:.1f}",
+              **comparison_values(frame, controllers)}
+    write_report(args.out / "metro_controllers.md", [fill_template(ROOT / "benchmarks" / "templates" /
+                                                                   "metro_controllers.md", values)], newline=False)
     print(f"wrote {args.out / 'metro_controllers.md'}")
 
 

@@ -1,15 +1,8 @@
-"""Table 3 and the weight sensitivity of Meng et al. (2017), through the study runner.
+"""Table 3 and the weight sensitivity of Meng et al. (2017): the study files ``examples/metro_table3.toml``
+and ``examples/metro_weights.toml`` through ``run_study``, the grid optimum, the phases on the simulator.
 
-Two study files run by ``pymoo_rail.experiments.run_study`` (one record per run, resumable):
-``examples/metro_table3.toml`` (the paper's weighted GA on ``KinematicPhasesProblem`` of metro-a,
-30 seeds) and ``examples/metro_weights.toml`` (the same GA under eight weight vectors). The report
-compares table 3 with the best and median run, the 1 m grid optimum and the paper's lengths in its
-own model, and replays the phases on the simulator. Its text is ``benchmarks/templates/metro_table3.md``.
-
-Usage::
-
-    nice -n 10 python benchmarks/metro_table3.py                 # both studies, then the report
-    python benchmarks/metro_table3.py --report-only
+Text: ``benchmarks/templates/metro_table3.md``.
+Usage: ``nice -n 10 python benchmarks/metro_table3.py [--seeds N] [--report-only]``
 """
 
 from __future__ import annotations
@@ -39,7 +32,7 @@ PAPER = {"traction_m": 262.37, "cruise_m": 169.15, "coast_m": 369.69, "brake_m":
          "energy_index_kwh": float("nan"), "f": float("nan"), "feasible": True}
 COLUMNS = ["traction_m", "cruise_m", "coast_m", "brake_m", "stop_m", "stop_error_m", "running_time_s", "time_error_s",
            "peak_kmh", "energy_index_kwh", "f", "feasible"]
-BRAKE_MS2 = 1.1
+BRAKE_MS2, COAST_END = 1.1, "1.1 m/s^2 from the coast's end"
 
 
 def quiet_problem(spec):
@@ -147,7 +140,7 @@ def write_report_files(out: Path, table3, weights) -> None:
         "n_seeds": len(fs), "f_best": f"{fs.min():.4f}", "f_median": f"{np.median(fs):.4f}", "f_worst": f"{fs.max():.4f}",
         "grid_f": f"{grid_f:.4f}", "cpu_median": f"{np.median([r['cpu_time_s'] for r in runs3]):.2f}",
         "replay_rows": "\n".join(
-            f"| {name.replace(' lengths', '')}, {'latest braking' if latest else '1.1 m/s^2 from the coast' + chr(39) + 's end'} "
+            f"| {name.replace(' lengths', '')}, {'latest braking' if latest else COAST_END} "
             f"| {tr.energy.net_kwh:.2f} | {tr.running_time_s:.2f} | {tr.position_m[-1]:.2f} | {tr.stop_error_m:.2f} | "
             f"{tr.speed_kmh.max():.2f} |" for (name, latest), tr in replays.items()),
         "paper_peak_kmh": f"{paper['peak_kmh']:.2f}", "paper_brake_m": f"{paper['brake_m']:.2f}",
@@ -159,7 +152,8 @@ def write_report_files(out: Path, table3, weights) -> None:
         "paper_wheel_kwh": f"{replays[(next(iter(lengths)), False)].energy.net_kwh:.2f}",
         "grid_wheel_kwh": f"{replays[('grid optimum', False)].energy.net_kwh:.2f}",
         "comfort_scale": f"{problem.scales[1]:.3f}", "weight_rows": weight_table}
-    write_report(out / "metro_table3.md", [fill_template(ROOT / "benchmarks" / "templates" / "metro_table3.md", values)])
+    write_report(out / "metro_table3.md", [fill_template(ROOT / "benchmarks" / "templates" / "metro_table3.md", values)],
+                 newline=False)
     table3_figure(lengths, problem, replays[("grid optimum", False)], out / "metro_table3.png")
     pd.DataFrame([{"study": study, "problem": r["problem"], "seed": r["seed"], "f": f"{r['f']:.6f}",
                    **dict(zip(("traction_m", "cruise_m", "coast_m"), (f"{v:.3f}" for v in problem.lengths(r["X"])[0])))}

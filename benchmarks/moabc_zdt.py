@@ -1,13 +1,9 @@
 """MOABC (three neighbour moves) vs NSGA-II, MOEA/D and SMS-EMOA on ZDT1-4, 25,000 evaluations each.
 
-Runs through ``pymoo_rail.experiments.run_study`` (study ``moabc-zdt``, seeds 1000 + run, one record
-per run in ``--work``). The report's text is ``benchmarks/templates/moabc_zdt.md``; its numbers come
-from the stored fronts, or from the committed ``moabc_zdt.csv`` when there are no records.
+Study ``moabc-zdt`` of ``run_study``; text ``benchmarks/templates/moabc_zdt.md``; without records,
+``--report-only`` rebuilds the report from the committed ``moabc_zdt.csv``.
 
-Usage::
-
-    nice -n 10 python benchmarks/moabc_zdt.py --runs 30
-    python benchmarks/moabc_zdt.py --report-only
+Usage: ``nice -n 10 python benchmarks/moabc_zdt.py [--runs 30] [--report-only]``
 """
 
 from __future__ import annotations
@@ -24,7 +20,7 @@ from pymoo_rail.experiments.metrics import raw_indicators
 from pymoo_rail.experiments.report import (add_study_options, count_range, fill_template, lower_priority,
                                            markdown_rows, report_runs, write_report)
 from pymoo_rail.experiments.stats import rank_sum
-from pymoo_rail.plotting import plot_fronts, save_figure
+from pymoo_rail.plotting import plot_boxplots, plot_fronts, save_figure
 from pymoo_rail.plotting.style import new_figure
 
 HERE = Path(__file__).resolve().parent
@@ -77,34 +73,29 @@ def problem_table(df, p: str) -> str:
                 if a != "NSGA2" and len(base) > 1 and len(g) > 1 else ""
             cells.append(f"{v.mean():.4g} | {v.median():.4g} | {v.std(ddof=1) if len(v) > 1 else 0:.2g} | {mark}")
         rows.append([a, len(g), f"{g.n_eval.mean():.0f}", *cells, f"{g.time_s.mean():.2f}"])
-    header = ["algorithm", "runs", "n_eval", *(c for i in INDICATORS for c in (f"{i} mean", f"{i} median", f"{i} std", "W")), "time s"]
+    header = ["algorithm", "runs", "n_eval", *(c for i in INDICATORS for c in (f"{i} mean", f"{i} median", f"{i} std", "W")),
+              "time s"]
     return f"## {p}\n\n" + markdown_rows(header, rows) + "\n"
 
 
 def figures(df, fronts: dict, out: Path) -> None:
-    """The first seed's front of every algorithm (only with the records) and the IGD box plots, per problem."""
-    for name, draw in (("fronts", bool(fronts)), ("igd", True)):
-        if not draw:  # rebuilt from the per-run CSV: the front figure needs the records
+    """The IGD box plots per problem and (with the records) the first seed's front of every algorithm."""
+    fig = plot_boxplots(df, "IGD", problems=[p for p in PROBLEMS if (df.problem == p).any()], algorithms=ALGORITHMS)
+    for ax in fig.axes:
+        ax.set_yscale("log")
+    save_figure(fig, out / "moabc_zdt_igd.png", dpi=110)
+    if not fronts:  # rebuilt from the per-run CSV: the front figure needs the records
+        return
+    fig, axes = new_figure(1, 4, figsize=(18, 4))
+    for ax, p in zip(axes[0], PROBLEMS):
+        runs = {a: F for a in ALGORITHMS if (F := fronts.get((p, a, FIRST_SEED))) is not None and len(F)}
+        if not runs:  # a reduced study
+            ax.set_axis_off()
             continue
-        fig, axes = new_figure(1, 4, figsize=(18, 4))
-        for ax, p in zip(axes[0], PROBLEMS):
-            present = [a for a in ALGORITHMS if ((df.problem == p) & (df.algorithm == a)).any()]
-            if not present:  # a reduced study
-                ax.set_axis_off()
-            elif name == "fronts":
-                runs = {a: F for a in present if (F := fronts.get((p, a, FIRST_SEED))) is not None and len(F)}
-                if not runs:
-                    ax.set_axis_off()
-                    continue
-                plot_fronts(runs, reference=get_problem(p.lower()).pareto_front(500), reference_label="exact front",
-                            title=f"{p}, run 0", ax=ax)
-                ax.set_ylim(min(-1.0, ax.get_ylim()[0]), 2.0)
-            else:
-                ax.boxplot([df[(df.problem == p) & (df.algorithm == a)].IGD.astype(float).values for a in present])
-                ax.set_xticks(range(1, len(present) + 1), [a.replace("MOABC-", "MOABC\n") for a in present])
-                ax.set(yscale="log", title=f"{p}: IGD")
-                ax.tick_params(axis="x", labelsize=7)
-        save_figure(fig, out / f"moabc_zdt_{name}.png", dpi=110)
+        plot_fronts(runs, reference=get_problem(p.lower()).pareto_front(500), reference_label="exact front",
+                    title=f"{p}, run 0", ax=ax)
+        ax.set_ylim(min(-1.0, ax.get_ylim()[0]), 2.0)
+    save_figure(fig, out / "moabc_zdt_fronts.png", dpi=110)
 
 
 def report(out: Path, results) -> None:

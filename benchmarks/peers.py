@@ -86,6 +86,21 @@ train.powerMax = 3129277
 train.powerMin = -train.powerMax
 train.etaTraction = 0.73
 train.etaRgBrake = 0.73
+# the efficiency study (optional 8th argument, JSON): the loss models of ms-eetc's fig. 5 script
+study = json.loads(sys.argv[8]) if len(sys.argv) > 8 else None
+result = {}
+if study is not None:
+    from mseetc.efficiency import totalLossesFunction
+    from mseetc.utils import postProcessDataFrame
+    # as in simulations/figure5.py: built first (it sets the train's power caps to its loss data's)
+    dynamic = totalLossesFunction(train, auxiliaries=study['aux_w'], etaGear=study['eta_gear'])
+    eta = study['eta_static']
+    static = lambda f, v: f*v*(f > 0)*(1 - eta)/eta - (1 - eta)*f*v*(f < 0)
+    train.powerLosses = {'perfect': lambda f, v: 0, 'static': static, 'dynamic': dynamic}[study['losses']]
+    grid = study.get('loss_grid')
+    if grid:  # the dynamic losses (W) at each speed (m/s) and its forces (N), for the other solver's maps
+        result['loss_w'] = [[float(dynamic(f, v)) for f in forces] for v, forces in zip(grid['speeds_ms'],
+                                                                                         grid['forces_n'])]
 track = Track(config={'id': track_id}, pathJSON=Path(tracks))
 opts = json.load(open('simulations/config.json'))
 opts['minimumVelocity'] = 1
@@ -97,8 +112,16 @@ for _ in range(repeats):
     df, stats = solver.solve(trip, terminalVelocity=v_end, initialVelocity=v0)
     cpu = time.process_time() - t0
     best = cpu if best is None else min(best, cpu)
-print(json.dumps({'energy_kwh': float(df['Energy [kWh]'].sum()), 'cpu_s': best,
-                  'final_speed_ms': float(df['Velocity [m/s]'].iloc[-1])}))
+result.update({'energy_kwh': float(df['Energy [kWh]'].sum()), 'cpu_s': best,
+               'final_speed_ms': float(df['Velocity [m/s]'].iloc[-1])})
+if study is not None:  # the run's energy under the dynamic losses, integrated as fig. 5 does, and the run
+    train.powerLosses = dynamic
+    real = postProcessDataFrame(df, solver.points, train, integrateLosses=True)
+    result.update({'dynamic_energy_kwh': float(real['Energy [kWh]'].sum()),
+                   'dynamic_losses_kwh': float(real['Losses [kWh]'].sum()),
+                   'position_m': df['Position [m]'].tolist(), 'speed_ms': df['Velocity [m/s]'].tolist(),
+                   'time_s': [float(t) for t in df.index]})
+print(json.dumps(result))
 """
 
 
@@ -118,6 +141,21 @@ def run_mseetc_full(checkout: Path, python: str, track_id: str, trip_s: float, n
                     extra_tracks: dict | None = None, v0_ms: float = 1.0, v_end_ms: float = 1.0,
                     repeats: int = 3) -> tuple[float, float, float]:
     """:func:`run_mseetc` and ms-eetc's final speed (m/s)."""
+    result = run_mseetc_json(checkout, python, track_id, trip_s, n_intervals, extra_tracks, v0_ms, v_end_ms, repeats)
+    return result["energy_kwh"], result["cpu_s"], float(result.get("final_speed_ms", math.nan))
+
+
+def run_mseetc_json(checkout: Path, python: str, track_id: str, trip_s: float, n_intervals: int,
+                    extra_tracks: dict | None = None, v0_ms: float = 1.0, v_end_ms: float = 1.0,
+                    repeats: int = 3, study: dict | None = None) -> dict:
+    """Everything the driver prints for one case (its last line, checked by :func:`parse_mseetc_output`).
+
+    ``study`` (the efficiency study, ``benchmarks/efficiency_study.py``): ``losses`` (``"perfect"``,
+    ``"static"`` or ``"dynamic"``, the models of ms-eetc's fig. 5), ``eta_static``, ``aux_w``,
+    ``eta_gear`` and optionally ``loss_grid`` (``speeds_ms`` and ``forces_n``, one list of forces per
+    speed); the result then also holds
+    the run (``position_m``, ``speed_ms``, ``time_s``), its energy under the dynamic losses and ``loss_w``.
+    """
     with tempfile.TemporaryDirectory() as tmp:
         tracks = Path(tmp)
         for p in (checkout / "tracks").glob("*.json"):
@@ -131,10 +169,12 @@ def run_mseetc_full(checkout: Path, python: str, track_id: str, trip_s: float, n
             (tracks / f"{name}.json").write_text(json.dumps(data))
         driver = tracks / "driver.py"
         driver.write_text(_DRIVER)
+        extra = [json.dumps(study)] if study is not None else []
         out = subprocess.run([python, str(driver), track_id, str(trip_s), str(n_intervals), str(tracks), str(v0_ms),
-                              str(v_end_ms), str(repeats)], cwd=checkout, capture_output=True, text=True, check=True)
-    energy, cpu = parse_mseetc_output(out.stdout)
-    return energy, cpu, float(json.loads(out.stdout.strip().splitlines()[-1]).get("final_speed_ms", math.nan))
+                              str(v_end_ms), str(repeats), *extra], cwd=checkout, capture_output=True, text=True,
+                             check=True)
+    parse_mseetc_output(out.stdout)
+    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def parse_mseetc_output(stdout: str) -> tuple[float, float]:

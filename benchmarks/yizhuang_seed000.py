@@ -1,18 +1,11 @@
-"""ABC and MOABC on yizhuang as in Zhou's thesis, chapter 5 (sections 5.2-5.3): tables 5-5 and 5-6,
-savings against simple strategies, gaps to the exact optimum, figures 5-3 to 5-7.
+"""ABC and MOABC on yizhuang as in Liu (2019), chapter 5: tables 5-5 and 5-6, savings, gaps, figs. 5-3 to 5-7.
 
-The seed's settings: colony 40, limit 50, 100 cycles (``n_gen = 201``); ABC on the constrained form
-(|T - 150 s| <= ``--tolerance``), MOABC on (energy, time error) with the least-energy archive member
-in that window chosen; both on the non-equal partition and on equal partitions of ``--n-equal``
-sections. Runs go through ``pymoo_rail.experiments.run_study`` (one record per run in ``--out``).
-The report's text is ``benchmarks/templates/yizhuang_seed000.md`` (the discussion:
-``reports/yizhuang_seed000_notes.md``); without records, ``--report-only`` rebuilds its tables from
-the committed ``yizhuang_seed000.csv``.
+The seed's colony and budget, ABC on the constrained form and MOABC on (energy, time error), on the
+non-equal and equal partitions, through ``run_study``. Text: ``benchmarks/templates/yizhuang_seed000.md``
+and the hand-written ``reports/yizhuang_seed000_notes.md``; without records, ``--report-only`` rebuilds
+the tables from the committed ``yizhuang_seed000.csv``.
 
-Usage::
-
-    nice -n 10 python benchmarks/yizhuang_seed000.py --seeds 30 --workers 2
-    python benchmarks/yizhuang_seed000.py --report-only
+Usage: ``nice -n 10 python benchmarks/yizhuang_seed000.py [--seeds 30] [--workers 2] [--report-only]``
 """
 
 from __future__ import annotations
@@ -32,7 +25,7 @@ from pymoo_rail.experiments.stats import nondominated, rank_sum
 from pymoo_rail.optimal import optimal_profile
 from pymoo_rail.optimal.baselines import strategy_baselines
 from pymoo_rail.optimal.reference.gap import solved_energy_gap
-from pymoo_rail.plotting import plot_fronts, plot_speed_profile, save_figure
+from pymoo_rail.plotting import plot_convergence, plot_fronts, plot_speed_profile, save_figure
 from pymoo_rail.plotting.style import new_figure
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.optimal.reference import exact_points
@@ -104,11 +97,6 @@ def choices(results: dict, planned_s: float, tolerance_s: float) -> pd.DataFrame
 def make_problem(case, partition: str = NON_EQUAL, tolerance_s: float = TOLERANCE_S) -> SpeedProfileProblem:
     kwargs = {} if partition == NON_EQUAL else {"partition": "equal", "n_sections": int(partition.split("-")[1])}
     return SpeedProfileProblem(case, objectives=("energy",), time_tolerance_s=tolerance_s, **kwargs)
-
-
-def baselines(case) -> dict:
-    """Flat-out, constant cruise and coast point at 150 s (``pymoo_rail.optimal.baselines``)."""
-    return strategy_baselines(make_problem(case))
 
 
 def reference_front(case, tolerance_s: float, path: Path) -> pd.DataFrame:
@@ -186,18 +174,10 @@ def report_values(case, ch, base, ref, gaps, tight, args, reports: Path) -> dict
     return {
         "planned_s": f"{planned:g}", "n_eval": int(ch["n_eval"].mean()), "n_seeds": args.seeds,
         "tolerance_s": f"{args.tolerance:g}", "n_equal": ", ".join(map(str, args.n_equal)),
-        "baselines_text": f"{fo['energy_kwh']:.2f} kWh in {fo['running_time_s']:.2f} s, i.e. "
-        f"{planned - fo['running_time_s']:.1f} s early; **constant cruise** = the 'existing strategy' analogue: one "
-        f"speed code for all sections (capped by each section's limit) found by bisection to run in {planned:g} s: code "
-        f"{cr['code_kmh']:.2f} km/h, {cr['energy_kwh']:.2f} kWh in {cr['running_time_s']:.2f} s; **coast point** = "
-        "maximum traction (held at the limits), coasting from one point, latest braking (the traction-coast-brake "
-        f"practice of 4.3.1) with the coasting point found by bisection for {planned:g} s: coasting from "
-        f"{co['coast_m']:.0f} m, {co['energy_kwh']:.2f} kWh in {co['running_time_s']:.2f} s.",
-        "baseline_rows": "\n".join([
-            f"| constant cruise at {cr['code_kmh']:.2f} km/h ('existing strategy' analogue) | {cr['running_time_s']:.2f} | "
-            f"{cr['energy_kwh']:.2f} | existing strategy: 150 s, 21.44 kWh |",
-            f"| coast point at {co['coast_m']:.0f} m (traction-coast-brake) | {co['running_time_s']:.2f} | "
-            f"{co['energy_kwh']:.2f} | |", f"| flat-out | {fo['running_time_s']:.2f} | {fo['energy_kwh']:.2f} | |"]),
+        "flat_kwh": f"{fo['energy_kwh']:.2f}", "flat_s": f"{fo['running_time_s']:.2f}",
+        "flat_early_s": f"{planned - fo['running_time_s']:.1f}", "cruise_code": f"{cr['code_kmh']:.2f}",
+        "cruise_kwh": f"{cr['energy_kwh']:.2f}", "cruise_s": f"{cr['running_time_s']:.2f}",
+        "coast_m": f"{co['coast_m']:.0f}", "coast_kwh": f"{co['energy_kwh']:.2f}", "coast_s": f"{co['running_time_s']:.2f}",
         "table55": summary_table(summ[summ["partition"] == NON_EQUAL], seed_55),
         "p55": ranksum(ch, ("ABC", NON_EQUAL), ("MOABC", NON_EQUAL)), "table56": summary_table(summ, seed_56),
         "partition_tests": "\n".join(f"* {alg}: non-equal vs equal-{n}, rank-sum p = "
@@ -269,22 +249,8 @@ def front_figure(results, ch, ref, planned: float, tolerance_s: float, reports: 
 
 
 def convergence_figure(results, tolerance_s: float, reports: Path) -> None:
-    """Fig. 5-3: ABC's best feasible energy over the cycles (median and quartiles of the seeds, best seed)."""
-    ab = results["ABC"]
-    fig, axes = new_figure(1, 1, figsize=(8.0, 4.6))
-    ax = axes[0, 0]
-    for part in sorted(ab["problem"].unique(), key=lambda p: 0 if p == NON_EQUAL else int(p.split("-")[1])):
-        curves = [np.array([np.nan if v is None else v for v in h["f0_min"]], float)
-                  for h in ab[ab["problem"] == part]["history"]]
-        C = np.vstack([c[:min(map(len, curves))] for c in curves])
-        q1, med, q3 = np.nanpercentile(C, [25, 50, 75], axis=0)
-        (line,) = ax.plot(med, lw=1.8, label=f"ABC, {part}: median of {len(curves)} seeds")
-        ax.fill_between(np.arange(C.shape[1]), q1, q3, color=line.get_color(), alpha=0.2, lw=0)
-        ax.plot(C[int(np.nanargmin(C[:, -1]))], lw=0.8, ls="--", color=line.get_color(), label=f"ABC, {part}: best seed")
-    ax.set(xlabel="cycle (0 = initial colony)", ylabel=f"best feasible energy (kWh), |T - 150 s| <= {tolerance_s:g} s",
-           title="Convergence of ABC (fig. 5-3); band: interquartile range")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="small")
+    """Fig. 5-3: ABC's best feasible energy against evaluations, median and interquartile range of the seeds."""
+    fig = plot_convergence(results["ABC"], "f0_min", ylabel=f"best feasible energy (kWh), |T - 150 s| <= {tolerance_s:g} s")
     save_figure(fig, reports / "yizhuang_seed000_convergence.png")
 
 
@@ -303,7 +269,7 @@ def write_report_files(args, results: dict | None) -> None:
     points = solved_energy_gap(ok[["running_time_s", "energy_kwh"]].to_numpy(float), case)["points"]
     gaps = pd.Series(100 * points["gap_rel"].to_numpy(), index=ok.index)
     tight = choices({"MOABC": results["MOABC"]}, planned, 0.2) if results is not None else None
-    values = report_values(case, ch, baselines(case), ref, gaps, tight, args, args.reports)
+    values = report_values(case, ch, strategy_baselines(make_problem(case)), ref, gaps, tight, args, args.reports)
     write_report(args.reports / "yizhuang_seed000.md", [fill_template(HERE / "templates" / "yizhuang_seed000.md", values)],
                  newline=False)
     if results is not None:

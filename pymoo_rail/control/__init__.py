@@ -27,6 +27,7 @@ from pymoo_rail.control.controllers import (
     symmetric_rules,
 )
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S, Tracker, track, tracked_summaries
+from pymoo_rail.control.comparison import TRACKING_METRICS, compare_tracking, tracking_metrics
 from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction
 from pymoo_rail.control.disturbances import (  # noqa: E402 (needs Tracker)
     DEFAULT_RANGES,
@@ -50,7 +51,7 @@ from pymoo_rail.control.advice import Advice, AdvisedDriving, advice_frame, advi
 
 __all__ = ["Hysteresis", "PID", "FuzzyPID", "Controller", "CLASSIC_RULES", "SYMMETRIC_RULES",
            "symmetric_rules", "make_controller", "TERMS", "Tracker", "track",
-           "tracked_summaries", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
+           "tracked_summaries", "compare_tracking", "tracking_metrics", "TRACKING_METRICS", "DEFAULT_CONTROL_PERIOD_S", "Disturbance", "draw_disturbances",
            "disturbed_tracker", "track_disturbed", "DEFAULT_RANGES", "OptimalPolicy", "SpeedRestriction",
            "closed_loop", "LoopController", "LoopDisturbance", "LoopState", "CurveTracking", "Replanning",
            "Recovery", "OptimalControls", "Advice", "AdvisedDriving", "advice_from_run", "advice_frame"]

@@ -14,7 +14,7 @@ Whatever the controller says, the train never rises above the braking envelope (
 the simulator has), so it respects every limit and stops at the platform.
 
 The integration scheme, the force functions and the energy accounting are the simulator's
-(:mod:`pymoo_rail.sim.kernel`); the summary has the same ``OUT_*`` columns.
+(:mod:`pymoo_rail.sim.kernel`, efficiency maps included); the summary has the same ``OUT_*`` columns.
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from numba import njit, prange
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control.controllers import CTRL_HYSTERESIS, CTRL_PID
 # Numba's disk cache checks only this file: a change to the run summary (N_OUT, OUT_*) or the
-# running totals of sim/kernel.py must touch this file too, or a stale cache keeps the old layout.
+# running totals of sim/kernel.py must touch this file too, or a stale cache keeps the old layout
+# (last: the two efficiency-map totals, N_TOTALS = 17).
 from pymoo_rail.sim.kernel import (
     N_OUT,
     TOTAL_TIME,

@@ -21,6 +21,17 @@ WORST = {"neutral_traction_j_max": "neutral_traction_j", "neutral_force_n_max": 
          "stop_error_m_max": "stop_error_m"}
 
 
+# a report's table of the checks: (what is checked, the worst value's key, what it must be, its pass/FAIL key)
+CHECKS = (("neutral traction work (J)", "neutral_traction_j_max", "0", "neutral_ok"),
+          ("largest force in a neutral section (N)", "neutral_force_n_max", "<= 0", "force_ok"),
+          ("kernel limit excess (m/s)", "limit_excess_ms_max", "<= 0", "limit_ok"),
+          ("independent limit excess over the train length (m/s)", "independent_excess_ms_max", "<= 0",
+           "independent_ok"),
+          ("stop error (m)", "stop_error_m_max", "<= 0.25", "stop_ok"),
+          ("stored vs re-simulated energy (kWh)", "energy_mismatch_kwh", "0", "energy_ok"),
+          ("stored vs re-simulated running time (s)", "time_mismatch_s", "0", "time_ok"))
+
+
 def check_members(problem, X: np.ndarray, energy_kwh: np.ndarray, running_time_s: np.ndarray,
                   stop_tolerance_m: float = 0.25, speed_tolerance_ms: float = 1e-6) -> dict:
     """The worst value of every check over the members ``X`` of one front (at least one member).
@@ -85,3 +96,9 @@ def worst_checks(rows: Iterable[Mapping], stop_tolerance_m: float = 0.25, speed_
     worst["fixed_ok"] = "pass" if all(r["fixed_genes_ok"] for r in checked) else "FAIL"
     worst["all_ok"] = all(r["verified"] for r in checked) and worst["energy_ok"] == worst["time_ok"] == "pass"
     return worst
+
+
+def check_rows(worst: Mapping, format_value=str) -> list[list[str]]:
+    """The rows of a report's check table from :func:`worst_checks`: check, worst value, requirement, result."""
+    rows = [[name, format_value(worst[key]), required, worst[ok]] for name, key, required, ok in CHECKS]
+    return rows + [["neutral-section genes at their fixed value (10 km/h, coast)", "", "all members", worst["fixed_ok"]]]

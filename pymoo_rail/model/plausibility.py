@@ -21,7 +21,7 @@ from pymoo_rail.model.errors import CaseError
 from pymoo_rail.model.train import GRAVITY_MS2
 
 # every kind of bound, in the order they are checked
-IMPLAUSIBLE_KINDS = ("length", "speed", "gradient", "mass", "force", "power", "time")
+IMPLAUSIBLE_KINDS = ("length", "speed", "gradient", "mass", "force", "power", "time", "efficiency")
 
 MAX_GRADIENT_PERMILLE = 60.0          # steepest adhesion main lines and metros ~40-60 permille
 SPEED_KMH = (1.0, 600.0)              # wheel-rail record 574.8 km/h; shunting limits >= 5 km/h
@@ -35,6 +35,8 @@ RESISTANCE_PER_WEIGHT = 0.3           # real W0 at top speed <= 0.05 of the weig
 ACCEL_MS2 = (0.01, 5.0)               # freight ~0.05 m/s^2; emergency braking ~1.5-2.5; beyond adhesion
 POWER_KW_PER_T = (0.1, 200.0)         # freight ~1 kW/t, EMUs 5-25 kW/t, a lone locomotive ~80 kW/t
 AUX_POWER_KW_PER_T = 20.0             # hotel load ~0.5-3 kW/t
+PEAK_EFFICIENCY = (0.5, 1.0)          # no traction chain peaks below ~0.6-0.7 (diesel-electric) at its best
+MAP_COVERAGE = (0.5, 100.0)           # a map's top speed / force over the train's: half of it, or km/h vs m/s
 MAX_TIME_S = 86_400.0                 # one stop-to-stop run or dwell longer than a day
 
 UNIT_FACTOR = 1000.0  # the mistakes the messages name: N for kN, W for kW, kg for t, ms for s
@@ -173,8 +175,27 @@ def _check_time(case) -> None:
                         f"would count as on time {_waiver('time')}")
 
 
+def _check_efficiency(case) -> None:
+    train = case.train
+    top_force_kn = float(np.max(train.traction.force_kn(np.linspace(0.0, train.max_speed_kmh, 201))))
+    for direction in ("traction", "regen"):
+        efficiency_map = getattr(train, f"{direction}_efficiency_map")
+        if efficiency_map is None:
+            continue
+        field = f"train.{direction}_efficiency_map"
+        _outside(f"{field}.values", efficiency_map.peak, "efficiency", "a peak efficiency of", PEAK_EFFICIENCY, "",
+                 efficiency_map.peak)
+        _outside(f"{field}.speeds_kmh", list(efficiency_map.speeds_kmh), "efficiency",
+                 "a top speed over the train's top speed (m/s for km/h below 0.3) of", MAP_COVERAGE, "",
+                 efficiency_map.speeds_kmh[-1] / train.max_speed_kmh)
+        _outside(f"{field}.forces_kn", list(efficiency_map.forces_kn), "efficiency",
+                 "a top force over the train's largest traction force of", MAP_COVERAGE, "",
+                 efficiency_map.forces_kn[-1] / top_force_kn, high_hint="N where kN is meant?")
+
+
 _CHECKS = {"length": _check_length, "speed": _check_speed, "gradient": _check_gradient, "mass": _check_mass,
-           "force": _check_force, "power": _check_power, "time": _check_time}
+           "force": _check_force, "power": _check_power, "time": _check_time,
+           "efficiency": _check_efficiency}
 
 
 def check_plausible(case, allow: bool | Iterable[str] = False) -> None:

@@ -12,6 +12,7 @@ from typing import Any
 from pymoo_rail.model.case import Case, Leg
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.curves import DavisResistance, ForceCurve
+from pymoo_rail.model.efficiency import EfficiencyMap
 from pymoo_rail.model.errors import CaseError, check_number
 from pymoo_rail.model.line import Line
 from pymoo_rail.model.train import Train
@@ -22,7 +23,8 @@ _RUN = {"planned_time_s", "dwell_s", "time_margin_s", "legs", "initial_speed_kmh
 _LEG = {"start_m", "end_m", "planned_time_s", "dwell_s"}
 _TRAIN = {"name", "mass_t", "rotary_factor", "length_m", "max_speed_kmh", "max_accel_ms2", "max_decel_ms2",
           "traction_efficiency", "regen_efficiency", "regen_min_speed_kmh", "aux_power_kw",
-          "resistance", "traction", "braking"}
+          "resistance", "traction", "braking", "traction_efficiency_map", "regen_efficiency_map"}
+_EFFICIENCY_MAP = {"speeds_kmh", "forces_kn", "values", "gear", "converter"}
 _RESISTANCE = {"a", "b", "c", "unit", "speed_unit"}
 _CURVE = {"segments", "table", "max_force_kn", "max_power_kw"}
 _BRAKING = _CURVE | {"regen_max_force_kn", "regen_max_power_kw"}
@@ -34,7 +36,8 @@ _LINE = {"length_m", "gradients", "speed_limits", "curves", "tunnels", "neutral_
 # every table of the format and the keys it may hold ("[]": each table of an array of tables)
 CASE_TABLES = {"": _TOP, "run": _RUN, "run.legs[]": _LEG, "train": _TRAIN, "train.resistance": _RESISTANCE,
                "train.traction": _CURVE, "train.traction.segments[]": _SEGMENT, "train.braking": _BRAKING,
-               "train.braking.segments[]": _SEGMENT, "line": _LINE}
+               "train.braking.segments[]": _SEGMENT, "train.traction_efficiency_map": _EFFICIENCY_MAP,
+               "train.regen_efficiency_map": _EFFICIENCY_MAP, "line": _LINE}
 
 
 def case_keys() -> list[str]:
@@ -169,13 +172,18 @@ def train_from_dict(data: Any, source: str = "<dict>") -> Train:
     braking = tr["braking"]
 
     def build() -> Train:
+        maps = {d: _efficiency_map(tr.get(f"{d}_efficiency_map"), f"train.{d}_efficiency_map", source)
+                for d in ("traction", "regen")}
+        # with a map, the constant defaults to its peak (Train checks a given one against it)
+        constant = {d: tr.get(f"{d}_efficiency", maps[d].peak if maps[d] is not None else default)
+                    for d, default in (("traction", 1.0), ("regen", 0.0))}
         return Train(
             name=tr.get("name", ""),
             mass_t=tr["mass_t"], length_m=tr["length_m"], max_speed_kmh=tr["max_speed_kmh"],
             rotary_factor=tr.get("rotary_factor", 0.0),
             max_accel_ms2=tr.get("max_accel_ms2"), max_decel_ms2=tr.get("max_decel_ms2"),
-            traction_efficiency=tr.get("traction_efficiency", 1.0),
-            regen_efficiency=tr.get("regen_efficiency", 0.0),
+            traction_efficiency=constant["traction"], regen_efficiency=constant["regen"],
+            traction_efficiency_map=maps["traction"], regen_efficiency_map=maps["regen"],
             regen_min_speed_kmh=tr.get("regen_min_speed_kmh", 0.0),
             aux_power_kw=tr.get("aux_power_kw", 0.0),
             resistance=DavisResistance(res["a"], res["b"], res["c"], res["unit"], res["speed_unit"]),
@@ -186,6 +194,30 @@ def train_from_dict(data: Any, source: str = "<dict>") -> Train:
         )
 
     return _named(build, "train", source)
+
+
+def _efficiency_map(data: Any, field: str, source: str) -> EfficiencyMap | None:
+    """An efficiency map table: the table (the motor's, where parts are given) times ``gear`` and
+    ``converter`` efficiencies when present (the chain motor x gear x converter)."""
+    if data is None:
+        return None
+    tab = _table(data, field, _EFFICIENCY_MAP, {"speeds_kmh", "forces_kn", "values"}, source)
+    for key in ("speeds_kmh", "forces_kn", "values"):
+        if not isinstance(tab[key], (list, tuple)):
+            raise CaseError(f"{field}.{key}", tab[key], "must be an array", source)
+    for i, row in enumerate(tab["values"]):
+        if not isinstance(row, (list, tuple)):
+            raise CaseError(f"{field}.values[{i}]", row, "must be an array (one row per speed)", source)
+    table = EfficiencyMap(tuple(tab["speeds_kmh"]), tuple(tab["forces_kn"]),
+                          tuple(tuple(row) for row in tab["values"]), field)
+    parts = [check_number(f"{field}.{k}", tab[k], positive=True, upper=1.0, source=source)
+             for k in ("gear", "converter") if k in tab]
+    return EfficiencyMap.chain((table, *parts), field) if parts else table
+
+
+def _map_to_dict(efficiency_map: EfficiencyMap) -> dict:
+    return {"speeds_kmh": list(efficiency_map.speeds_kmh), "forces_kn": list(efficiency_map.forces_kn),
+            "values": [list(row) for row in efficiency_map.values]}
 
 
 def case_to_dict(case: Case) -> dict:
@@ -217,6 +249,10 @@ def case_to_dict(case: Case) -> dict:
         train["max_accel_ms2"] = t.max_accel_ms2
     if t.max_decel_ms2 is not None:
         train["max_decel_ms2"] = t.max_decel_ms2
+    for direction in ("traction", "regen"):  # only when set: other cases' files and fingerprints stay as they were
+        efficiency_map = getattr(t, f"{direction}_efficiency_map")
+        if efficiency_map is not None:
+            train[f"{direction}_efficiency_map"] = _map_to_dict(efficiency_map)
     r = t.resistance
     train["resistance"] = {"a": r.a, "b": r.b, "c": r.c, "unit": r.unit, "speed_unit": r.speed_unit}
     train["traction"] = curve(t.traction)

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.curves import DavisResistance, ForceCurve
+from pymoo_rail.model.efficiency import EfficiencyMap
 from pymoo_rail.model.errors import CaseError, check_number
 
 GRAVITY_MS2 = 9.81
@@ -15,12 +16,26 @@ def _require(field: str, value: float | None, **kwargs) -> None:
     check_number(field, value, **kwargs)
 
 
+def _check_map(direction: str, efficiency_map: EfficiencyMap | None, constant: float) -> None:
+    if efficiency_map is None:
+        return
+    if not isinstance(efficiency_map, EfficiencyMap):
+        raise CaseError(f"train.{direction}_efficiency_map", efficiency_map, "must be an EfficiencyMap")
+    if constant != efficiency_map.peak:
+        raise CaseError(f"train.{direction}_efficiency", constant,
+                        f"must be the peak of train.{direction}_efficiency_map ({efficiency_map.peak!r}) when a map "
+                        "is given: the constant is what closed forms and estimates use")
+
+
 @dataclass(frozen=True)
 class Train:
     """A train as a point mass with a length (for limits and averaged gradients).
 
     Units follow the case file: tonnes, metres, km/h, kN, kW; ``*_si`` properties give SI.
     ``rotary_factor`` is gamma: the effective inertial mass is ``mass (1 + gamma)``.
+    ``traction_efficiency_map`` and ``regen_efficiency_map`` (optional) make the efficiency a
+    function of the operating point (speed, force); with one, the constant of that direction must be
+    the map's peak (the value the closed forms and estimates see), see docs/efficiency.md.
     """
 
     mass_t: float
@@ -39,6 +54,8 @@ class Train:
     regen_max_power_kw: float | None = None
     aux_power_kw: float = 0.0
     name: str = ""
+    traction_efficiency_map: EfficiencyMap | None = None
+    regen_efficiency_map: EfficiencyMap | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -55,6 +72,8 @@ class Train:
         _require("train.braking.regen_max_force_kn", self.regen_max_force_kn, positive=True, optional=True)
         _require("train.braking.regen_max_power_kw", self.regen_max_power_kw, positive=True, optional=True)
         _require("train.aux_power_kw", self.aux_power_kw, nonneg=True)
+        for direction in ("traction", "regen"):
+            _check_map(direction, getattr(self, f"{direction}_efficiency_map"), getattr(self, f"{direction}_efficiency"))
         for name in ("traction", "braking"):
             curve = getattr(self, name)
             if not isinstance(curve, ForceCurve):

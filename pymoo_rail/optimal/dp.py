@@ -42,7 +42,13 @@ from pymoo_rail.sim.kernel import (
     share_above,
 )
 from pymoo_rail.sim.jit import inlined
-from pymoo_rail.sim.physics import electric_braking_capped, landing_force
+from pymoo_rail.sim.physics import (
+    davis_force,
+    electric_braking_capped,
+    landing_force,
+    regen_map_shortfall,
+    traction_map_excess,
+)
 
 INF = math.inf
 # Cost-to-go stored for a node from which the platform cannot be reached (e.g. too slow to clear a
@@ -131,7 +137,8 @@ def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     """Net energy of the cell plus ``time_price_w`` x its time (J), and its time (s).
 
     The simulator's own accounting (``complete_cell``): traction work / eta_traction minus
-    eta_regen x the electric braking work above the regen cut-off. Infinite when the train stops
+    eta_regen x the electric braking work above the regen cut-off, with the efficiency maps at the
+    cell's mean speed and force where the train has them. Infinite when the train stops
     inside the cell before the platform (the simulator ends the run there). Only the three totals
     the cost needs (time, traction work, electric braking work), in ``complete_cell``'s arithmetic
     bit for bit (``tests/optimal/test_dp_kernels.py`` holds them equal); the comfort and limit
@@ -146,12 +153,17 @@ def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     dt = 0.0 + 2.0 * d / (v0 + v1)
     w_trac = 0.0
     w_elec = 0.0
+    extra = 0.0  # an efficiency map's excess over w_trac / eta and shortfall below eta_regen w_elec
+    short = 0.0
     if f > 0.0:
         w_trac += f * d
+        extra = traction_map_excess(m, 0.5 * (v0 + v1), f, f * d)
     elif f < 0.0:
         share = share_above(v0, v1, m.regen_min_speed_ms)
-        w_elec += electric_braking_capped(m, 0.5 * (v0 + v1), -f) * d * share
-    e = w_trac / m.traction_efficiency - m.regen_efficiency * w_elec
+        f_electric = electric_braking_capped(m, 0.5 * (v0 + v1), -f)
+        w_elec += f_electric * d * share
+        short = regen_map_shortfall(m, 0.5 * (v0 + v1), f_electric, f_electric * d * share)
+    e = w_trac / m.traction_efficiency + extra - (m.regen_efficiency * w_elec - short)
     return e + time_price_w * dt, dt
 
 
@@ -251,6 +263,70 @@ def psi_speed(b_nsm, c_ns2m2, psi_w):
 
 
 @njit(cache=True)
+def electric_force(m, v, f):
+    """Electrical energy per metre (N) of the control force ``f`` (N) at speed ``v``: ``f / eta_traction(v, f)``
+    when pulling, ``-eta_regen(v, |f|) |f|`` when braking electrically (the maps where the train has them;
+    regen caps and cut-off aside: they do not enter the stationarity condition)."""
+    if f > 0.0:
+        return f / m.traction_efficiency + traction_map_excess(m, v, f, f)
+    if f < 0.0:
+        return -(m.regen_efficiency * -f - regen_map_shortfall(m, v, -f, -f))
+    return 0.0
+
+
+@njit(cache=True)
+def map_is_constant(values, constant):
+    """Whether an efficiency map gives ``constant`` everywhere (then the constant's closed form serves)."""
+    for i in range(values.shape[0]):
+        for j in range(values.shape[1]):
+            if values[i, j] != constant:
+                return False
+    return True
+
+
+@njit(cache=True)
+def hold_stationarity(m, v, line_force_n, braking):
+    """``v^2 (R'(v) dg/dF + dg/dv)`` at the holding force ``F = R(v) + line force`` (N x m/s = W).
+
+    ``g(v, F)`` is :func:`electric_force`; a holding speed of the price ``lambda + P_aux`` is a root of
+    ``hold_stationarity = lambda + P_aux`` (docs/efficiency.md). With a constant efficiency it is
+    ``psi(v) / eta_traction`` (``braking``: ``eta_regen psi(v)``), the condition :func:`psi_speed`
+    solves. The holding force is kept on its side of zero (at least 1 N) where the gradient alone
+    would hold the speed; derivatives are central differences (the maps are piecewise bilinear).
+    """
+    f = davis_force(m, v) + line_force_n
+    if braking:
+        f = f if f < -1.0 else -1.0
+    else:
+        f = f if f > 1.0 else 1.0
+    hf = 1e-4 * abs(f)
+    hv = 1e-5 * v + 1e-7
+    g_f = (electric_force(m, v, f + hf) - electric_force(m, v, f - hf)) / (2.0 * hf)
+    g_v = (electric_force(m, v + hv, f) - electric_force(m, v - hv, f)) / (2.0 * hv)
+    return v * v * ((m.davis_b_nsm + 2.0 * m.davis_c_ns2m2 * v) * g_f + g_v)
+
+
+@njit(cache=True)
+def map_hold_speed(m, price_w, line_force_n, braking, v_top):
+    """The speed below ``v_top`` where :func:`hold_stationarity` equals ``price_w``, by bisection (0 if
+    there is none: the condition stays above or below the price over ``(0, v_top)``)."""
+    lo, hi = 1e-3, v_top
+    if hi <= lo or hold_stationarity(m, hi, line_force_n, braking) < price_w:
+        return 0.0
+    if hold_stationarity(m, lo, line_force_n, braking) > price_w:
+        return 0.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if hold_stationarity(m, mid, line_force_n, braking) < price_w:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-13 * hi:
+            break
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
 def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p):
     """The speeds at which holding is optimal for the price of time, at every grid node (Pontryagin).
 
@@ -261,10 +337,16 @@ def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p):
     ``sing_v`` (n_nodes, 2) and their fractional node indices ``sing_p`` (-1 where a speed does not
     apply: at or above the braking envelope, where the top node holds the limit; ``W`` without
     regeneration or below its cut-off speed; within 1e-3 of a regular node, which holds it already;
-    at the last node). ``time_price_w`` (n_cells,) is each cell's ``lambda + P_aux``.
+    at the last node). ``time_price_w`` (n_cells,) is each cell's ``lambda + P_aux``. With an
+    efficiency map the speeds solve :func:`hold_stationarity` instead, the same condition with the
+    map's efficiency and its slopes at the holding force of the cell (so they depend on the gradient).
     """
     n = m.position_m.shape[0]
     k_max = n_speeds - 1
+    # an efficiency map (not constant): the stationarity condition at the holding force, per cell
+    map_traction = m.traction_map_values.shape[0] > 0 and not map_is_constant(m.traction_map_values,
+                                                                              m.traction_efficiency)
+    map_regen = m.regen_map_values.shape[0] > 0 and not map_is_constant(m.regen_map_values, m.regen_efficiency)
     for i in range(n):
         for s in range(2):
             sing_v[i, s] = 0.0
@@ -273,10 +355,16 @@ def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p):
             continue
         price = time_price_w[i]
         top_u = m.envelope_ms[i] ** 2
-        v_hold = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
+        if map_traction:
+            v_hold = map_hold_speed(m, price, m.line_force_n[i], False, m.envelope_ms[i])
+        else:
+            v_hold = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
         v_regen = 0.0
         if m.regen_efficiency > 0.0:
-            v_regen = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
+            if map_regen:
+                v_regen = map_hold_speed(m, price, m.line_force_n[i], True, m.envelope_ms[i])
+            else:
+                v_regen = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
             if v_regen <= m.regen_min_speed_ms:
                 v_regen = 0.0
         for s in range(2):

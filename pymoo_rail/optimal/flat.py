@@ -55,6 +55,8 @@ def _check_flat(case: Case, level: bool = True) -> float:
                                           or train.regen_max_power_kw is not None):
         raise ValueError(f"case '{case.name}': the closed form with regeneration assumes that all braking "
                          "regenerates (no regen caps, no cut-off speed)")
+    if train.traction_efficiency_map is not None or train.regen_efficiency_map is not None:
+        raise ValueError(f"case '{case.name}': the closed form assumes constant efficiencies, not an efficiency map")
     return grades.pop()
 
 

@@ -10,9 +10,11 @@ from pymoo_rail.plotting.convergence import convergence_frame, history_curve, pl
 from pymoo_rail.plotting.fronts import plot_front, plot_fronts, plot_study_fronts, representative_runs
 from pymoo_rail.plotting.journey import plot_timed_run
 from pymoo_rail.plotting.profiles import Trace, as_trace, plot_speed_profile, plot_speed_time
+from pymoo_rail.plotting.speed_runs import plot_speed_runs
 from pymoo_rail.plotting.study import plot_study
 from pymoo_rail.plotting.style import OBJECTIVE_LABELS, REGIME_COLORS, save_figure
 
 __all__ = ["plot_advised_run", "plot_front", "plot_fronts", "plot_study_fronts", "representative_runs", "plot_speed_profile",
            "plot_speed_time", "Trace", "as_trace", "plot_convergence", "convergence_frame", "plot_history",
-           "history_curve", "plot_boxplots", "plot_study", "save_figure", "OBJECTIVE_LABELS", "REGIME_COLORS", "plot_timed_run"]
+           "history_curve", "plot_boxplots", "plot_study", "save_figure", "OBJECTIVE_LABELS", "REGIME_COLORS", "plot_timed_run",
+           "plot_speed_runs"]

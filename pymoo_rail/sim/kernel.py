@@ -50,6 +50,8 @@ from pymoo_rail.sim.physics import (
     landing_force,
     max_braking,
     max_traction,
+    regen_map_shortfall,
+    traction_map_excess,
 )
 
 MODE_TOWARD, MODE_TRACTION, MODE_HOLD, MODE_COAST, MODE_BRAKE, MODE_HOLD_BRAKE = 0, 1, 2, 3, 4, 5
@@ -177,8 +179,10 @@ TOTAL_TIME, TOTAL_TRACTION_J, TOTAL_BRAKE_J, TOTAL_ELECTRIC_BRAKE_J = 0, 1, 2, 3
 TOTAL_DAVIS_J, TOTAL_LINE_J, TOTAL_GRADE_J, TOTAL_NEUTRAL_TRACTION_J = 4, 5, 6, 7
 TOTAL_ACCEL_VARIATION, TOTAL_PREV_ACCEL, TOTAL_MAX_ABS_ACCEL = 8, 9, 10
 TOTAL_PREV_REGIME, TOTAL_REGIME_CHANGES, TOTAL_LIMIT_EXCESS = 11, 12, 13
-TOTAL_PEAK_TRACTION_W = 14  # the highest mechanical traction power of a cell, F (v0 + v1) / 2
-N_TOTALS = 15
+TOTAL_PEAK_TRACTION_W = 14  # the highest traction power of a cell, F (v0 + v1) / 2, x eta_ref / eta(v, F)
+# what an efficiency map adds to traction energy and takes from regeneration (J; 0 without a map)
+TOTAL_TRACTION_EXCESS_J, TOTAL_REGEN_SHORTFALL_J = 15, 16
+N_TOTALS = 17
 
 
 @inlined
@@ -187,7 +191,7 @@ def new_totals():
 
     A tuple, not an array: the kernels rebind it every cell and Numba keeps it in registers.
     """
-    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300, 0.0)
+    return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1e300, 0.0, 0.0, 0.0)
 
 
 @inlined
@@ -242,20 +246,28 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
         u1 = 0.0
     v1 = math.sqrt(u1)
     (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
-     jerk, prev_acc, max_acc, prev_regime, changes, excess, peak_w) = totals
+     jerk, prev_acc, max_acc, prev_regime, changes, excess, peak_w, trac_excess, regen_short) = totals
     time_s += 2.0 * d / (v + v1) if v + v1 > 0.0 else 0.0
     brake_n = -f if f < 0.0 else 0.0
     if f > 0.0:
         w_trac += f * d
         if m.neutral[cell] != 0:
             w_neutral += f * d
-        # the cell's mean power, its work over its duration: f d / (2 d / (v + v1))
-        if f * 0.5 * (v + v1) > peak_w:
-            peak_w = f * 0.5 * (v + v1)
+        extra = traction_map_excess(m, 0.5 * (v + v1), f, f * d)
+        trac_excess += extra
+        # the cell's mean power, its work over its duration: f d / (2 d / (v + v1)); with a map, the
+        # electrical power over eta_ref (write_summary divides by it)
+        power_w = f * 0.5 * (v + v1)
+        if extra != 0.0:
+            power_w *= (f * d + extra * m.traction_efficiency) / (f * d)
+        if power_w > peak_w:
+            peak_w = power_w
     w_brake += brake_n * d
     if brake_n > 0.0:
         share = share_above(v, v1, m.regen_min_speed_ms)
-        w_elec += electric_braking_capped(m, 0.5 * (v + v1), brake_n) * d * share
+        f_electric = electric_braking_capped(m, 0.5 * (v + v1), brake_n)
+        w_elec += f_electric * d * share
+        regen_short += regen_map_shortfall(m, 0.5 * (v + v1), f_electric, f_electric * d * share)
     w_davis += w0 * d
     w_line += m.line_force_n[cell] * d
     w_grade += m.grade_force_n[cell] * d
@@ -268,7 +280,7 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
         excess = v1 - m.limit_ms[cell + 1]
     x1 = m.position_m[cell] + d
     totals = (time_s, w_trac, w_brake, w_elec, w_davis, w_line, w_grade, w_neutral,
-              jerk, a_cell, max_acc, float(regime), changes, excess, peak_w)
+              jerk, a_cell, max_acc, float(regime), changes, excess, peak_w, trac_excess, regen_short)
     return v1, stopped, x1, a_cell, totals
 
 
@@ -286,11 +298,14 @@ def trace_cell_energies(m, x, v, f):
     regen = np.zeros(n_cells)
     for i in range(n_cells):
         d = x[i + 1] - x[i]
+        v_mid = 0.5 * (v[i] + v[i + 1])
         if f[i] > 0.0:
-            trac[i] = f[i] * d / m.traction_efficiency
+            trac[i] = f[i] * d / m.traction_efficiency + traction_map_excess(m, v_mid, f[i], f[i] * d)
         elif f[i] < 0.0:
             share = share_above(v[i], v[i + 1], m.regen_min_speed_ms)
-            regen[i] = m.regen_efficiency * electric_braking_capped(m, 0.5 * (v[i] + v[i + 1]), -f[i]) * d * share
+            f_electric = electric_braking_capped(m, v_mid, -f[i])
+            regen[i] = (m.regen_efficiency * f_electric * d * share
+                        - regen_map_shortfall(m, v_mid, f_electric, f_electric * d * share))
     return trac, regen
 
 
@@ -324,8 +339,11 @@ def write_summary(m, totals, out, v, reached, stop_pos, count, record, tr_a, tr_
         tr_f[count - 1] = 0.0
         tr_r[count - 1] = REGIME_BRAKE if reached else REGIME_COAST
     t = totals[TOTAL_TIME]
-    out[OUT_TRACTION_KWH] = totals[TOTAL_TRACTION_J] / m.traction_efficiency / J_PER_KWH
-    out[OUT_REGEN_KWH] = m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J] / J_PER_KWH
+    # + 0.0 / - 0.0 without a map: the constant-efficiency figures bit for bit
+    out[OUT_TRACTION_KWH] = (totals[TOTAL_TRACTION_J] / m.traction_efficiency
+                             + totals[TOTAL_TRACTION_EXCESS_J]) / J_PER_KWH
+    out[OUT_REGEN_KWH] = (m.regen_efficiency * totals[TOTAL_ELECTRIC_BRAKE_J]
+                          - totals[TOTAL_REGEN_SHORTFALL_J]) / J_PER_KWH
     out[OUT_AUX_KWH] = m.aux_power_w * t / J_PER_KWH
     out[OUT_NET_KWH] = out[OUT_TRACTION_KWH] + out[OUT_AUX_KWH] - out[OUT_REGEN_KWH]
     out[OUT_RUNNING_TIME_S] = t

@@ -51,6 +51,20 @@ class KernelModel(NamedTuple):
     initial_speed_ms: float = 0.0
     final_speed_ms: float = 0.0
     dx_per_mass_m_kg: float = 0.0  # dx_m / effective_mass_kg, precomputed for the kernel's step
+    # efficiency maps over (speed, force magnitude), empty without one (``model.EfficiencyMap``)
+    traction_map_speeds_ms: np.ndarray = np.empty(0)
+    traction_map_forces_n: np.ndarray = np.empty(0)
+    traction_map_values: np.ndarray = np.empty((0, 0))
+    regen_map_speeds_ms: np.ndarray = np.empty(0)
+    regen_map_forces_n: np.ndarray = np.empty(0)
+    regen_map_values: np.ndarray = np.empty((0, 0))
+
+
+def efficiency_map_arrays(efficiency_map) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The kernels' arrays of an :class:`~pymoo_rail.model.EfficiencyMap` (empty for ``None``)."""
+    if efficiency_map is None:
+        return np.empty(0), np.empty(0), np.empty((0, 0))
+    return efficiency_map.table_si()
 
 
 def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | None = None) -> KernelModel:
@@ -79,6 +93,10 @@ def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | 
         initial_speed_ms=float(case.initial_speed_ms), final_speed_ms=float(case.final_speed_ms),
         dx_per_mass_m_kg=grid.dx_m / train.effective_mass_kg,
     )
+    ts, tf_, tv = efficiency_map_arrays(train.traction_efficiency_map)
+    rs, rf, rv = efficiency_map_arrays(train.regen_efficiency_map)
+    model = model._replace(traction_map_speeds_ms=ts, traction_map_forces_n=tf_, traction_map_values=tv,
+                           regen_map_speeds_ms=rs, regen_map_forces_n=rf, regen_map_values=rv)
     envelope = braking_envelope(model)
     if model.initial_speed_ms > envelope[0]:
         raise InfeasibleCaseError("run.initial_speed_kmh", case.initial_speed_ms * KMH_PER_MS,
@@ -151,6 +169,62 @@ def electric_braking_capped(m, v, brake_n):
     if v > 0.0 and f * v > m.regen_max_w:
         f = m.regen_max_w / v
     return f
+
+
+@inlined
+def map_node(nodes, x):
+    """Table cell of ``x`` among ascending ``nodes`` and the fraction across it (held at the edges)."""
+    n = nodes.shape[0]
+    if n == 1 or x <= nodes[0]:
+        return 0, 0.0
+    if x >= nodes[n - 1]:
+        return n - 2, 1.0
+    lo, hi = 0, n - 1  # bisection: nodes[lo] <= x < nodes[hi] (maps from loss tables have ~100 nodes)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if x >= nodes[mid]:
+            lo = mid
+        else:
+            hi = mid
+    return lo, (x - nodes[lo]) / (nodes[lo + 1] - nodes[lo])
+
+
+@inlined
+def map_efficiency(speeds, forces, values, v, f):
+    """Bilinear efficiency of a map at speed ``v`` (m/s) and force magnitude ``f`` (N), the edge
+    values beyond its nodes (``EfficiencyMap.efficiency`` in SI)."""
+    i, ti = map_node(speeds, v)
+    j, tj = map_node(forces, abs(f))
+    i1 = i + 1 if speeds.shape[0] > 1 else i
+    j1 = j + 1 if forces.shape[0] > 1 else j
+    low = values[i, j] + tj * (values[i, j1] - values[i, j])
+    high = values[i1, j] + tj * (values[i1, j1] - values[i1, j])
+    return low + ti * (high - low)
+
+
+@inlined
+def traction_map_excess(m, v, f, work_j):
+    """Electrical energy of the traction work ``work_j`` at (``v``, ``f``) beyond ``work_j /
+    traction_efficiency`` (J): zero without a map, and exactly zero where the map gives the constant,
+    so that a constant map reproduces the constant efficiency bit for bit."""
+    if m.traction_map_values.shape[0] == 0:
+        return 0.0
+    eta = map_efficiency(m.traction_map_speeds_ms, m.traction_map_forces_n, m.traction_map_values, v, f)
+    if eta == m.traction_efficiency:
+        return 0.0
+    return work_j / eta - work_j / m.traction_efficiency
+
+
+@inlined
+def regen_map_shortfall(m, v, f_electric, work_j):
+    """Regenerated energy of the electric braking work ``work_j`` at (``v``, ``f_electric``) short of
+    ``regen_efficiency x work_j`` (J): zero without a map or where it gives the constant."""
+    if m.regen_map_values.shape[0] == 0:
+        return 0.0
+    eta = map_efficiency(m.regen_map_speeds_ms, m.regen_map_forces_n, m.regen_map_values, v, f_electric)
+    if eta == m.regen_efficiency:
+        return 0.0
+    return m.regen_efficiency * work_j - eta * work_j
 
 
 # Relative tolerance of a landing: the force it needs may exceed what the train has by this much

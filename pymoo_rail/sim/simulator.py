@@ -10,7 +10,8 @@ from pymoo_rail.sim import kernel as k
 from pymoo_rail.sim.drivers import flat_out_program
 from pymoo_rail.sim.physics import KernelModel, build_kernel_model
 from pymoo_rail.sim.stall import explain_stall
-from pymoo_rail.sim.trajectory import Trajectory, energy_from_summary, summary_dict
+from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.sim.trajectory import EnergyBreakdown, Trajectory, energy_from_summary, summary_dict
 
 # Below this many cells (runs x grid cells) a batch runs in the calling thread: waking the
 # other threads and waiting for the slowest one costs more than it saves, and waiting threads
@@ -63,6 +64,20 @@ class Simulator:
                           limit_ms=self.grid.limit_ms[: x.shape[0]], energy=energy_from_summary(out),
                           running_time_s=float(out[k.OUT_RUNNING_TIME_S]),
                           stop_error_m=float(out[k.OUT_STOP_ERROR_M]), summary=summary_dict(out))
+
+    def energy_of(self, run: Trajectory) -> EnergyBreakdown:
+        """The energy of a recorded run (any train's, on this line) drawn by this case's train.
+
+        The run's positions, speeds and forces are kept; the accounting is this train's (its
+        efficiencies or efficiency maps, regeneration caps and auxiliary power), cell by cell as the
+        kernel does (``kernel.trace_cell_energies``): what a run planned under one efficiency model
+        costs under another (docs/efficiency.md).
+        """
+        x, v, f = (np.ascontiguousarray(a, dtype=float) for a in (run.position_m, run.speed_ms, run.force_n))
+        traction_j, regen_j = k.trace_cell_energies(self.model, x, v, f)
+        traction, regen = float(traction_j.sum()) / J_PER_KWH, float(regen_j.sum()) / J_PER_KWH
+        aux = self.model.aux_power_w * run.running_time_s / J_PER_KWH
+        return EnergyBreakdown(traction_kwh=traction, regen_kwh=regen, aux_kwh=aux, net_kwh=traction + aux - regen)
 
     def flat_out(self) -> Trajectory:
         """The fastest run: maximum traction, held at the limits, latest braking."""

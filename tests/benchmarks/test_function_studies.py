@@ -147,18 +147,20 @@ def test_abc_function_studies_give_equal_budgets_curves_and_report(tmp_path):
     settings, extra = [(3, 10)], [("sphere", 4, 12)]
     for (dim, iterations), study in af.build_studies(2, settings, extra).items():
         run_study(study, af.study_directory(tmp_path, dim, iterations), workers=1, progress=False)
-    table, curves = af.load_runs(tmp_path, 2, settings, extra)
+    table, results = af.load_runs(tmp_path, 2, settings, extra)
     assert len(table) == 3 * 4 * 2 + 2 * 2
     assert (table.n_eval >= 30 * 11).all() and set(table.seed) == {1000, 1001}
-    curve = curves[("rosenbrock", 3, 10, "ABC")][0]
+    runs = results[(3, 10)]
+    history = runs[(runs.problem == "rosenbrock") & (runs.algorithm == "ABC")].sort_values("seed").iloc[0].history
+    curve = np.column_stack([history["n_eval"], history["f0_min"]])
     assert curve[0, 0] == 30 and np.all(np.diff(curve[:, 1]) <= 0)  # best-so-far never worsens
     best = table[(table.function == "rosenbrock") & (table.dim == 3) & (table.algorithm == "ABC")].best
     assert curve[-1, 1] == best.iloc[0]
     out = tmp_path / "rep"
     out.mkdir()
-    af.report(out, table, curves)
+    af.report(out, table, results)
     assert len(pd.read_csv(out / "abc_functions.csv")) == len(table)
-    assert (out / "abc_functions_sphere.png").exists() and "## What reproduces" in (out / "abc_functions.md").read_text()
+    assert (out / "abc_functions_d3-it10.png").exists() and "## What reproduces" in (out / "abc_functions.md").read_text()
 
 
 @pytest.mark.parametrize("name", ["abc_functions", "moabc_zdt", "grnsga2_zdt"])

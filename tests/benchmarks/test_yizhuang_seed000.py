@@ -14,6 +14,7 @@ import pytest
 from pymoo.optimize import minimize
 
 from pymoo_rail.algorithms import ABC
+from pymoo_rail.optimal.baselines import strategy_baselines
 from pymoo_rail.problems import SpeedProfileProblem
 
 SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "yizhuang_seed000.py"
@@ -59,7 +60,7 @@ def test_reduced_yizhuang_study_reproduces_the_qualitative_results(tmp_path, yiz
     results = ys.load(tmp_path, seeds, TOLERANCE_S, (10,))
     ch = ys.choices(results, PLANNED_S, TOLERANCE_S)
     assert len(ch) == 2 * 2 * len(seeds)  # ABC, MOABC x non-equal, equal-10 x seeds
-    base = ys.baselines(yizhuang)
+    base = strategy_baselines(ys.make_problem(yizhuang))  # flat-out, constant cruise and coast point at 150 s
 
     # every run yields a feasible solution within the window of 150 s that stops at the platform
     assert ch["energy_kwh"].notna().all()

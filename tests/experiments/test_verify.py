@@ -38,3 +38,13 @@ def test_a_stored_energy_that_the_replay_does_not_give_fails(members):
     assert worst["energy_ok"] == "FAIL" and not worst["all_ok"] and worst["time_ok"] == "pass"
     with pytest.raises(ValueError, match="no member"):
         check_members(problem, X[:0], energy[:0], time_s[:0])
+
+
+def test_the_check_table_has_one_row_per_check_and_says_pass_or_fail(members):
+    from pymoo_rail.experiments.verify import CHECKS, check_rows
+
+    problem, X, energy, time_s = members
+    worst = worst_checks([{**check_members(problem, X, energy, time_s + 1.0), "n_points": len(X)}])
+    rows = check_rows(worst, lambda v: f"{v:.1f}")
+    assert len(rows) == len(CHECKS) + 1 and rows[-1][-1] == "pass"
+    assert rows[6] == ["stored vs re-simulated running time (s)", "1.0", "0", "FAIL"]

@@ -63,8 +63,15 @@ def _curve_form(key: str) -> bool:
     return len(parts) == 3 and parts[1] in ("traction", "braking") and parts[2] in ("segments", "table", "max_force_kn")
 
 
+def _map_part(key: str) -> bool:
+    """``train.traction_efficiency_map.gear`` and the like: keys of an optional table, checked with
+    a map in ``tests/model/test_efficiency_map.py``."""
+    parts = key.split(".")
+    return len(parts) == 3 and parts[1].endswith("_efficiency_map")
+
+
 @pytest.mark.parametrize("key, default", [(k, d) for k, d in documented().items()
-                                          if d != "required" and not _curve_form(k)])
+                                          if d != "required" and not _curve_form(k) and not _map_part(k)])
 def test_documented_defaults_are_the_loaders(key, default):
     data = copy.deepcopy(MINIMAL)
     if key.startswith("run.legs[]"):
@@ -82,6 +89,9 @@ def test_documented_required_keys_are_required(key):
     data["run"]["legs"] = [dict(LEG)]
     data["train"]["traction"] = {"segments": [{"v_max_kmh": 80.0, "poly": [200.0]}]}
     data["train"]["braking"] = {"segments": [{"v_max_kmh": 80.0, "poly": [200.0]}]}
+    for direction in ("traction", "regen"):
+        data["train"][f"{direction}_efficiency_map"] = {"speeds_kmh": [0.0, 80.0], "forces_kn": [0.0, 200.0],
+                                                       "values": [[0.8, 0.9], [0.85, 0.9]]}
     parts = key.split(".")
     table = data
     for part in parts[:-1]:

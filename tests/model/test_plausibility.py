@@ -210,6 +210,7 @@ def test_the_documented_bounds_are_the_loaders():
                                                                        bounds.RESISTANCE_PER_WEIGHT,
                                                                        *bounds.ACCEL_MS2],
         "power": [*bounds.POWER_KW_PER_T, bounds.AUX_POWER_KW_PER_T], "time": [bounds.MAX_TIME_S],
+        "efficiency": [*bounds.PEAK_EFFICIENCY, *bounds.MAP_COVERAGE],
     }
     for kind, values in expected.items():
         text = " ".join(rows[kind])
