@@ -97,6 +97,28 @@ def report_lines(study, frame, pictures, command: str) -> list[str]:
             to_markdown(table, bold_marker=None), *[f"![{name}]({name})" for name in pictures]]
 
 
+def projected_cpu_h(frame, full) -> tuple[float, str]:
+    """CPU hours of the ``full`` study from measured CPU per evaluation (linear in n_var between measured sizes).
+
+    Per family and algorithm, the CPU seconds per evaluation of the stored runs are averaged per
+    n_var and interpolated (held constant outside the measured range), then multiplied by the full
+    study's evaluations and seeds. Returns the hours and which sizes were measured.
+    """
+    import numpy as np
+
+    per_eval = (frame.assign(s=frame["cpu_time_s"] / frame["n_eval"])
+                .groupby(["family", "algorithm", "n_var"])["s"].mean())
+    total_s = 0.0
+    for p in full.problems:
+        for a in full.algorithms:
+            known = per_eval.get((p.params["family"], a.display))
+            if known is None:
+                raise SystemExit(f"--estimate: no stored run of {p.params['family']} / {a.display}")
+            total_s += np.interp(p.params["n_var"], known.index, known.to_numpy()) * full.budget.value
+    sizes = ", ".join(str(n) for n in sorted(frame["n_var"].unique()))
+    return total_s * len(full.seeds) / 3600, sizes
+
+
 def archive(work: Path, path: Path) -> str:
     """Pack the study file and every record of ``work`` into ``path`` (.tar.gz); return its SHA-256."""
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -118,6 +140,8 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "reports"), help="report directory")
     parser.add_argument("--report-only", action="store_true", help="write the report from stored records")
     parser.add_argument("--archive", type=Path, default=None, help="pack the raw records into this .tar.gz")
+    parser.add_argument("--estimate", action="store_true",
+                        help="print the whole study's CPU time projected from the stored runs' CPU per evaluation")
     args = parser.parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")
     study = build_study(args.families, args.ladder, args.seeds, args.n_eval)
@@ -131,6 +155,9 @@ def main(argv=None) -> int:
     command = "python benchmarks/suite_baseline.py " + " ".join(argv if argv is not None else sys.argv[1:])
     pictures = figures(records, frame, out)
     print(f"wrote {write_report(out / 'suite_baseline.md', report_lines(study, frame, pictures, command.strip()))}")
+    if args.estimate:
+        hours, sizes = projected_cpu_h(frame, read_study(STUDY_FILE))
+        print(f"the whole study (measured n_var {sizes}): {hours:.1f} CPU hours, {hours / 2:.1f} h on 2 cores")
     if args.archive:
         print(f"archive {args.archive}: sha256 {archive(Path(args.work), args.archive)}")
     return 0

@@ -50,3 +50,18 @@ def test_the_archive_holds_the_records_and_its_checksum_is_the_files(tmp_path):
     assert digest == hashlib.sha256(path.read_bytes()).hexdigest()
     with tarfile.open(path) as tar:
         assert sorted(tar.getnames()) == ["suite_baseline/runs/a.json", "suite_baseline/study.toml"]
+
+
+def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
+    import pandas as pd
+
+    script = _script()
+    full = script.build_study(["generated-metro-bi"], [10, 30, 100], 2, 1000)
+    names = [a.display for a in full.algorithms]
+    # 1 ms per evaluation at n_var 10, 3 ms at 100: 2 ms at 55 (not asked), 1.4444 ms at 30
+    frame = pd.DataFrame([{"family": "generated-metro-bi", "algorithm": name, "n_var": n, "n_eval": 100,
+                           "cpu_time_s": 0.1 if n == 10 else 0.3} for name in names for n in (10, 100)])
+    hours, sizes = script.projected_cpu_h(frame, full)
+    per_algorithm_s = (1e-3 + (1e-3 + 20 / 90 * 2e-3) + 3e-3) * 1000 * 2
+    assert hours == pytest.approx(len(names) * per_algorithm_s / 3600)
+    assert sizes == "10, 100"
