@@ -100,14 +100,14 @@ def report_lines(study, frame, pictures, command: str) -> list[str]:
 def projected_cpu_h(frame, full) -> tuple[float, str]:
     """CPU hours of the ``full`` study from measured CPU per evaluation (linear in n_var between measured sizes).
 
-    Per family and algorithm, the CPU seconds per evaluation of the stored runs are averaged per
+    Per family and algorithm, the median CPU seconds per evaluation of the stored runs, taken per
     n_var and interpolated (held constant outside the measured range), then multiplied by the full
     study's evaluations and seeds. Returns the hours and which sizes were measured.
     """
     import numpy as np
 
     per_eval = (frame.assign(s=frame["cpu_time_s"] / frame["n_eval"])
-                .groupby(["family", "algorithm", "n_var"])["s"].mean())
+                .groupby(["family", "algorithm", "n_var"])["s"].median())
     total_s = 0.0
     for p in full.problems:
         for a in full.algorithms:
