@@ -75,3 +75,14 @@ def test_too_little_data_says_what_is_missing(table, words):
 def test_bad_alpha_is_named():
     with pytest.raises(ValueError, match="alpha"):
         friedman_holm(_table({"a": 1.0, "b": 2.0}), alpha=1.5)
+
+
+@pytest.mark.parametrize("n_seeds, significant", [(5, False), (9, False), (10, True)])
+def test_seven_algorithms_need_ten_seeds_for_any_holm_mark(n_seeds, significant):
+    # exact two-sided signed-rank p of n same-sign differences is 2 / 2**n; Holm multiplies the
+    # smallest of the 21 pairs' p by 21: 21 * 2 / 2**9 = 0.082 > 0.05, 21 * 2 / 2**10 = 0.041 < 0.05
+    table = _table({name: float(i) for i, name in enumerate("abcdefg")}, n_seeds=n_seeds, noise=0.01)
+    result = friedman_holm(table)
+    assert list(result.mean_ranks.index) == list("abcdefg")
+    assert result.p_value < 1e-3  # Friedman sees the order at once
+    assert (result.mark("g") == "-") is significant
