@@ -90,8 +90,7 @@ def main() -> None:
     parser.add_argument("--min-cpu-s", type=float, default=0.5, help="CPU seconds per throughput measurement")
     parser.add_argument("--no-fronts", action="store_true", help="throughput only")
     args = parser.parse_args()
-    families = [f for f in list_families() if any(f == f"generated-{k}-{form}" for k in args.kinds
-                                                   for form in ("bi", "single"))]
+    families = [f for f in list_families() if any(f.startswith(f"generated-{k}-") for k in args.kinds)]
     table = throughput_table(families, args.n_vars, args.seed, args.min_cpu_s)
     print("\nEvaluations per CPU second (batches of 100):")
     print(table.pivot(index="n_var", columns="family", values="evals_per_cpu_s").to_string())

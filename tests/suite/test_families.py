@@ -141,3 +141,16 @@ def test_a_line_the_exact_solver_gives_up_on_has_no_front_and_says_so(monkeypatc
         problem.pareto_front()
     with pytest.raises(ref.NoExactFrontError, match="refine the grid"):
         problem.hv_reference_point()
+
+
+def test_a_study_file_names_an_instance_by_family_n_var_and_seed():
+    from pymoo_rail.experiments import problem as problem_spec
+    from pymoo_rail.experiments.registry import build_problem
+    from pymoo_rail.experiments.spec import StudyError
+
+    built = build_problem(problem_spec("rail_suite", suite_problem="generated-metro-bi", n_var=20, seed=3))
+    assert built.checksum == get_problem("generated-metro-bi", n_var=20, seed=3).checksum
+    with pytest.raises(StudyError, match="n_var = 1001"):
+        build_problem(problem_spec("rail_suite", suite_problem="generated-metro-bi", n_var=1001, seed=3))
+    with pytest.raises(StudyError, match="not a family"):
+        build_problem(problem_spec("rail_suite", suite_problem="metro-a-bi", seed=3))
