@@ -15,25 +15,12 @@ from __future__ import annotations
 
 import argparse
 import tempfile
-import time
-from dataclasses import replace
-from pathlib import Path
 
-import numpy as np
-
-from pymoo_rail.cases import load_case, write_case
+from pymoo_rail.cases import load_case
+from pymoo_rail.experiments.scaling import case_with_rows, load_and_grid_timing
 from pymoo_rail.model import build_grid
 
 ROWS = (16_000, 32_000, 64_000, 200_000, 600_000, 1_200_000)
-
-
-def case_with_rows(n_rows: int):
-    """Yizhuang with ``n_rows`` gradient rows of -30 to +30 permille."""
-    case = load_case("yizhuang")
-    edges = np.linspace(0.0, case.line.length_m, n_rows + 1)
-    permille = np.round(np.random.default_rng(n_rows).uniform(-30.0, 30.0, n_rows), 3)
-    rows = tuple(zip(edges[:-1].tolist(), edges[1:].tolist(), permille.tolist()))
-    return replace(case, name=f"yizhuang-{n_rows}-rows", line=replace(case.line, gradients=rows))
 
 
 def main() -> None:
@@ -45,17 +32,10 @@ def main() -> None:
     build_grid(load_case("yizhuang"))  # compiles (or loads) the grid's Numba helper before timing
     with tempfile.TemporaryDirectory() as folder:
         for n_rows in (n for n in ROWS if n <= args.max_rows):
-            path = write_case(case_with_rows(n_rows), Path(folder) / f"rows{n_rows}.toml")
-            start, start_cpu = time.perf_counter(), time.process_time()
-            case = load_case(path)
-            loaded, loaded_cpu = time.perf_counter(), time.process_time()
-            build_grid(case)
-            gridded, gridded_cpu = time.perf_counter(), time.process_time()
-            load_cpu, grid_cpu = loaded_cpu - start_cpu, gridded_cpu - loaded_cpu
-            print(f"{n_rows:>10} {path.stat().st_size / 1e6:>8.1f} {loaded - start:>8.2f} {load_cpu:>10.2f} "
-                  f"{gridded - loaded:>8.2f} {grid_cpu:>10.2f} {load_cpu / n_rows * 1e5:>16.3f} "
-                  f"{grid_cpu / n_rows * 1e5:>16.3f}", flush=True)
-            path.unlink()
+            r = load_and_grid_timing(case_with_rows(n_rows), folder)
+            print(f"{n_rows:>10} {r['file_mb']:>8.1f} {r['load_s']:>8.2f} {r['load_cpu_s']:>10.2f} {r['grid_s']:>8.2f} "
+                  f"{r['grid_cpu_s']:>10.2f} {r['load_cpu_s'] / n_rows * 1e5:>16.3f} "
+                  f"{r['grid_cpu_s'] / n_rows * 1e5:>16.3f}", flush=True)
 
 
 if __name__ == "__main__":

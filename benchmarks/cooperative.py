@@ -26,26 +26,14 @@ Usage: ``python benchmarks/cooperative.py [--seeds 15] [--phis 0.7,0.4,0] [--phi
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments import load_results, run_study
-from pymoo_rail.experiments.cooperative import (
-    best_clocked_runs,
-    exact_baselines,
-    offsets_study,
-    savings_table,
-    sharing_potential,
-)
+from pymoo_rail.experiments.cooperative import exact_baselines, nested_run, offsets_study, savings_table, sharing_rows
 from pymoo_rail.experiments.report import add_study_options, fill_template, lower_priority, write_report
-from pymoo_rail.problems import CooperativeTrainsProblem
-from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S
-from pymoo_rail.problems.cooperative_baseline import exact_baseline
-from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem, nested_minimize
 
 REPORTS = Path(__file__).parent / "reports"
 TEMPLATES = Path(__file__).resolve().parent / "templates"
@@ -71,23 +59,16 @@ def savings_lines(table: pd.DataFrame) -> list[str]:
     return lines
 
 
-def potential_lines(results: pd.DataFrame, paper_results, base) -> list[str]:
+def potential_lines(case, results: pd.DataFrame, paper_results, base) -> list[str]:
     """Regenerated energy per train and offset, from the traces of the exact runs and of the best GA runs."""
-    case = load_case("cooperative-pair")
     lines = ["| x (s) | runs | A regenerates (kWh, when on the clock) | of it while B moves | B regenerates | "
              "of it while A moves | shared |", "|---|---|---|---|---|---|---|"]
-    for x in SEED_001_OFFSETS_S:
-        candidates = [("exact, alone", base.clocked_pair(x)),
-                      ("best GA, speed codes", best_clocked_runs(results, x, lambda o: CooperativeTrainsProblem(case, o))),
-                      ("best GA, paper's encoding",
-                       best_clocked_runs(paper_results, x, lambda o: CooperativeSeedProblem(case, o)))]
-        for label, runs in [(label, runs) for label, runs in candidates if runs is not None]:
-            pot = sharing_potential(runs)
-            a, b = pot.iloc[0], pot.iloc[1]
-            lines.append(f"| {x:+g} | {label} | {a.regen_kwh:.2f} ({a.braking_from_s:.0f}-{a.braking_to_s:.0f} s) | "
-                         f"{a.while_others_move_kwh:.2f} | {b.regen_kwh:.2f} ({b.braking_from_s:.0f}-"
-                         f"{b.braking_to_s:.0f} s) | {b.while_others_move_kwh:.2f} | "
-                         f"{a.others_draw_kwh + b.others_draw_kwh:.2f} |")
+    for x, label, pot in sharing_rows(case, results, paper_results, base):
+        a, b = pot.iloc[0], pot.iloc[1]
+        lines.append(f"| {x:+g} | {label} | {a.regen_kwh:.2f} ({a.braking_from_s:.0f}-{a.braking_to_s:.0f} s) | "
+                     f"{a.while_others_move_kwh:.2f} | {b.regen_kwh:.2f} ({b.braking_from_s:.0f}-"
+                     f"{b.braking_to_s:.0f} s) | {b.while_others_move_kwh:.2f} | "
+                     f"{a.others_draw_kwh + b.others_draw_kwh:.2f} |")
     return lines
 
 
@@ -122,26 +103,19 @@ def report_text(results, paper_results, baselines) -> str:
                                for phi, b in baselines.items()),
         "cpu_s": f"{table['cpu_s'].sum():.0f}", "cpu_per_run_s": f"{table['cpu_s'].sum() / table['seeds'].sum():.1f}",
         "feasible": table["feasible"].sum(), "runs": table["seeds"].sum(),
-        "potential": "\n".join(potential_lines(results, paper_results, baselines[1.0])), "paper_section": paper_section})
+        "potential": "\n".join(potential_lines(load_case("cooperative-pair"), results, paper_results, baselines[1.0])), "paper_section": paper_section})
 
 
 def nested_text(args, case) -> str:
     """The nested GA of Chen et al. (2017), once, at ``--nested OUTER_POP OUTER_GEN`` (inner GA 100 x 80)."""
     outer_pop, outer_gen = args.nested
-    problem = CooperativeSeedProblem(case, args.offset)
-    X = problem.xl + np.random.default_rng(0).random((100, problem.n_var)) * (problem.xu - problem.xl)
-    problem.evaluate(X[:2])  # compile first
-    start = time.process_time()
-    for _ in range(3):
-        problem.evaluate(X)
-    per_eval_s = (time.process_time() - start) / (3 * X.shape[0])
+    run = nested_run(case, args.offset, outer_pop, outer_gen)
+    problem, x, f, sol, base, per_eval_s = (run[k] for k in ("problem", "x", "f_kwh", "solution", "baseline",
+                                                             "per_eval_s"))
     paper, asked = 24 * 20 * 100 * 80, outer_pop * outer_gen * 100 * 80  # pymoo's GA: pop_size per generation
-    base, start = exact_baseline(case), time.process_time()
-    x, f, _ = nested_minimize(problem, outer_pop_size=outer_pop, outer_n_gen=outer_gen, seed=1, verbose=True)
-    cpu_s, sol = time.process_time() - start, problem.decode(x)
     return fill_template(TEMPLATES / "cooperative_nested.md", {
         "outer_pop": outer_pop, "outer_gen": outer_gen, "offset": f"{args.offset:g}", "evaluations": f"{asked:,}",
-        "cpu_min": f"{cpu_s / 60:.1f}", "per_eval_ms": f"{1e3 * per_eval_s:.2f}", "paper_evaluations": f"{paper:,}",
+        "cpu_min": f"{run['cpu_s'] / 60:.1f}", "per_eval_ms": f"{1e3 * per_eval_s:.2f}", "paper_evaluations": f"{paper:,}",
         "paper_cpu_min": f"{paper * per_eval_s / 60:.0f}", "f_kwh": f"{f:.3f}", "a_kwh": f"{sol.traction_a_kwh:.3f}",
         "b_kwh": f"{sol.traction_b_kwh:.3f}", "shared_kwh": f"{sol.shared_kwh:.3f}", "feasible": sol.feasible,
         "constraints": ", ".join(f"{k} {v:.3g}" for k, v in sol.constraints.items()),

@@ -16,35 +16,11 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import os
-import subprocess
-import sys
-from dataclasses import dataclass
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
+from pymoo_rail.experiments.report import ScriptFigures as Figures
 
-
-@dataclass(frozen=True)
-class Figures:
-    """The figures of one script and what they are drawn from."""
-
-    script: str
-    figures: tuple[str, ...]
-    records: str | None = None  # folder under the repository the script's --report-only reads, None: no report mode
-    from_committed: tuple[str, ...] = ()  # figures drawn from committed files alone
-
-    def has_records(self) -> bool:
-        """Whether the script's study records (or per-run tables) are under ``records``."""
-        return self.records is not None and (ROOT / self.records).is_dir() and any(
-            p.is_file() for p in (ROOT / self.records).rglob("*"))
-
-    def ready(self) -> bool:
-        """Whether ``--report-only`` has its inputs (the records or, for some figures, the committed files)."""
-        if self.has_records():
-            return True
-        return bool(self.from_committed)
+ROOT = Path(__file__).resolve().parents[1]
 
 
 SUITE_CASES = ("metro-a", "ttobench-ref", "ttobench-ref-downhill", "ttobench-ref-limit120", "ttobench-ref-uphill",
@@ -70,19 +46,9 @@ FIGURES = (
     Figures("closed_loop_study", ("closed_loop_study.png",), "out/closed_loop_study"),
     Figures("journeys", ("journeys.png",)),
     Figures("optimal", ("optimal_front.png", "optimal_profile.png")),
+    Figures("efficiency_study", ("efficiency_study.png",)),  # written where --figure says
     Figures("tracking", ("tracking_metro_a.png", "tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png")),
 )
-
-
-def rebuild(entry: Figures) -> int:
-    """Run the script's report mode in a child process (this checkout's package first on the path)."""
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=os.pathsep.join(filter(None, (str(ROOT),
-                                                                                       os.environ.get("PYTHONPATH")))))
-    done = subprocess.run([sys.executable, str(HERE / f"{entry.script}.py"), "--report-only"], cwd=ROOT, env=env,
-                          capture_output=True, text=True)
-    if done.returncode:
-        print(f"  failed ({done.returncode}): {done.stderr.strip().splitlines()[-1] if done.stderr else ''}")
-    return done.returncode
 
 
 def main(argv=None) -> int:
@@ -91,16 +57,16 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     failed = 0
     for entry in FIGURES:
-        if not entry.ready():
+        if not entry.ready(ROOT):
             print(f"{entry.script}: needs a rerun (`python benchmarks/{entry.script}.py`): {', '.join(entry.figures)}")
             continue
-        records = entry.has_records()
+        records = entry.has_records(ROOT)
         names = entry.figures if records else entry.from_committed
         rest = [name for name in entry.figures if name not in names]
         print(f"{entry.script}: {'would rebuild' if args.list else 'rebuilding'} {', '.join(names)}"
               + (f"; needs a rerun (`python benchmarks/{entry.script}.py`): {', '.join(rest)}" if rest else ""))
         if not args.list:
-            failed += rebuild(entry) != 0
+            failed += entry.rebuild(ROOT) != 0
     return 1 if failed else 0
 
 

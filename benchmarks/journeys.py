@@ -32,14 +32,13 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from pymoo.algorithms.soo.nonconvex.de import DE
-from pymoo.optimize import minimize
 
 from pymoo_rail.cases.ttobench import BEIJING_SUBWAY_TRAIN, YIZHUANG_STOP_NAMES, YIZHUANG_TRACK
 from pymoo_rail.experiments.report import fill_template, markdown
-from pymoo_rail.journeys import (BudgetRepair, RunningTimeAllocationProblem, allocate_running_time, convex_front,
-                                 journey_from_ttobench, section_fronts, strategy_front, supplement_split)
-from pymoo_rail.journeys.compare import front_gaps, split_sweep, supplement_tables
+from pymoo_rail.journeys import (allocate_running_time, convex_front, journey_from_ttobench, strategy_front,
+                                 supplement_split)
+from pymoo_rail.journeys.compare import (de_allocation_runs, front_gaps, split_sweep, supplement_tables,
+                                         timed_section_fronts)
 from pymoo_rail.plotting import save_figure
 from pymoo_rail.plotting.journey import plot_split_costs
 
@@ -48,27 +47,6 @@ TRIP_TIME_S = 1800.0
 TEMPLATE = Path(__file__).resolve().parent / "templates" / "journeys.md"
 GAP_COLUMNS = ["section", "label", "range s", "31x31 mean %", "31x31 min %", "31x31 max %", "61x61 mean %",
                "combined mean %", "combined min %"]
-
-
-def timed_fronts(journey, source, cache, **kwargs):
-    """The fronts, the wall seconds they took, and how many sections were read from ``cache``."""
-    read = []
-    t0 = time.perf_counter()
-    fronts = section_fronts(journey, source, cache_path=cache, on_front=lambda k, computed: read.append(not computed),
-                            **kwargs)
-    return fronts, time.perf_counter() - t0, sum(read)
-
-
-def de_runs(exact, total: float, best_kwh: float, n_gen: int) -> pd.DataFrame:
-    """pymoo's DE with the budget repair on the allocation problem, seeds 1-3, against the exact optimum."""
-    rows = []
-    for seed in (1, 2, 3):
-        t0 = time.perf_counter()
-        res = minimize(RunningTimeAllocationProblem(exact, total), DE(pop_size=40, repair=BudgetRepair()),
-                       ("n_gen", n_gen), seed=seed)
-        rows.append({"seed": seed, "DE kWh": float(res.F[0]), "gap to exact %": 100 * (res.F[0] / best_kwh - 1),
-                     "evaluations": res.algorithm.evaluator.n_eval, "time s": time.perf_counter() - t0})
-    return pd.DataFrame(rows)
 
 
 def cache_notes(journey, timing: Path, exact_time: float, exact_cached: int, sim_cached: int):
@@ -93,12 +71,12 @@ def main(argv=None) -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     journey = journey_from_ttobench(YIZHUANG_TRACK, BEIJING_SUBWAY_TRAIN, stop_names=YIZHUANG_STOP_NAMES)
     strategy_front(journey.sections[0], n_speeds=3, n_coast=3)  # JIT warm-up outside the timings
-    exact, exact_time, exact_cached = timed_fronts(journey, "optimal", args.out / "journeys_fronts_optimal.csv",
+    exact, exact_time, exact_cached = timed_section_fronts(journey, "optimal", args.out / "journeys_fronts_optimal.csv",
                                                    n_times=args.n_times)
     timing = args.out / "journeys_fronts_optimal.time.json"
     if exact_cached == 0:  # all computed in this run: keep the time for re-runs that read the CSV
         timing.write_text(json.dumps({"seconds": exact_time, "n_times": args.n_times}) + "\n")
-    sim, sim_time, sim_cached = timed_fronts(journey, "simulated", args.out / "journeys_fronts_simulated.csv")
+    sim, sim_time, sim_cached = timed_section_fronts(journey, "simulated", args.out / "journeys_fronts_simulated.csv")
     t0 = time.perf_counter()
     fine = [strategy_front(c, n_speeds=61, n_coast=61) for c in journey.sections]
     fine_time = time.perf_counter() - t0
@@ -111,7 +89,7 @@ def main(argv=None) -> None:
     total = journey.running_time_s(TRIP_TIME_S)
     best = allocate_running_time(journey, total, fronts=exact)
     equal = supplement_split(journey, total, fronts=exact)
-    de = de_runs(exact, total, best.energy_kwh, args.de_gens)
+    de = de_allocation_runs(exact, total, best.energy_kwh, args.de_gens)
     save_figure(plot_split_costs(split_sweep(journey, exact), best, equal, "Yizhuang line, 13 sections (exact fronts)"),
                 args.out / "journeys.png", dpi=110)
     per_section = best.table[["section", "label", "length_m", "min_time_s", "running_time_s", "supplement_s",

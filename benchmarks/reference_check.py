@@ -18,9 +18,8 @@ and with twice the speed nodes; a *miss* is another solve lower by more than the
 (wuguang-crh3 at 1050.53 s, Yizhuang section 1-2 at 119.43 s) beside finer grids and the run
 without the tie rule. Writes ``certificate.md``.
 
-``--check grid-steps``: CPU time of the exact optimum against line length with the default grid
-step (first stretches of the TTOBench 48.5 km reference track, VIRM6, 1.15 x the minimum time);
-prints a table.
+The CPU time of the exact optimum against line length (``--check grid-steps``, whose conclusion
+docs/ttobench.md gives) is in the script's last version with it: ``git show be39f07:benchmarks/reference_check.py``.
 
 Usage::
 
@@ -28,14 +27,13 @@ Usage::
     python benchmarks/reference_check.py --report-only                   # report from reference_check.csv
     nice -n 10 python benchmarks/reference_check.py --check coverage     # about 4 CPU minutes
     python benchmarks/reference_check.py --check parts                   # about a minute
-    python benchmarks/reference_check.py --check grid-steps
 """
 
 from __future__ import annotations
 
 import argparse
 import time
-import warnings
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -43,36 +41,19 @@ import pandas as pd
 from tqdm import tqdm
 
 from pymoo_rail.cases import load_case
-from pymoo_rail.cases.ttobench import TTOBenchWarning, case_between, read_track, read_train
 from pymoo_rail.experiments.reference_audit import (DERIVED, certificate_parts, check_members, coverage_summary,
                                                      coverage_table, members_summary, with_derived_columns)
-from pymoo_rail.experiments.report import (committed_members, fill_template, lower_priority, markdown, member_cases,
-                                          write_report)
-from pymoo_rail.model.grid import default_dx_m
-from pymoo_rail.optimal import min_running_time, optimal_profile
+from pymoo_rail.experiments.report import committed_members, lower_priority, markdown, member_cases, write_filled
 
 REPORTS = Path(__file__).resolve().parent / "reports"
 TEMPLATES = Path(__file__).resolve().parent / "templates"
-TTOBENCH = Path(__file__).resolve().parents[1] / "tests" / "data" / "ttobench"
+PROGRESS = partial(tqdm, desc="cases", unit="case")
 PARTS_VARIANTS = ({"n_speeds": 100}, {"n_speeds": 400}, {"n_speeds": 800}, {"tie_j": 0.0})
-
-
-def progress(items):
-    """A progress bar over the cases."""
-    return tqdm(items, desc="cases", unit="case")
-
-
-def chosen_members(limit: int | None):
-    """The committed members, or the first ``limit`` of each case (a quick run)."""
-    table = committed_members(REPORTS)
-    return table if limit is None else table.groupby("case", sort=False).head(limit)
 
 
 def show(path: Path, values: dict) -> None:
     """Fill the report's template (``benchmarks/templates/<name>``), write it and print it."""
-    text = fill_template(TEMPLATES / path.name, values)
-    write_report(path, [text], newline=False)
-    print(text)
+    print(write_filled(path, TEMPLATES / path.name, values))
 
 
 def members(args) -> int:
@@ -83,7 +64,7 @@ def members(args) -> int:
             raise SystemExit(f"--report-only: no {csv_path}; run without --report-only first")
         table = with_derived_columns(pd.read_csv(csv_path))
     else:
-        table = check_members(chosen_members(args.limit), member_cases(), progress=progress)
+        table = check_members(committed_members(REPORTS, args.limit), member_cases(), progress=PROGRESS)
         # 9 digits (1 mWh on 1000 kWh), far below any gap quoted; the derived columns are rebuilt on reading
         table.drop(columns=list(DERIVED)).to_csv(csv_path, index=False, float_format="%.9g")
     s = members_summary(table)
@@ -96,7 +77,7 @@ def members(args) -> int:
 def coverage(args) -> int:
     """The certificate against other grids at every member time; the number of misses."""
     start = time.process_time()
-    result = coverage_table(chosen_members(args.limit), member_cases(), progress=progress)
+    result = coverage_table(committed_members(REPORTS, args.limit), member_cases(), progress=PROGRESS)
     cpu = time.process_time() - start
     s, sentences = coverage_summary(result)
     misses = int(s["misses"].sum())
@@ -119,37 +100,16 @@ def parts(args) -> int:
     return 0
 
 
-def grid_steps(args) -> int:
-    """Print the CPU time of the exact optimum against line length (the default step grows with length)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", TTOBenchWarning)
-        track = read_track(TTOBENCH / "tracks" / "00_reference.json")
-        train = read_train(TTOBENCH / "trains" / "NL_Intercity_VIRM6.json")
-    warm = case_between(track, train, 0.0, 3000.0, 1.0)
-    optimal_profile(warm, 1.15 * min_running_time(warm))  # compile outside the timings
-    rows = []
-    for km in (5, 8, 10, 12, 15, 20, 30, 40, 48.531):
-        case = case_between(track, train, 0.0, km * 1000.0, 1.0)
-        start = time.process_time()
-        optimal_profile(case, 1.15 * min_running_time(case))
-        rows.append({"km": km, "dx m": default_dx_m(case), "cells": case.line.length_m / default_dx_m(case),
-                     "CPU s": time.process_time() - start})
-    table = pd.DataFrame(rows)
-    table["/ 10 km"] = table["CPU s"] / table.loc[table["km"] == 10, "CPU s"].iloc[0]
-    print(markdown(table, 2))
-    return 0
-
-
 def main(argv=None) -> int:
     """Run one check; exit status 1 when a member lies below the reference or the certificate misses."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--check", choices=("members", "coverage", "parts", "grid-steps"), default="members")
+    parser.add_argument("--check", choices=("members", "coverage", "parts"), default="members")
     parser.add_argument("--out", type=Path, default=REPORTS, help="report folder")
     parser.add_argument("--report-only", action="store_true", help="members: report from the stored CSV")
     parser.add_argument("--limit", type=int, default=None, help="only the first N members of each case (a quick run)")
     args = parser.parse_args(argv)
     lower_priority()
-    check = {"members": members, "coverage": coverage, "parts": parts, "grid-steps": grid_steps}[args.check]
+    check = {"members": members, "coverage": coverage, "parts": parts}[args.check]
     return 1 if check(args) else 0
 
 

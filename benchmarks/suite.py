@@ -28,11 +28,12 @@ from dataclasses import replace
 from pathlib import Path
 
 from pymoo_rail.experiments import load_results, read_study, run_study
-from pymoo_rail.experiments.report import write_report
+from pymoo_rail.experiments.report import add_study_options, fill_template, write_report
 from pymoo_rail.experiments.suite_report import complete_seeds, scores, suite_report
 
 ROOT = Path(__file__).resolve().parent.parent
 STUDY_FILE = ROOT / "examples" / "suite.toml"
+TEMPLATES = Path(__file__).resolve().parent / "templates"
 QUICK_PROBLEMS = ("metro-a-bi", "ttobench-wanyuan-rongjing-bi", "yizhuang-bi")
 QUICK_SEEDS = 3
 
@@ -52,16 +53,10 @@ def build_study(quick: bool, seeds: int | None, problems):
 
 def study_note(study, coverage: str, cpu_min: float, seeds: list[int], n_runs: int) -> str:
     """The report's paragraph on the study's size, its budget and which runs it uses."""
-    return (f"Study: {len(study.problems)} problems x {len(study.algorithms)} algorithms x {len(study.seeds)} seeds, "
-            f"{study.budget.kind} = {study.budget.value:,} per run for every problem and algorithm (NSGA-II: "
-            f"population 100, {study.budget.value // 100} generations). The budget was set from "
-            "`pymoo_rail.experiments.suite_report.cost_table` (CPU seconds per run at 1,000 and 4,000 evaluations, per problem and "
-            "algorithm, projected to the whole study): 0.04-0.27 ms of CPU per evaluation, the 48.5 km lines and "
-            "AGE-MOEA the dearest, about 35 CPU minutes for the study at 10,000 evaluations and 70 at 20,000, "
-            "against about 80 CPU minutes available. "
-            f"{coverage} The stored runs took {cpu_min:.1f} CPU minutes (sum of the records' CPU times); the wall "
-            "time, not the CPU, limited the study: the 2-core machine was shared with five other jobs. "
-            f"Every table below uses the {len(seeds)} complete seeds ({n_runs} runs).")
+    return fill_template(TEMPLATES / "suite_note.md", {
+        "problems": len(study.problems), "algorithms": len(study.algorithms), "seeds": len(study.seeds),
+        "budget_kind": study.budget.kind, "budget": f"{study.budget.value:,}", "generations": study.budget.value // 100,
+        "coverage": coverage, "cpu_min": f"{cpu_min:.1f}", "complete": len(seeds), "runs": n_runs}).rstrip("\n")
 
 
 def main(argv=None) -> int:
@@ -70,9 +65,7 @@ def main(argv=None) -> int:
     parser.add_argument("--seeds", type=int, default=None, help="seeds 1..N (default: the study file's 30)")
     parser.add_argument("--problems", nargs="+", default=None, help="problem labels of the study file")
     parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument("--work", default=str(ROOT / "out" / "suite"), help="study directory (records)")
-    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "reports"), help="report directory")
-    parser.add_argument("--report-only", action="store_true", help="write the report from stored records")
+    add_study_options(parser, ROOT / "out" / "suite", ROOT / "benchmarks" / "reports")
     args = parser.parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")
     study = build_study(args.quick, args.seeds, args.problems)

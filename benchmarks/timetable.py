@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from pymoo_rail.cases import load_case
-from pymoo_rail.experiments import load_results, run_study
-from pymoo_rail.experiments.report import add_study_options, fill_template, lower_priority, require_runs, write_report
+from pymoo_rail.experiments.report import add_study_options, lower_priority, write_filled
+from pymoo_rail.experiments.script import study_results
 from pymoo_rail.experiments.study_file import read_study
 from pymoo_rail.problems import TimetableProblem
 
@@ -48,23 +48,15 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     lower_priority()
     study = read_study(ROOT.parent / "examples" / "timetable.toml")
-    if not args.report_only:
-        run_study(study, args.work, workers=args.workers, seed_major=True)
-    results = load_results(args.work, study)
-    try:
-        require_runs(results, study, args.work)
-    except FileNotFoundError as error:
-        raise SystemExit(str(error)) from None
+    results = study_results(study, args, seed_major=True)
     # each train exactly optimal alone on the study's grid, in its own direction (the other way climbs
     # where this one descends)
     dx_m = float(results["problem_spec"].iloc[0].get("dx_m", 1.0))
     per_train = TimetableProblem(load_case("cooperative-pair"), 2, 120.0, dx_m=dx_m,
                                  directions=2).references_per_train_kwh()
-    text = fill_template(ROOT / "templates" / "timetable.md", {
+    print(write_filled(args.out / "timetable.md", ROOT / "templates" / "timetable.md", {
         "reference_kwh": f"{per_train[0]:.3f}", "reference_back_kwh": f"{per_train[1]:.3f}",
-        "rows": "\n".join(report_rows(results, per_train)), "cpu_s": f"{results['cpu_time_s'].sum():.0f}"})
-    write_report(args.out / "timetable.md", [text], newline=False)
-    print(text)
+        "rows": "\n".join(report_rows(results, per_train)), "cpu_s": f"{results['cpu_time_s'].sum():.0f}"}))
 
 
 if __name__ == "__main__":

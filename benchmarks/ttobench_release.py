@@ -13,22 +13,14 @@ from __future__ import annotations
 
 import argparse
 import time
-import warnings
 from pathlib import Path
 
-import numpy as np
-from pymoo.algorithms.moo.nsga2 import NSGA2
-from pymoo.optimize import minimize
-
-from pymoo_rail.cases.ttobench import TTOBenchWarning, from_ttobench
 from pymoo_rail.cases.ttobench_release import release_pairs
-from pymoo_rail.optimal import min_running_time, optimal_profile
-from pymoo_rail.problems import SpeedProfileProblem
+from pymoo_rail.experiments.release_check import release_case, release_row
 
-TIME_TOL_S = 2.0  # NSGA2 members this close to the planned time count as punctual
-LIMIT_TOL_MS = 1e-6  # the problem's own limit tolerance
-STOP_TOL_M = 0.25  # the problem's default stop tolerance
 DEFAULT_ROOT = Path(__file__).resolve().parents[1] / "tests" / "data" / "ttobench"
+HEADER = ["| track | train | km | T_min s | optimum kWh @1.15 | limits, stop | CPU s | NSGA2 kWh | gap % "
+          "| front size | n_var | CPU s |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
 
 
 def main() -> None:
@@ -41,38 +33,18 @@ def main() -> None:
     parser.add_argument("--pop-size", type=int, default=40)
     parser.add_argument("--report", type=Path, default=None, help="also write the table to this markdown file")
     args = parser.parse_args()
-    lines = ["| track | train | km | T_min s | optimum kWh @1.15 | limits, stop | CPU s | NSGA2 kWh | gap % "
-             "| front size | n_var | CPU s |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = list(HEADER)
     print("\n".join(lines), flush=True)
     cpu0 = time.process_time()
+    settings = {} if args.max_section_m is None else {"max_section_m": args.max_section_m}
     for track, train in release_pairs(args.root):
         if args.only and track.stem not in args.only:
             continue
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", TTOBenchWarning)
-            case = from_ttobench(track, train, 0, -1, 1.0)
-        t0 = time.process_time()
-        t_min = min_running_time(case)
-        case = case.with_planned_time(1.15 * t_min)
-        best = optimal_profile(case, case.planned_time_s)
-        s = best.summary
-        held = (s["limit_excess_ms"] <= LIMIT_TOL_MS and s["stop_error_m"] <= STOP_TOL_M
-                and s["final_speed_ms"] == 0.0 and bool(s["reached"]))
-        t1 = time.process_time()
-        settings = {} if args.max_section_m is None else {"max_section_m": args.max_section_m}
-        problem = SpeedProfileProblem(case, objectives=("energy", "time_error"), **settings)
-        res = minimize(problem, NSGA2(pop_size=args.pop_size), ("n_gen", args.nsga2_gen), seed=1)
-        t2 = time.process_time()
-        F = np.atleast_2d(res.F) if res.F is not None else np.empty((0, 2))
-        close = F[F[:, 1] <= TIME_TOL_S]
-        nsga = float(close[:, 0].min()) if close.size else float("nan")
-        gap = 100.0 * (nsga / best.energy.net_kwh - 1.0)
-        row = (f"| {track.stem} | {train.stem} | {case.line.length_m / 1000:.1f} | {t_min:.1f} | "
-               f"{best.energy.net_kwh:.2f} | {'held' if held else 'VIOLATED'} | {t1 - t0:.1f} | {nsga:.2f} | "
-               f"{gap:.1f} | {F.shape[0]} | {problem.n_var} | {t2 - t1:.1f} |")
-        print(row, flush=True)
-        lines.append(row)
+        r = release_row(release_case(track, train), args.nsga2_gen, args.pop_size, settings)
+        lines.append(f"| {track.stem} | {train.stem} | {r['km']:.1f} | {r['t_min_s']:.1f} | {r['optimum_kwh']:.2f} | "
+                     f"{'held' if r['held'] else 'VIOLATED'} | {r['optimum_cpu_s']:.1f} | {r['nsga2_kwh']:.2f} | "
+                     f"{r['gap_pct']:.1f} | {r['front_size']} | {r['n_var']} | {r['nsga2_cpu_s']:.1f} |")
+        print(lines[-1], flush=True)
     total = f"Total CPU: {time.process_time() - cpu0:.0f} s (NSGA2 pop {args.pop_size}, {args.nsga2_gen} generations, seed 1)."
     print(total)
     if args.report is not None:

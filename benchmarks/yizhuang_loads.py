@@ -21,7 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from pymoo_rail.experiments.report import add_study_options, fill_template, lower_priority, require_runs, write_report
+from pymoo_rail.experiments.report import add_study_options, fill_template, lower_priority, write_report
+from pymoo_rail.experiments.script import study_results
+from pymoo_rail.experiments.study_file import read_study
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -69,18 +71,10 @@ def main(argv=None) -> None:
     add_study_options(parser, ROOT / "out" / "yizhuang_loads", REPORTS)
     args = parser.parse_args(argv)
     lower_priority()
-    from pymoo_rail.experiments import load_results, read_study, run_study
-
     study = read_study(STUDY)
     if args.seeds is not None:
         study = replace(study, seeds=tuple(range(1, args.seeds + 1)))
-    if not args.report_only:
-        print(run_study(study, args.work, workers=args.workers, seed_major=True), flush=True)
-    results = load_results(args.work, study=study)
-    try:
-        require_runs(results, study, args.work)  # a missing record is an error, not an empty report
-    except FileNotFoundError as error:
-        raise SystemExit(str(error)) from None
+    results = study_results(study, args, echo=True, seed_major=True)  # a missing record: an error, not an empty report
     args.out.mkdir(parents=True, exist_ok=True)
     write_loads_report(args.out, results, study)
     print(f"wrote {args.out / 'yizhuang_loads.md'}")

@@ -24,7 +24,7 @@ TRACKING_METRICS = ("energy_kwh", "running_time_s", "stop_error_m", "jerk_ms2", 
 def tracking_metrics(tracked: Trajectory) -> dict:
     """The :data:`TRACKING_METRICS` of a tracked run (:func:`pymoo_rail.control.track`).
 
-    Energy is net kWh at the wheel; ``jerk_ms2`` the sum of |a_i - a_(i-1)|; speed errors are speed
+    Energy is net kWh at the wheel; ``jerk_ms2`` the sum of ``|a_i - a_(i-1)|``; speed errors are speed
     minus reference at the same position, over the whole run and over the part the controller drives.
     """
     s = tracked.summary

@@ -10,6 +10,7 @@ all, from the kernel's traces. ``benchmarks/cooperative.py`` is a thin script ov
 
 from __future__ import annotations
 
+import time
 from typing import Sequence
 
 import numpy as np
@@ -19,7 +20,9 @@ from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.experiments.spec import Study, algorithm, problem
 from pymoo_rail.experiments.stats import signed_rank_vs
 from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S, scale_gradients
+from pymoo_rail.problems.cooperative import CooperativeTrainsProblem
 from pymoo_rail.problems.cooperative_baseline import ExactBaseline, exact_baseline
+from pymoo_rail.problems.cooperative_seed import CooperativeSeedProblem, nested_minimize
 from pymoo_rail.sim import cooperation as coop
 
 
@@ -124,3 +127,45 @@ def best_clocked_runs(results: pd.DataFrame | None, offset_s: float, problem) ->
     best = sel.iloc[int(np.argmin([float(np.min(F[:, 0])) for F in sel["F"]]))]
     x_best = np.asarray(best["X"])[int(np.argmin(best["F"][:, 0]))]
     return problem(offset_s).simulate(x_best[None, :])["clocked"][0]
+
+
+def sharing_rows(case, results: pd.DataFrame, paper_results: pd.DataFrame | None, base: ExactBaseline,
+                 offsets_s: Sequence[float] = SEED_001_OFFSETS_S) -> list[tuple]:
+    """What there is to share at each offset: the exact runs alone, the best GA runs on speed codes and
+    on the paper's encoding (when ``paper_results`` is given).
+
+    Returns
+    -------
+    list of (float, str, pandas.DataFrame)
+        ``(offset s, label, sharing_potential of its two runs)``; runs missing from a study are left out.
+    """
+    rows = []
+    for x in offsets_s:
+        candidates = [("exact, alone", base.clocked_pair(x)),
+                      ("best GA, speed codes", best_clocked_runs(results, x, lambda o: CooperativeTrainsProblem(case, o))),
+                      ("best GA, paper's encoding",
+                       best_clocked_runs(paper_results, x, lambda o: CooperativeSeedProblem(case, o)))]
+        rows += [(x, label, sharing_potential(runs)) for label, runs in candidates if runs is not None]
+    return rows
+
+
+def nested_run(case, offset_s: float, outer_pop: int, outer_gen: int, seed: int = 1, verbose: bool = True) -> dict:
+    """The nested GA of Chen et al. (2017) once (inner GA 100 x 80), after timing one evaluation.
+
+    Returns
+    -------
+    dict
+        ``problem``, ``per_eval_s`` (CPU s per evaluation of the paper's encoding), ``x``, ``f_kwh``,
+        ``solution`` (``problem.decode(x)``), ``cpu_s`` of the nested run and the exact ``baseline``.
+    """
+    problem = CooperativeSeedProblem(case, offset_s)
+    X = problem.xl + np.random.default_rng(0).random((100, problem.n_var)) * (problem.xu - problem.xl)
+    problem.evaluate(X[:2])  # compile first
+    start = time.process_time()
+    for _ in range(3):
+        problem.evaluate(X)
+    per_eval_s = (time.process_time() - start) / (3 * X.shape[0])
+    base, start = exact_baseline(case), time.process_time()
+    x, f, _ = nested_minimize(problem, outer_pop_size=outer_pop, outer_n_gen=outer_gen, seed=seed, verbose=verbose)
+    return {"problem": problem, "per_eval_s": per_eval_s, "x": x, "f_kwh": f, "solution": problem.decode(x),
+            "cpu_s": time.process_time() - start, "baseline": base}

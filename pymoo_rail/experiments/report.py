@@ -15,6 +15,9 @@ import math
 import numbers
 import os
 import string
+import subprocess
+import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable, Mapping, Sequence
 
@@ -279,6 +282,13 @@ def fill_template(template: str | Path, values: Mapping[str, object]) -> str:
 
 
 # ------------------------------------------------------------------------------------ files
+def write_filled(path: str | Path, template: str | Path, values: Mapping[str, object]) -> str:
+    """Write the report ``path`` from its template (:func:`fill_template`), atomically; returns its text."""
+    text = fill_template(template, values)
+    atomic_write_text(path, text)
+    return text
+
+
 def write_report(path: str | Path, lines: Sequence[str], newline: bool = True) -> Path:
     """Write a report's lines (joined by newlines, one more at the end unless ``newline=False``), atomically.
 
@@ -291,8 +301,10 @@ def write_report(path: str | Path, lines: Sequence[str], newline: bool = True) -
 
 
 # ------------------------------------------------------------------------------------ committed members
-def committed_members(reports_dir: str | Path):
+def committed_members(reports_dir: str | Path, limit: int | None = None):
     """Every optimiser member the committed study CSVs in ``reports_dir`` hold (``benchmarks/reports``).
+
+    With ``limit``, only the first ``limit`` members of each case (a quick check).
 
     Returns
     -------
@@ -317,7 +329,8 @@ def committed_members(reports_dir: str | Path):
     for r in j.itertuples():
         rows.append(("journeys", f"section {int(r.section)}", r.case, int(r.section), "strategy",
                      r.running_time_s, r.energy_kwh))
-    return pd.DataFrame(rows, columns=["source", "case", "label", "seed", "member", "running_time_s", "energy_kwh"])
+    table = pd.DataFrame(rows, columns=["source", "case", "label", "seed", "member", "running_time_s", "energy_kwh"])
+    return table if limit is None else table.groupby("case", sort=False).head(limit)
 
 
 def member_cases() -> dict:
@@ -330,3 +343,47 @@ def member_cases() -> dict:
     cases = {"yizhuang": load_case("yizhuang"), "wuguang-crh3": load_case("wuguang-crh3")}
     cases.update({f"section {k}": c for k, c in enumerate(journey.sections)})
     return cases
+
+
+# ------------------------------------------------------------------------------------ figures
+@dataclass(frozen=True)
+class ScriptFigures:
+    """The figures a benchmark script draws and what its ``--report-only`` draws them from.
+
+    Parameters
+    ----------
+    script : str
+        The script's name in ``benchmarks/`` without ``.py``.
+    figures : tuple of str
+        The PNG files it writes next to its report.
+    records : str, optional
+        The folder (relative to the repository) whose study records ``--report-only`` reads; None:
+        the script has no report mode.
+    from_committed : tuple of str
+        The figures ``--report-only`` draws from committed files alone.
+    """
+
+    script: str
+    figures: tuple[str, ...]
+    records: str | None = None
+    from_committed: tuple[str, ...] = ()
+
+    def has_records(self, root: str | Path) -> bool:
+        """Whether the script's study records (or per-run tables) are under ``root / records``."""
+        folder = Path(root) / self.records if self.records is not None else None
+        return folder is not None and folder.is_dir() and any(p.is_file() for p in folder.rglob("*"))
+
+    def ready(self, root: str | Path) -> bool:
+        """Whether ``--report-only`` has its inputs (the records or, for some figures, the committed files)."""
+        return self.has_records(root) or bool(self.from_committed)
+
+    def rebuild(self, root: str | Path) -> int:
+        """Run ``benchmarks/<script>.py --report-only`` in a child (``root``'s package first); its exit status."""
+        root = Path(root)
+        env = dict(os.environ, MPLBACKEND="Agg",
+                   PYTHONPATH=os.pathsep.join(filter(None, (str(root), os.environ.get("PYTHONPATH")))))
+        done = subprocess.run([sys.executable, str(root / "benchmarks" / f"{self.script}.py"), "--report-only"],
+                              cwd=root, env=env, capture_output=True, text=True)
+        if done.returncode:
+            print(f"  failed ({done.returncode}): {done.stderr.strip().splitlines()[-1] if done.stderr else ''}")
+        return done.returncode

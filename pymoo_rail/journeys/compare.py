@@ -9,13 +9,15 @@ the same against the trip time. ``benchmarks/journeys.py`` writes them as a repo
 
 from __future__ import annotations
 
+import time
 from typing import Sequence
 
 import numpy as np
 import pandas as pd
 
-from pymoo_rail.journeys.allocation import allocate_running_time, supplement_split
+from pymoo_rail.journeys.allocation import allocate_running_time, section_fronts, supplement_split
 from pymoo_rail.journeys.fronts import front_energy
+from pymoo_rail.journeys.problem import BudgetRepair, RunningTimeAllocationProblem
 from pymoo_rail.model import CaseError
 
 
@@ -152,3 +154,38 @@ def split_sweep(journey, fronts, n_points: int = 60) -> pd.DataFrame:
         "optimal_kwh": [allocate_running_time(journey, t, fronts=fronts).energy_kwh for t in sweep_t],
         "equal_kwh": [rule_energy(journey, t, fronts, "equal") for t in sweep_t],
         "proportional_kwh": [rule_energy(journey, t, fronts, "proportional") for t in sweep_t]})
+
+
+def timed_section_fronts(journey, source: str, cache_path, **kwargs) -> tuple:
+    """:func:`~pymoo_rail.journeys.section_fronts` with its wall-clock seconds and how many sections came from the cache.
+
+    Returns
+    -------
+    (list of pandas.DataFrame, float, int)
+    """
+    read = []
+    t0 = time.perf_counter()
+    fronts = section_fronts(journey, source, cache_path=cache_path,
+                            on_front=lambda k, computed: read.append(not computed), **kwargs)
+    return fronts, time.perf_counter() - t0, sum(read)
+
+
+def de_allocation_runs(fronts, total_s: float, best_kwh: float, n_gen: int, seeds=(1, 2, 3)) -> pd.DataFrame:
+    """pymoo's DE (pop 40) with the budget repair on the allocation problem, per seed, against ``best_kwh``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``seed``, ``DE kWh``, ``gap to exact %``, ``evaluations``, ``time s`` (wall clock).
+    """
+    from pymoo.algorithms.soo.nonconvex.de import DE
+    from pymoo.optimize import minimize
+
+    rows = []
+    for seed in seeds:
+        t0 = time.perf_counter()
+        res = minimize(RunningTimeAllocationProblem(fronts, total_s), DE(pop_size=40, repair=BudgetRepair()),
+                       ("n_gen", n_gen), seed=seed)
+        rows.append({"seed": seed, "DE kWh": float(res.F[0]), "gap to exact %": 100 * (res.F[0] / best_kwh - 1),
+                     "evaluations": res.algorithm.evaluator.n_eval, "time s": time.perf_counter() - t0})
+    return pd.DataFrame(rows)

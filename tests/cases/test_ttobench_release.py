@@ -236,7 +236,8 @@ def test_a_coasting_point_makes_the_train_coast_from_there():
 @pytest.mark.parametrize("track, seed", [("00_var_speed_limit_110", 3), ("00_var_speed_limit_wind", 3)])
 def test_punctual_nsga2_on_a_long_sparse_line_comes_within_two_percent_of_the_optimum(track, seed):
     # with codes from 10 km/h these runs ended 11.6 % (seed 3 coasted through the 10 km of the
-    # 110 km/h zone) and 4.6 % above; benchmarks/encodings.py --job sparse measures every track and seed
+    # 110 km/h zone) and 4.6 % above; --job sparse of `git show 0e95633:benchmarks/encodings.py`
+    # measured every track and seed
     case = quietly(from_ttobench, RELEASE / "tracks" / f"{track}.json", RELEASE / "trains" / "NL_Intercity_VIRM6.json",
                    0, -1, 1.0)
     case = case.with_planned_time(1.15 * min_running_time(case))

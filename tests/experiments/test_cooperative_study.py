@@ -67,3 +67,16 @@ def test_best_clocked_runs_resimulates_the_least_energy_member_of_the_offset():
     assert best_clocked_runs(results, 45.0, Problem) == ("runs of", 12.0)  # run 2, its first member
     assert simulated == [(45.0, [[12.0]])]
     assert best_clocked_runs(results, 90.0, Problem) is None and best_clocked_runs(None, 45.0, Problem) is None
+
+
+def test_without_stored_studies_only_the_exact_runs_show_what_there_is_to_share():
+    from pymoo_rail.cases import load_case
+    from pymoo_rail.experiments.cooperative import sharing_rows
+    from pymoo_rail.problems.cooperative import SEED_001_OFFSETS_S
+    from pymoo_rail.problems.cooperative_baseline import exact_baseline
+
+    case = load_case("cooperative-pair")
+    rows = sharing_rows(case, None, None, exact_baseline(case))
+    assert [(x, label) for x, label, _ in rows] == [(x, "exact, alone") for x in SEED_001_OFFSETS_S]
+    for _, _, potential in rows:
+        assert len(potential) == 2 and (potential["regen_kwh"] >= potential["while_others_move_kwh"] - 1e-12).all()

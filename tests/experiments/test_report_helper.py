@@ -64,3 +64,45 @@ def test_require_runs_names_the_missing_record(tmp_path):
         require_runs(pd.DataFrame({"run_id": [first.run_id]}), study, tmp_path)
     with pytest.raises(FileNotFoundError, match="2 of the 2 runs"):
         require_runs(pd.DataFrame(), study, tmp_path)
+
+
+def test_script_figures_are_ready_with_records_or_committed_inputs(tmp_path):
+    from pymoo_rail.experiments.report import ScriptFigures
+
+    entry = ScriptFigures("x", ("x.png",), records="out/x")
+    assert not entry.has_records(tmp_path) and not entry.ready(tmp_path)
+    (tmp_path / "out" / "x" / "sub").mkdir(parents=True)
+    assert not entry.ready(tmp_path)  # an empty folder holds no records
+    (tmp_path / "out" / "x" / "sub" / "run.json").write_text("{}")
+    assert entry.has_records(tmp_path) and entry.ready(tmp_path)
+    assert ScriptFigures("y", ("y.png",), from_committed=("y.png",)).ready(tmp_path)
+    assert not ScriptFigures("z", ("z.png",)).has_records(tmp_path)
+
+
+def test_a_failing_report_mode_returns_its_exit_status(tmp_path, capsys):
+    from pymoo_rail.experiments.report import ScriptFigures
+
+    (tmp_path / "benchmarks").mkdir()
+    (tmp_path / "benchmarks" / "bad.py").write_text("raise SystemExit('no records')\n")
+    assert ScriptFigures("bad", ("bad.png",)).rebuild(tmp_path) == 1
+    assert "failed (1): no records" in capsys.readouterr().out
+
+
+def test_write_filled_writes_exactly_the_filled_template(tmp_path):
+    from pymoo_rail.experiments.report import write_filled
+
+    template = tmp_path / "t.md"
+    template.write_text("# ${title}\n\n${body}\n", encoding="utf-8")
+    text = write_filled(tmp_path / "out.md", template, {"title": "T", "body": "b"})
+    assert text == "# T\n\nb\n" == (tmp_path / "out.md").read_text(encoding="utf-8")
+
+
+def test_committed_members_limit_keeps_the_first_of_each_case():
+    from pathlib import Path
+
+    from pymoo_rail.experiments.report import committed_members
+
+    reports = Path(__file__).resolve().parents[2] / "benchmarks" / "reports"
+    every, first = committed_members(reports), committed_members(reports, limit=1)
+    assert len(first) == every["case"].nunique()
+    assert first.reset_index(drop=True).equals(every.groupby("case", sort=False).head(1).reset_index(drop=True))

@@ -79,3 +79,29 @@ def test_plot_split_costs_draws_the_sweep_and_one_trip(journey):
     np.testing.assert_allclose(second.lines[0].get_ydata(), sweep["equal_kwh"] - sweep["optimal_kwh"])
     assert [p.get_height() for p in third.patches[:journey.n_sections]] == pytest.approx(best.table.supplement_s.tolist())
     assert first.get_title() == "hand-made fronts" and f"{best.trip_time_s / 60:.0f}-min" in third.get_title()
+
+
+def test_de_with_the_budget_repair_comes_close_to_the_exact_split(journey):
+    from pymoo_rail.journeys import allocate_running_time
+    from pymoo_rail.journeys.compare import de_allocation_runs
+
+    fronts = [STEEP] + [FLAT] * (journey.n_sections - 1)
+    total = 13 * 60.0 + 78.0
+    best = allocate_running_time(journey, total, fronts=fronts)
+    runs = de_allocation_runs(fronts, total, best.energy_kwh, n_gen=30, seeds=(1,))
+    assert list(runs.columns) == ["seed", "DE kWh", "gap to exact %", "evaluations", "time s"]
+    assert runs["gap to exact %"].iloc[0] >= -1e-6  # the exact split is the least energy on these fronts
+    assert runs["gap to exact %"].iloc[0] < 5.0 and runs["evaluations"].iloc[0] == 40 * 30
+
+
+@pytest.mark.slow  # 13 sections' strategy fronts
+def test_timed_fronts_count_the_sections_read_back_from_the_cache(journey, tmp_path):
+    from pymoo_rail.journeys.compare import timed_section_fronts
+
+    cache = tmp_path / "fronts.csv"
+    computed, seconds, read = timed_section_fronts(journey, "simulated", cache)
+    assert read == 0 and seconds > 0 and len(computed) == journey.n_sections
+    again, _, read = timed_section_fronts(journey, "simulated", cache)
+    assert read == journey.n_sections
+    for a, b in zip(computed, again):
+        np.testing.assert_allclose(a["energy_kwh"], b["energy_kwh"])
