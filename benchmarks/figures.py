@@ -47,7 +47,8 @@ FIGURES = (
     Figures("journeys", ("journeys.png",)),
     Figures("optimal", ("optimal_front.png", "optimal_profile.png")),
     Figures("efficiency_study", ("efficiency_study.png",)),  # written where --figure says
-    Figures("tracking", ("tracking_metro_a.png", "tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png")),
+    Figures("tracking", ("tracking_metro_a.png",), args=("metro-a",)),
+    Figures("tracking", ("tracking_yizhuang_profiles.png", "tracking_yizhuang_table.png"), args=("yizhuang",)),
 )
 
 
@@ -58,13 +59,13 @@ def main(argv=None) -> int:
     failed = 0
     for entry in FIGURES:
         if not entry.ready(ROOT):
-            print(f"{entry.script}: needs a rerun (`python benchmarks/{entry.script}.py`): {', '.join(entry.figures)}")
+            print(f"{entry.script}: needs a rerun (`{entry.command}`): {', '.join(entry.figures)}")
             continue
         records = entry.has_records(ROOT)
         names = entry.figures if records else entry.from_committed
         rest = [name for name in entry.figures if name not in names]
         print(f"{entry.script}: {'would rebuild' if args.list else 'rebuilding'} {', '.join(names)}"
-              + (f"; needs a rerun (`python benchmarks/{entry.script}.py`): {', '.join(rest)}" if rest else ""))
+              + (f"; needs a rerun (`{entry.command}`): {', '.join(rest)}" if rest else ""))
         if not args.list:
             failed += entry.rebuild(ROOT) != 0
     return 1 if failed else 0

@@ -361,12 +361,20 @@ class ScriptFigures:
         the script has no report mode.
     from_committed : tuple of str
         The figures ``--report-only`` draws from committed files alone.
+    args : tuple of str
+        Arguments the script needs on every call (e.g. the case it runs on).
     """
 
     script: str
     figures: tuple[str, ...]
     records: str | None = None
     from_committed: tuple[str, ...] = ()
+    args: tuple[str, ...] = ()
+
+    @property
+    def command(self) -> str:
+        """The command that reruns the script's study."""
+        return " ".join((f"python benchmarks/{self.script}.py", *self.args))
 
     def has_records(self, root: str | Path) -> bool:
         """Whether the script's study records (or per-run tables) are under ``root / records``."""
@@ -382,7 +390,8 @@ class ScriptFigures:
         root = Path(root)
         env = dict(os.environ, MPLBACKEND="Agg",
                    PYTHONPATH=os.pathsep.join(filter(None, (str(root), os.environ.get("PYTHONPATH")))))
-        done = subprocess.run([sys.executable, str(root / "benchmarks" / f"{self.script}.py"), "--report-only"],
+        done = subprocess.run([sys.executable, str(root / "benchmarks" / f"{self.script}.py"), *self.args,
+                               "--report-only"],
                               cwd=root, env=env, capture_output=True, text=True)
         if done.returncode:
             print(f"  failed ({done.returncode}): {done.stderr.strip().splitlines()[-1] if done.stderr else ''}")
