@@ -9,6 +9,9 @@ seed and budget. The result also depends on things a spec only names:
   loaded case itself is handed to the run, so a file edited while the study runs can never give
   a record computed on one content and labelled with another;
 - any other file a problem or algorithm parameter names (its bytes);
+- the definition checksum of a suite family instance (``problem = "suite_family"``, or
+  ``"rail_suite"`` with a ``seed``), so a record
+  computed on another definition of ``(family, n_var, seed)`` is redone;
 - the module of a ``"package.module:factory"`` spec (its source bytes; looked up only when the
   study is trusted, since finding a module imports its parent packages);
 - the code that computes the result: a digest of the package's own source and data files
@@ -81,6 +84,16 @@ def _module_digest(path: str) -> str | None:
     return _digest(Path(found.origin).read_bytes())
 
 
+def _instance_checksum(params: Mapping[str, Any]) -> str:
+    """The definition checksum of the suite family instance ``params`` name (or why it has none)."""
+    from pymoo_rail.suite import get_problem
+
+    try:
+        return get_problem(params.get("family"), n_var=params.get("n_var"), seed=params.get("seed")).checksum
+    except Exception as err:  # noqa: BLE001 - the run itself will report the error
+        return f"unbuildable: {type(err).__name__}"
+
+
 def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
     """Digests of the case, files and module a problem or algorithm spec refers to, with the case loaded.
 
@@ -93,6 +106,10 @@ def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
         digest = _module_digest(spec.name)
         if digest is not None:
             out[f"{kind} module {spec.name.partition(':')[0]}"] = digest
+    if kind == "problem" and spec.name.replace("-", "_") == "suite_family":
+        out["problem instance checksum"] = _instance_checksum(spec.params)
+    elif kind == "problem" and spec.name.replace("-", "_") == "rail_suite" and spec.params.get("seed") is not None:
+        out["problem instance checksum"] = _instance_checksum({**spec.params, "family": spec.params.get("suite_problem")})
     for key, value in spec.params.items():
         if not isinstance(value, str):
             continue

@@ -180,6 +180,22 @@ def _rail_suite(suite_problem: str, n_var: int | None = None, seed: int | None =
         raise StudyError("problem rail_suite suite_problem", suite_problem, str(err)) from None
 
 
+def _suite_family(family: str, n_var: int = 30, seed: int = 1):
+    """An instance of a seeded suite family (``pymoo_rail.suite.get_problem(family, n_var=, seed=)``).
+
+    Its definition checksum goes into the run's input fingerprint (:mod:`.inputs`), so a record
+    computed on another definition of the instance is never served.
+    """
+    from pymoo_rail.suite import get_problem, list_families
+
+    if family not in list_families():
+        raise StudyError("problem suite_family family", family, f"not a suite family ({', '.join(list_families())})")
+    try:
+        return get_problem(family, n_var=n_var, seed=seed)
+    except ValueError as err:
+        raise StudyError("problem suite_family", {"family": family, "n_var": n_var, "seed": seed}, str(err)) from None
+
+
 PROBLEMS: dict[str, Callable[..., Any]] = {
     **{f"zdt{i}": _pymoo_problem(f"zdt{i}", "pymoo.problems.multi.zdt") for i in range(1, 7)},
     **{f"dtlz{i}": _pymoo_problem(f"dtlz{i}", "pymoo.problems.many.dtlz") for i in range(1, 8)},
@@ -191,6 +207,7 @@ PROBLEMS: dict[str, Callable[..., Any]] = {
     "kinematic_phases": _kinematic_phases,
     "controller_tuning": _controller_tuning,
     "rail_suite": _rail_suite,
+    "suite_family": _suite_family,
     "cooperative_trains_scaled": _cooperative_scaled,
     "timetable": _timetable,
     "cooperative_seed": _cooperative_seed,
@@ -239,6 +256,7 @@ def _moead(problem, pop_size: int = 100, n_neighbors: int = 20, **params):
 
 _smsemoa = _pymoo_algorithm("pymoo.algorithms.moo.sms", "SMSEMOA")
 _agemoea = _pymoo_algorithm("pymoo.algorithms.moo.age", "AGEMOEA")
+_random = _pymoo_algorithm("pymoo.algorithms.soo.nonconvex.random_search", "RandomSearch")
 _de = _pymoo_algorithm("pymoo.algorithms.soo.nonconvex.de", "DE", "Variant")  # DE hands its keywords to its variant too
 _pso = _pymoo_algorithm("pymoo.algorithms.soo.nonconvex.pso", "PSO")
 _ga = _pymoo_algorithm("pymoo.algorithms.soo.nonconvex.ga", "GA")
@@ -304,6 +322,8 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
     "moead": AlgorithmEntry(_moead, "multi", "MOEA/D with pop_size weight vectors (pymoo)"),
     "sms-emoa": AlgorithmEntry(_smsemoa, "multi", "SMS-EMOA (pymoo)"),
     "age-moea": AlgorithmEntry(_agemoea, "multi", "AGE-MOEA, adaptive geometry estimation (pymoo)"),
+    "random": AlgorithmEntry(_random, "any", "random search: n_points_per_iteration uniform samples a step, "
+                                             "the non-dominated ones kept (pymoo)"),
     "de": AlgorithmEntry(_de, "single", "differential evolution (pymoo)"),
     "pso": AlgorithmEntry(_pso, "single", "particle swarm (pymoo)"),
     "ga": AlgorithmEntry(_ga, "single", "genetic algorithm (pymoo)"),
@@ -315,6 +335,7 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
 ALIASES = {"smsemoa": "sms-emoa", "agemoea": "age-moea", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
            "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
            "cooperative-trains": "cooperative_trains", "rail-suite": "rail_suite",
+           "suite-family": "suite_family", "random-search": "random",
            "kinematic-phases": "kinematic_phases", "controller-tuning": "controller_tuning"}
 
 # -------------------------------------------------------------------------------- operators

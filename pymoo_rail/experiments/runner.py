@@ -41,6 +41,7 @@ from pymoo_rail.experiments.fronts import distinct_front
 from pymoo_rail.experiments.inputs import RunInputs, changed_inputs, resolve_run
 from pymoo_rail.experiments.metrics import (convergence_point, front_indicators, true_front_and_reason,
                                             unavailable_indicators)
+from pymoo_rail.experiments.penalty import DEFAULT_PENALTY, PenalisedConstraints, handles_constraints
 from pymoo_rail.experiments.registry import build_algorithm, build_problem, check_parameters, check_trust
 from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
 from pymoo_rail.experiments.store import (CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, LegacyRecordError,
@@ -139,6 +140,8 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
     its threads), the algorithm's :func:`run_counters`, the per-generation history and the versions
     of pymoo and pymoo-rail.
     """
+    from pymoo.core.evaluator import Evaluator
+    from pymoo.core.population import Population
     from pymoo.optimize import minimize
 
     inputs = _as_inputs(inputs, run)
@@ -149,12 +152,19 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
     start, start_cpu = time.perf_counter(), time.process_time()
     # pymoo 0.6.2 calls algorithm.callback unconditionally once given one: pass it only when recording
     callback = {"callback": history} if history is not None else {}
-    res = minimize(problem, algorithm, run.budget.termination, seed=run.seed, verbose=False,
+    # an algorithm without constraint handling (MOEA/D) searches the penalised problem; its front is
+    # then evaluated again on the problem itself, so the record holds true objectives and violations
+    penalised = problem.has_constraints() and not handles_constraints(algorithm)
+    searched = PenalisedConstraints(problem, DEFAULT_PENALTY) if penalised else problem
+    res = minimize(searched, algorithm, run.budget.termination, seed=run.seed, verbose=False,
                    copy_algorithm=False, **callback)
     wall_time_s = time.perf_counter() - start
     cpu_time_s = time.process_time() - start_cpu
 
-    opt = distinct_front(res.algorithm.opt)  # one member per objective vector
+    opt = res.algorithm.opt
+    if penalised and opt is not None and len(opt):
+        opt = Evaluator().eval(problem, Population.new(X=opt.get("X")))
+    opt = distinct_front(opt)  # one member per objective vector
     X = np.asarray(opt.get("X"), dtype=float) if len(opt) else np.empty((0, problem.n_var))
     F = np.asarray(opt.get("F"), dtype=float) if len(opt) else np.empty((0, problem.n_obj))
     CV = np.asarray(opt.get("CV"), dtype=float).reshape(-1) if len(opt) else np.empty(0)

@@ -9,10 +9,17 @@ small samples without ties (scipy chooses), of each algorithm against a baseline
 problem and indicator. A verdict ``+`` means significantly better than the baseline at level
 ``alpha``, ``-`` significantly worse, ``=`` no significant difference; "better" follows the
 indicator's direction (lower IGD, higher HV, ...) and the side of the U statistic.
+
+Ranks over several algorithms run on the same seeds (:func:`friedman_holm`): Friedman's test over
+the algorithms with the seeds as blocks, mean ranks, then Wilcoxon's signed-rank test on every
+pair (paired by seed) with Holm's step-down correction of the p-values (Demsar (2006),
+"Statistical comparisons of classifiers over multiple data sets"; Garcia & Herrera (2008)).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from itertools import combinations
 from pathlib import Path
 from typing import Mapping, Sequence
 
@@ -398,7 +405,7 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
 
 __all__ = ["summarize", "rank_sum", "rank_sum_tests", "indicator_table", "missing_reason", "verdict_counts", "reference_fronts",
            "add_reference_indicators", "add_energy_gap", "to_markdown", "write_tables", "nondominated",
-           "gd_van_veldhuizen"]
+           "gd_van_veldhuizen", "friedman_holm", "holm", "RankTest"]
 
 
 def signed_rank_vs(sample: Sequence[float], reference: float, lower_better: bool = True,
@@ -423,3 +430,89 @@ def signed_rank_vs(sample: Sequence[float], reference: float, lower_better: bool
         return p, "="
     better = np.median(d) < 0 if lower_better else np.median(d) > 0
     return p, "+" if better else "-"
+
+
+@dataclass(frozen=True)
+class RankTest:
+    """Friedman's test of several algorithms on the same seeds, mean ranks and Holm-corrected pairs.
+
+    Attributes
+    ----------
+    statistic, p_value : float
+        Friedman's chi-square and its p-value (NaN with fewer than 3 algorithms or 2 seeds).
+    mean_ranks : pandas.Series
+        Mean rank of each algorithm over the seeds (1 = best; ties share the mean rank), ascending.
+    pairs : pandas.DataFrame
+        One row per pair (``a``, ``b``): ``p`` the two-sided signed-rank p-value, ``p_holm`` after
+        Holm's correction over all pairs, ``better`` the algorithm with the better median
+        difference when ``p_holm < alpha`` (else empty).
+    best : str
+        The algorithm of the lowest mean rank.
+    """
+
+    statistic: float
+    p_value: float
+    mean_ranks: pd.Series
+    pairs: pd.DataFrame
+    best: str
+
+    def mark(self, algorithm: str) -> str:
+        """``"best"``, ``"="`` (not significantly different from the best) or ``"-"`` (significantly worse)."""
+        if algorithm == self.best:
+            return "best"
+        row = self.pairs[((self.pairs["a"] == algorithm) & (self.pairs["b"] == self.best))
+                         | ((self.pairs["b"] == algorithm) & (self.pairs["a"] == self.best))]
+        return "-" if len(row) and row["better"].iloc[0] == self.best else "="
+
+
+def _signed_rank_p(d: np.ndarray) -> float:
+    from scipy.stats import wilcoxon
+
+    return 1.0 if np.all(d == 0) else float(wilcoxon(d, alternative="two-sided").pvalue)
+
+
+def holm(p_values: Sequence[float]) -> np.ndarray:
+    """Holm's step-down adjusted p-values (statsmodels' ``multipletests(method="holm")``)."""
+    from statsmodels.stats.multitest import multipletests
+
+    p = np.asarray(p_values, dtype=float)
+    return p.copy() if len(p) == 0 else multipletests(p, method="holm")[1]
+
+
+def friedman_holm(scores: pd.DataFrame, lower_better: bool = True, alpha: float = 0.05) -> RankTest:
+    """Friedman's test, mean ranks and Holm-corrected pairwise signed-rank tests of one indicator.
+
+    Parameters
+    ----------
+    scores : pandas.DataFrame
+        One row per seed (the blocks), one column per algorithm; a seed with any missing value
+        is dropped (the tests are paired).
+    lower_better : bool
+        Direction of the indicator.
+    alpha : float
+        Level of the pairwise verdicts.
+    """
+    from scipy.stats import friedmanchisquare, rankdata
+
+    if scores.shape[1] < 2:
+        raise ValueError(f"scores: {scores.shape[1]} algorithm column(s); ranks need at least 2")
+    if not 0 < alpha < 1:
+        raise ValueError(f"alpha = {alpha!r} must lie in (0, 1)")
+    table = scores.dropna(axis=0, how="any").astype(float)
+    if len(table) < 2:
+        raise ValueError(f"scores: {len(table)} seed(s) with every algorithm's value; ranks need at least 2")
+    values = table.to_numpy() if lower_better else -table.to_numpy()
+    ranks = pd.Series(rankdata(values, axis=1).mean(axis=0), index=table.columns).sort_values(kind="stable")
+    if table.shape[1] >= 3 and np.ptp(values, axis=1).any():
+        statistic, p_value = (float(v) for v in friedmanchisquare(*values.T))
+    else:
+        statistic, p_value = float("nan"), float("nan") if table.shape[1] < 3 else 1.0
+    rows = []
+    for a, b in combinations(table.columns, 2):
+        d = values[:, table.columns.get_loc(a)] - values[:, table.columns.get_loc(b)]
+        rows.append({"a": a, "b": b, "p": _signed_rank_p(d), "median_diff": float(np.median(d))})
+    pairs = pd.DataFrame(rows)
+    pairs["p_holm"] = holm(pairs["p"])
+    pairs["better"] = [("" if r.p_holm >= alpha or r.median_diff == 0 else (r.a if r.median_diff < 0 else r.b))
+                       for r in pairs.itertuples()]
+    return RankTest(statistic, p_value, ranks, pairs.drop(columns="median_diff"), str(ranks.index[0]))

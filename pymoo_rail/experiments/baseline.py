@@ -1,0 +1,145 @@
+"""The suite's baseline table: indicators of study runs on family instances, ranks and profiles.
+
+A baseline study (``benchmarks/suite_baseline.toml``) runs algorithms on instances
+``problem = "suite_family"`` (family, n_var, seed). Each record is scored here against its
+instance's certified front:
+
+- ``igd_plus``: pymoo's IGD+ of the feasible final front to the certified front (raw units);
+- ``hv_norm``: hypervolume at the family's fixed reference point
+  (:meth:`~pymoo_rail.suite.FamilyProblem.hv_reference_point`) over that of the certified front
+  (1 = the whole front's hypervolume);
+- ``gap_kwh``: median energy gap of the members to the optimum at their own running times
+  (:func:`pymoo_rail.optimal.reference.certified_gap`).
+
+A record whose instance checksum (``inputs["problem instance checksum"]``) differs from the
+instance this code builds is refused: it was computed on another definition.
+:func:`baseline_table` ranks the algorithms per (family, n_var) with
+:func:`.stats.friedman_holm`; :func:`performance_profile` gives Dolan & More's (2002) profile.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Sequence
+
+import numpy as np
+import pandas as pd
+
+from pymoo_rail.experiments.stats import friedman_holm
+from pymoo_rail.optimal.reference import certified_gap
+from pymoo_rail.suite import get_problem
+
+INDICATORS = {"igd_plus": True, "hv_norm": False, "gap_kwh": True}
+"""The table's indicators and whether lower is better."""
+RANK_INDICATOR = "igd_plus"
+"""The indicator the ranks and Holm marks of the table are computed on."""
+
+
+def instance_of(record: dict):
+    """The suite family instance of a study record, refused when its checksum is not the record's."""
+    params = record["problem"]
+    if params.get("problem") not in ("suite_family", "suite-family"):
+        raise ValueError(f"record {record.get('run_id')}: problem {params.get('problem')!r} is not a suite family instance")
+    problem = get_problem(params["family"], n_var=params.get("n_var"), seed=params.get("seed"))
+    stored = record.get("inputs", {}).get("problem instance checksum")
+    if stored != problem.checksum:
+        raise ValueError(f"record {record.get('run_id')}: inputs['problem instance checksum'] = {stored!r} is not the "
+                         f"checksum of {problem.suite_name} ({problem.checksum}): computed on another definition")
+    return problem
+
+
+def baseline_indicators(record: dict, problem=None) -> dict[str, float]:
+    """IGD+, normalised HV and median energy gap of one record (NaN where no member is feasible)."""
+    from pymoo.indicators.hv import HV
+    from pymoo.indicators.igd_plus import IGDPlus
+
+    problem = instance_of(record) if problem is None else problem
+    F = np.asarray(record["front"]["F"], dtype=float).reshape(-1, problem.n_obj)
+    F = F[np.asarray(record["front"]["CV"], dtype=float).reshape(-1) <= 0]
+    out = dict.fromkeys(INDICATORS, float("nan"))
+    if len(F) == 0:
+        return out
+    pf = problem.pareto_front()
+    hv = HV(ref_point=problem.hv_reference_point())
+    objectives = list(problem.objectives)
+    gap = certified_gap(problem.certified_front(), F[:, objectives.index("running_time")],
+                        F[:, objectives.index("energy")])
+    out.update(igd_plus=float(IGDPlus(pf)(F)), hv_norm=float(hv(F) / hv(pf)), gap_kwh=gap["gap_median_kwh"])
+    return out
+
+
+def indicator_frame(records: Iterable[dict]) -> pd.DataFrame:
+    """One row per record: family, n_var, instance seed, run seed, algorithm, the indicators, CPU and evaluations."""
+    rows, instances = [], {}
+    for record in records:
+        key = tuple(sorted(record["problem"].items()))
+        if key not in instances:
+            instances[key] = instance_of(record)
+        problem = instances[key]
+        rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
+                     "seed": int(record["seed"]), "algorithm": record["algorithm_label"],
+                     **baseline_indicators(record, problem),
+                     "cpu_time_s": float(record["cpu_time_s"]), "n_eval": int(record["n_eval"])})
+    return pd.DataFrame(rows)
+
+
+def _cell(values: pd.Series) -> str:
+    values = values.dropna()
+    if values.empty:
+        return "n/a"
+    return f"{values.mean():.4g} +- {values.std(ddof=1):.2g}" if len(values) > 1 else f"{values.mean():.4g}"
+
+
+def baseline_table(frame: pd.DataFrame, alpha: float = 0.05,
+                   indicators: Sequence[str] = tuple(INDICATORS)) -> pd.DataFrame:
+    """Mean +- std of each indicator, mean rank and Holm mark vs the best, per (family, n_var) and algorithm.
+
+    Ranks and marks are on :data:`RANK_INDICATOR`, paired by run seed; ``friedman_p`` is the
+    Friedman p-value of the cell. Mark ``best``, ``=`` (not significantly worse than the best at
+    ``alpha`` after Holm's correction) or ``-`` (significantly worse); ``n/a`` (rank NaN) in a cell
+    with fewer than 2 seeds where every algorithm has a value.
+    """
+    rows = []
+    for (family, n_var), cell in frame.groupby(["family", "n_var"], sort=True):
+        scores = cell.pivot_table(index="seed", columns="algorithm", values=RANK_INDICATOR, aggfunc="first")
+        complete = scores.dropna(axis=0, how="any")
+        test = (friedman_holm(complete, lower_better=INDICATORS[RANK_INDICATOR], alpha=alpha)
+                if len(complete) >= 2 and complete.shape[1] >= 2 else None)  # else no ranks: too few paired seeds
+        for algorithm, runs in cell.groupby("algorithm", sort=False):
+            rows.append({"family": family, "n_var": n_var, "algorithm": algorithm,
+                         **{name: _cell(runs[name]) for name in indicators},
+                         "mean_rank": float(test.mean_ranks.get(algorithm, np.nan)) if test else float("nan"),
+                         "mark": test.mark(algorithm) if test else "n/a",
+                         "friedman_p": test.p_value if test else float("nan"), "runs": len(runs)})
+    return pd.DataFrame(rows).sort_values(["family", "n_var", "mean_rank"], kind="stable").reset_index(drop=True)
+
+
+def performance_profile(frame: pd.DataFrame, indicator: str = RANK_INDICATOR,
+                        taus: Sequence[float] = tuple(np.geomspace(1, 100, 60))) -> pd.DataFrame:
+    """Dolan & More's performance profile: share of (instance, seed) pairs an algorithm solves within tau x the best.
+
+    The ratio of an algorithm on a pair is its indicator over the pair's best (lower is better;
+    a missing value counts as never within). Returns one column per algorithm, indexed by tau.
+    """
+    keys = ["family", "n_var", "instance_seed", "seed"]
+    table = frame.pivot_table(index=keys, columns="algorithm", values=indicator, aggfunc="first")
+    best = table.min(axis=1)
+    ratio = table.div(best.where(best > 0), axis=0)
+    return pd.DataFrame({name: [(ratio[name] <= tau).mean() for tau in taus] for name in table.columns},
+                        index=pd.Index(taus, name="tau"))
+
+
+def convergence(records: Iterable[dict], indicator: str = "igd") -> pd.DataFrame:
+    """The per-generation history of the records: family, n_var, algorithm, seed, n_eval and ``indicator``."""
+    rows = []
+    for record in records:
+        history = record.get("history") or {}
+        values = history.get(indicator) or []
+        params = record["problem"]
+        rows += [{"family": params["family"], "n_var": params.get("n_var"), "algorithm": record["algorithm_label"],
+                  "seed": record["seed"], "n_eval": n_eval, indicator: value}
+                 for n_eval, value in zip(history.get("n_eval", []), values) if value is not None]
+    return pd.DataFrame(rows)
+
+
+__all__ = ["INDICATORS", "RANK_INDICATOR", "instance_of", "baseline_indicators", "indicator_frame", "baseline_table",
+           "performance_profile", "convergence"]

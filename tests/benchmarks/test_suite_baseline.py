@@ -1,0 +1,69 @@
+"""benchmarks/suite_baseline.py: the study file's size, its reduction options and the records archive."""
+
+from __future__ import annotations
+
+import hashlib
+import tarfile
+
+import pytest
+
+
+def _script():
+    from benchmarks import suite_baseline
+
+    return suite_baseline
+
+
+def test_the_full_study_is_every_bi_family_on_the_ladder_with_seven_algorithms_and_31_seeds():
+    from pymoo_rail.suite import list_families
+
+    study = _script().build_study(None, None, None, None)
+    bi = {name for name in list_families() if name.endswith("-bi")}
+    assert {p.params["family"] for p in study.problems} == bi
+    assert sorted({p.params["n_var"] for p in study.problems}) == [10, 30, 100, 300, 1000]
+    assert len(study.problems) == 5 * len(bi)
+    assert {a.name for a in study.algorithms} == {"nsga2", "sms-emoa", "moead", "age-moea", "moabc", "grnsga2",
+                                                  "random"}
+    assert len(study.seeds) == 31
+
+
+def test_reductions_cut_the_study():
+    study = _script().build_study(["generated-metro-bi"], [10, 30], 5, 2000)
+    assert [p.display for p in study.problems] == ["generated-metro-bi/10", "generated-metro-bi/30"]
+    assert study.seeds == (1, 2, 3, 4, 5)
+    assert study.budget.value == 2000
+
+
+def test_a_reduction_that_leaves_nothing_says_so():
+    with pytest.raises(SystemExit, match="no problem"):
+        _script().build_study(["atlantis-bi"], None, None, None)
+
+
+def test_the_archive_holds_the_records_and_its_checksum_is_the_files(tmp_path):
+    work = tmp_path / "work"
+    (work / "runs").mkdir(parents=True)
+    (work / "runs" / "a.json").write_text('{"x": 1}')
+    (work / "study.toml").write_text('name = "x"')
+    (work / "runs" / "a.json.lock").write_text("")
+    path = tmp_path / "records.tar.gz"
+    digest = _script().archive(work, path)
+    assert digest == hashlib.sha256(path.read_bytes()).hexdigest()
+    with tarfile.open(path) as tar:
+        assert sorted(tar.getnames()) == ["suite_baseline/runs/a.json", "suite_baseline/study.toml"]
+
+
+def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
+    import pandas as pd
+
+    script = _script()
+    full = script.build_study(["generated-metro-bi"], [10, 30, 100], 2, 1000)
+    names = [a.display for a in full.algorithms]
+    # 1 ms per evaluation at n_var 10, 3 ms at 100: 2 ms at 55 (not asked), 1.4444 ms at 30
+    frame = pd.DataFrame([{"family": "generated-metro-bi", "algorithm": name, "n_var": n, "n_eval": 100,
+                           "cpu_time_s": 0.1 if n == 10 else 0.3} for name in names for n in (10, 100)])
+    # a first run of a process paying the compilation (10 x) does not move the median of three
+    frame = pd.concat([frame, frame, frame.assign(cpu_time_s=frame["cpu_time_s"] * 10)], ignore_index=True)
+    hours, sizes = script.projected_cpu_h(frame, full)
+    per_algorithm_s = (1e-3 + (1e-3 + 20 / 90 * 2e-3) + 3e-3) * 1000 * 2
+    assert hours == pytest.approx(len(names) * per_algorithm_s / 3600)
+    assert sizes == "10, 100"

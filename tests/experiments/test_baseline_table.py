@@ -1,0 +1,80 @@
+"""The suite baseline table: indicators of family-instance records, checksum refusal, ranks, profiles."""
+
+import copy
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, convergence, indicator_frame,
+                                             instance_of, performance_profile)
+from pymoo_rail.experiments.runner import execute_run
+from pymoo_rail.experiments.spec import Budget, RunSpec, algorithm, problem
+from pymoo_rail.suite import get_problem
+
+FAMILY = "generated-metro-bi"
+
+
+@pytest.fixture(scope="module")
+def records():
+    spec = problem("suite_family", family=FAMILY, n_var=10, seed=1)
+    out = []
+    for seed in (1, 2, 3):
+        for name, params in (("nsga2", {"pop_size": 20}), ("random", {"n_points_per_iteration": 20})):
+            record = execute_run(RunSpec(spec, algorithm(name, **params), seed, Budget("n_eval", 200)))
+            out.append({**record, "algorithm_label": name})
+    return out
+
+
+def test_the_certified_front_scores_perfectly(records):
+    instance = get_problem(FAMILY, n_var=10, seed=1)
+    pf = instance.pareto_front()
+    record = copy.deepcopy(records[0])
+    record["front"]["F"], record["front"]["CV"] = pf.tolist(), [0.0] * len(pf)
+    scores = baseline_indicators(record)
+    assert scores["igd_plus"] == pytest.approx(0.0, abs=1e-9)
+    assert scores["hv_norm"] == pytest.approx(1.0)
+
+
+def test_runs_score_inside_the_bounds(records):
+    frame = indicator_frame(records)
+    assert len(frame) == 6 and set(frame["algorithm"]) == {"nsga2", "random"}
+    assert (frame["igd_plus"] > 0).all()
+    assert ((frame["hv_norm"] > 0) & (frame["hv_norm"] < 1)).all()
+    assert (frame["gap_kwh"].dropna() > -1e-6).all()  # above the optimum, up to its certificate
+
+
+def test_a_record_without_feasible_members_scores_nan(records):
+    record = copy.deepcopy(records[0])
+    record["front"]["CV"] = [1.0] * len(record["front"]["CV"])
+    assert all(np.isnan(v) for v in baseline_indicators(record).values())
+
+
+def test_a_record_of_another_definition_is_refused(records):
+    record = copy.deepcopy(records[0])
+    record["inputs"]["problem instance checksum"] = "0" * 64
+    with pytest.raises(ValueError, match="another definition"):
+        instance_of(record)
+
+
+def test_the_table_ranks_every_algorithm_of_a_cell(records):
+    table = baseline_table(indicator_frame(records))
+    assert set(table["algorithm"]) == {"nsga2", "random"}
+    assert table["mean_rank"].is_monotonic_increasing
+    assert table["mean_rank"].sum() == pytest.approx(3.0)  # ranks 1 and 2 share the seeds
+    assert (table["mark"] == "best").sum() == 1
+    assert table["runs"].tolist() == [3, 3]
+
+
+def test_performance_profile_reaches_one_for_the_best_at_tau_one():
+    frame = pd.DataFrame({"family": "f", "n_var": 10, "instance_seed": 1, "seed": [1, 1, 2, 2],
+                          "algorithm": ["a", "b", "a", "b"], "igd_plus": [1.0, 2.0, 1.0, 4.0]})
+    profile = performance_profile(frame, taus=[1.0, 2.0, 3.0, 4.0])
+    assert profile["a"].tolist() == [1.0, 1.0, 1.0, 1.0]
+    assert profile["b"].tolist() == [0.0, 0.5, 0.5, 1.0]
+
+
+def test_convergence_holds_each_generation(records):
+    history = convergence(records)
+    assert set(history["algorithm"]) == {"nsga2", "random"}
+    assert history.groupby(["algorithm", "seed"])["n_eval"].max().max() <= 200
