@@ -9,8 +9,7 @@ seed and budget. The result also depends on things a spec only names:
   loaded case itself is handed to the run, so a file edited while the study runs can never give
   a record computed on one content and labelled with another;
 - any other file a problem or algorithm parameter names (its bytes);
-- the definition checksum of a suite family instance (``problem = "suite_family"``, or
-  ``"rail_suite"`` with a ``seed``), so a record
+- the definition checksum of a suite family instance (``problem = "suite_family"``), so a record
   computed on another definition of ``(family, n_var, seed)`` is redone;
 - the module of a ``"package.module:factory"`` spec (its source bytes; looked up only when the
   study is trusted, since finding a module imports its parent packages);
@@ -108,8 +107,6 @@ def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
             out[f"{kind} module {spec.name.partition(':')[0]}"] = digest
     if kind == "problem" and spec.name.replace("-", "_") == "suite_family":
         out["problem instance checksum"] = _instance_checksum(spec.params)
-    elif kind == "problem" and spec.name.replace("-", "_") == "rail_suite" and spec.params.get("seed") is not None:
-        out["problem instance checksum"] = _instance_checksum({**spec.params, "family": spec.params.get("suite_problem")})
     for key, value in spec.params.items():
         if not isinstance(value, str):
             continue

@@ -169,13 +169,16 @@ def _controller_tuning(case: Any = "metro-a", load: str | None = None, **params)
 
 
 @_forwards("pymoo_rail.problems", "SpeedProfileProblem")
-def _rail_suite(suite_problem: str, n_var: int | None = None, seed: int | None = None, **params):
-    """A problem of the rail benchmark suite by name (``pymoo_rail.suite.get_problem``): a named
-    problem with its settings, or a family instance with ``n_var`` and ``seed``."""
-    from pymoo_rail.suite import get_problem
+def _rail_suite(suite_problem: str, **params):
+    """A named problem of the rail benchmark suite (``pymoo_rail.suite.get_problem``) with its
+    settings; a seeded family instance is the ``suite_family`` entry (one way to name it)."""
+    from pymoo_rail.suite import get_problem, list_families
 
+    if suite_problem in list_families():
+        raise StudyError("problem rail_suite suite_problem", suite_problem,
+                         'a suite family: name an instance with problem = "suite_family", family, n_var and seed')
     try:
-        return get_problem(suite_problem, n_var=n_var, seed=seed, **_tuples(params))
+        return get_problem(suite_problem, **_tuples(params))
     except ValueError as err:
         raise StudyError("problem rail_suite suite_problem", suite_problem, str(err)) from None
 

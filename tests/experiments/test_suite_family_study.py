@@ -74,9 +74,8 @@ def test_random_search_spends_its_budget_and_keeps_a_nondominated_front():
     assert not any(dominated)
 
 
-def test_rail_suite_names_the_same_instance_with_the_same_checksum_in_its_fingerprint():
-    by_family = problem("suite_family", family=FAMILY, n_var=10, seed=7)
-    by_name = problem("rail_suite", suite_problem=FAMILY, n_var=10, seed=7)
-    assert build_problem(by_name).checksum == build_problem(by_family).checksum
-    fingerprint = resolve_run(RunSpec(by_name, algorithm("nsga2"), 1, Budget("n_eval", 100))).fingerprint
-    assert fingerprint["problem instance checksum"] == get_problem(FAMILY, n_var=10, seed=7).checksum
+def test_rail_suite_refuses_a_family_and_names_the_entry_that_takes_it():
+    with pytest.raises(StudyError, match='problem = "suite_family"'):
+        build_problem(problem("rail_suite", suite_problem=FAMILY))
+    with pytest.raises(StudyError):
+        build_problem(problem("rail_suite", suite_problem=FAMILY, n_var=10, seed=7))

@@ -149,9 +149,10 @@ def test_a_study_file_names_an_instance_by_family_n_var_and_seed():
     from pymoo_rail.experiments.registry import build_problem
     from pymoo_rail.experiments.spec import StudyError
 
-    built = build_problem(problem_spec("rail_suite", suite_problem="generated-metro-bi", n_var=20, seed=3))
+    built = build_problem(problem_spec("suite_family", family="generated-metro-bi", n_var=20, seed=3))
     assert built.checksum == get_problem("generated-metro-bi", n_var=20, seed=3).checksum
     with pytest.raises(StudyError, match="n_var = 1001"):
-        build_problem(problem_spec("rail_suite", suite_problem="generated-metro-bi", n_var=1001, seed=3))
-    with pytest.raises(StudyError, match="not a family"):
-        build_problem(problem_spec("rail_suite", suite_problem="metro-a-bi", seed=3))
+        build_problem(problem_spec("suite_family", family="generated-metro-bi", n_var=1001, seed=3))
+    # one way to name an instance: rail_suite takes the named problems only, and says which entry to use
+    with pytest.raises(StudyError, match='problem = "suite_family"'):
+        build_problem(problem_spec("rail_suite", suite_problem="generated-metro-bi"))
