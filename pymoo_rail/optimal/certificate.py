@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 CERTIFICATE_FACTOR = 2.0
 # ... plus this share of the run's net energy: the two grids can agree by coincidence where a grid
 # of twice the nodes or the uniform node placement still differs (at 2 of 861 times of
-# ``benchmarks/certificate_coverage.py``, by 1.0 and 2.7 Wh beyond the two-grid part, 2.6e-5 and
+# ``benchmarks/reference_check.py --check coverage``, by 1.0 and 2.7 Wh beyond the two-grid part, 2.6e-5 and
 # 2.3e-6 of the energy)
 CERTIFICATE_FLOOR_REL = 1.0e-4
 # ... or, where the run's traction energy is known (``OptimalSolver.profile``), this share of it, the larger:
@@ -67,7 +67,7 @@ def untied_excess_j(solver: OptimalSolver, solution: Solve) -> float:
 
     Keeping the regime between near-tied controls changes the rest of the run too, so its cost
     is measured on the whole run: the forward run with ``tie_j = 0`` at the same price, compared
-    in ``energy + lambda x time`` (measured: 6.1 Wh on a 1.7 km metro section, 0.07 %, ``benchmarks/certificate.py``).
+    in ``energy + lambda x time`` (measured: 6.1 Wh on a 1.7 km metro section, 0.07 %, ``benchmarks/reference_check.py --check parts``).
     """
     if solver.tie_j <= 0.0:
         return 0.0

@@ -264,7 +264,7 @@ class OptimalSolver:
           without the tie rule is at the same price; the larger of the two.
 
         An estimate, not a proven bound: ``benchmarks/reference_check.py`` checks it against every
-        optimiser result the project's studies committed, ``benchmarks/certificate_coverage.py``
+        optimiser result the project's studies committed, ``benchmarks/reference_check.py --check coverage``
         against a grid of twice the nodes and the uniform node placement at all their times. The
         optimum meant is that of the simulator's model on this position grid, the model every
         optimiser's run is evaluated with.
