@@ -23,13 +23,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-try:
-    from benchmarks.peers import mseetc_track, run_mseetc_json
-except ModuleNotFoundError:  # run as a script: the sibling module
-    from peers import mseetc_track, run_mseetc_json
-
 from pymoo_rail.cases import load_case
 from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.experiments.peers import mseetc_track, run_mseetc_json
 from pymoo_rail.model.efficiency import maps_from_losses
 from pymoo_rail.optimal import efficiency_study as es
 
@@ -41,7 +37,7 @@ COLOURS = {"perfect": "tab:blue", "static": "tab:red", "dynamic": "tab:green"}
 
 
 def mseetc(args, case, running_time_s: float, losses: str, loss_grid: dict | None = None) -> dict:
-    """ms-eetc's optimal run under one loss model, through ``peers.py``'s driver."""
+    """ms-eetc's optimal run under one loss model, through ``pymoo_rail.experiments.peers``' driver."""
     study = {"losses": losses, "eta_static": es.STATIC_EFFICIENCY, "aux_w": es.AUX_POWER_KW * 1000.0,
              "eta_gear": es.GEAR_EFFICIENCY}
     if loss_grid is not None:
