@@ -5,6 +5,7 @@ from the suffix). matplotlib is imported when a figure is made, not at import ti
 """
 
 from pymoo_rail.plotting.advice import plot_advised_run
+from pymoo_rail.plotting.baseline import plot_cell_convergence, plot_performance_profile
 from pymoo_rail.plotting.comparison import plot_boxplots
 from pymoo_rail.plotting.convergence import convergence_frame, history_curve, plot_convergence, plot_history
 from pymoo_rail.plotting.fronts import plot_front, plot_fronts, plot_study_fronts, representative_runs
@@ -17,4 +18,4 @@ from pymoo_rail.plotting.style import OBJECTIVE_LABELS, REGIME_COLORS, save_figu
 __all__ = ["plot_advised_run", "plot_front", "plot_fronts", "plot_study_fronts", "representative_runs", "plot_speed_profile",
            "plot_speed_time", "Trace", "as_trace", "plot_convergence", "convergence_frame", "plot_history",
            "history_curve", "plot_boxplots", "plot_study", "save_figure", "OBJECTIVE_LABELS", "REGIME_COLORS", "plot_timed_run",
-           "plot_speed_runs"]
+           "plot_speed_runs", "plot_cell_convergence", "plot_performance_profile"]
