@@ -56,3 +56,22 @@ def test_loop_tests_pair_the_worlds():
     assert gap.loc["better", "verdict"] == "+" and gap.loc["worse", "verdict"] == "-"
     assert gap.loc["tracking_b", "verdict"] == "-"
     assert (tests[tests["measure"] == "lateness_abs_s"]["verdict"] == "=").all()
+
+
+def test_the_advice_table_pairs_the_advised_run_with_the_policys_in_the_same_world():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import pandas as pd
+
+    from pymoo_rail.experiments.loop_study import advice_markdown
+    from pymoo_rail.plotting import plot_gap_lateness
+
+    runs = pd.DataFrame([{"case": "a", "controller": c, "run": r, "cost_kwh": cost, "lateness_s": 1.0, "gap_pct": 2.0}
+                         for r, (adv, opt) in enumerate([(100.5, 100.0), (103.0, 100.0), (99.0, 100.0)])
+                         for c, cost in (("advice", adv), ("optimal_controls", opt))])
+    rows = advice_markdown(runs.iloc[::-1]).splitlines()  # paired by world, not by order
+    assert rows[0] == "| case | worlds | median extra cost | 90th percentile | worlds over 1 % |"
+    assert rows[2] == "| a | 3 | +0.50 % | +2.50 % | 1 |"  # extra costs -1, +0.5, +3 %
+    fig = plot_gap_lateness(runs, ("advice", "optimal_controls"))
+    assert len(fig.axes) == 1 and len(fig.axes[0].collections) == 4  # each controller: its runs and its median
