@@ -120,19 +120,12 @@ def rank_sum(rows, enc: str, key: str, lower_better: bool):
     return p, verdict, f"{100 * ((gr.mean() - base.mean()) / abs(base.mean())):+.3f} %" if base.mean() != 0 else ""
 
 
-def median_run(rows, enc: str, alg: str) -> dict:
-    """The run with the median ``hv_ref`` (the lower seed for an even count)."""
-    runs = sorted((r for r in rows if r["problem"] == enc and r["algorithm"] == alg),
-                  key=lambda r: (-r["hv_ref"] if np.isfinite(r["hv_ref"]) else np.inf, r["seed"]))
-    return runs[(len(runs) - 1) // 2]
-
-
 def punctual_choices(results, rows, problems: dict) -> dict:
     """Per (encoding, algorithm): the most punctual member of the median-HV run, re-simulated."""
     chosen = {}
     for enc in sorted({r["problem"] for r in rows}):
         for alg in (NSGA2_LABEL, GR_LABEL):
-            seed = median_run(rows, enc, alg)["seed"]
+            seed = stats.median_run(rows, enc, alg)["seed"]
             run = results[(results["problem"] == enc) & (results["algorithm"] == alg) & (results["seed"] == seed)].iloc[0]
             F, X = run["F"][run["CV"] <= 0], run["X"][run["CV"] <= 0]
             k = most_punctual(F, problems[enc].case.planned_time_s)

@@ -30,3 +30,15 @@ def test_front_statistics_extent_on_time_and_gap_of_the_punctual_member():
     assert row["gap_min_pct"] == pytest.approx(10.0) and row["gap_max_pct"] == pytest.approx(10.0)
     assert "gap_mean_pct" not in front_statistics(F, 110.0)
     assert np.isnan(front_statistics(F, 90.0)["e_at_plan"])  # no member on time
+
+
+def test_median_run_is_the_middle_by_the_indicator_and_names_a_missing_pair():
+    from pymoo_rail.experiments.stats import median_run
+
+    rows = [{"problem": "p", "algorithm": "a", "seed": s, "hv_ref": hv} for s, hv in
+            ((1, 0.5), (2, 0.9), (3, np.nan), (4, 0.7))]
+    assert median_run(rows, "p", "a")["seed"] == 4  # 0.9, 0.7 | 0.5, nan: the better middle one
+    assert median_run(rows[:3], "p", "a")["seed"] == 1
+    assert median_run(rows, "p", "a", lower_better=True)["seed"] == 4  # 0.5, 0.7 | 0.9, nan
+    with pytest.raises(ValueError, match="'b'.*'p'"):
+        median_run(rows, "p", "b")
