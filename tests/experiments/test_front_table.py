@@ -42,3 +42,18 @@ def test_median_run_is_the_middle_by_the_indicator_and_names_a_missing_pair():
     assert median_run(rows, "p", "a", lower_better=True)["seed"] == 4  # 0.5, 0.7 | 0.9, nan
     with pytest.raises(ValueError, match="'b'.*'p'"):
         median_run(rows, "p", "b")
+
+
+def test_describe_comparison_words_the_verdict_of_compare_means():
+    from pymoo_rail.experiments.stats import compare_means, describe_comparison
+
+    a, b = [1.0, 1.1, 0.9, 1.05, 0.95], [2.0, 2.1, 1.9, 2.05, 1.95]
+    assert describe_comparison(compare_means(a, b)).startswith("better (-50.0 %, p = ")
+    assert describe_comparison(compare_means(b, a)).startswith("worse (+100.0 %")
+    assert describe_comparison((True, -0.5, 0.2)) == "no significant difference (-0.50 %, p = 0.2)"
+
+
+def test_signed_percent_keeps_two_decimals_under_one_percent():
+    from pymoo_rail.experiments.stats import signed_percent
+
+    assert (signed_percent(0.456), signed_percent(-12.34), signed_percent(1.0)) == ("+0.46 %", "-12.3 %", "+1.0 %")
