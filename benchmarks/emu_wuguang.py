@@ -19,12 +19,12 @@ import pandas as pd
 
 from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.cases import load_case
-from pymoo_rail.experiments import (Study, algorithm, build_problem, choose_member, load_results, problem, run_study,
+from pymoo_rail.experiments import (Study, algorithm, build_problem, load_results, problem, run_study,
                                     stats, tang2020_nsga2)
+from pymoo_rail.experiments.front_table import exact_energy_kwh, front_statistics, most_punctual
 from pymoo_rail.experiments.metrics import gd_van_veldhuizen
 from pymoo_rail.experiments.report import fill_template, markdown_rows, mean_std, significant, write_report
 from pymoo_rail.experiments.verify import check_members, check_rows, worst_checks
-from pymoo_rail.indicators.energy import energy_gap
 from pymoo_rail.optimal.reference import exact_points
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -80,31 +80,6 @@ def exact_front(path: Path, profile_path: Path):
     return exact_points(case, EXACT_TIMES_S, path, n_speeds=EXACT_N_SPEEDS, redo_s=redo, on_run=keep_profile)
 
 
-def most_punctual(F: np.ndarray, planned_time_s: float) -> int:
-    """Index of the (energy, running time) member closest to the planned time (ties: the lower energy)."""
-    return choose_member(F, np.zeros(len(F)), F[:, 1], F[:, 0], planned_time_s, window_s=0.0)
-
-
-def exact_energy_kwh(exact, time_s: float) -> float:
-    """The exact front's energy at ``time_s`` (linear between its points; NaN outside them)."""
-    t, e = exact["running_time_s"].to_numpy(float), exact["energy_kwh"].to_numpy(float)
-    return float(np.interp(time_s, t, e)) if t[0] <= time_s <= t[-1] else float("nan")
-
-
-def front_row(F: np.ndarray, planned: float, exact) -> dict:
-    """Extent, most punctual member, least energy on time and (with ``exact``) the gaps of one feasible front."""
-    k = most_punctual(F, planned)
-    inside = F[:, 1] <= planned
-    row = dict(e_min=F[:, 0].min(), e_max=F[:, 0].max(), t_min=F[:, 1].min(), t_max=F[:, 1].max(), punctual_e=F[k, 0],
-               punctual_t=F[k, 1], e_at_plan=float(F[inside, 0].min()) if inside.any() else float("nan"))
-    if exact is not None:
-        gap = energy_gap(F[:, ::-1], exact[["running_time_s", "energy_kwh"]].to_numpy(float))
-        row.update(gap_mean_pct=100 * gap["mean_gap_rel"], gap_min_pct=100 * gap["min_gap_rel"],
-                   gap_max_pct=100 * gap["max_gap_rel"], hv_ratio_exact=gap["hv_ratio"],
-                   punctual_gap_pct=100 * (F[k, 0] / exact_energy_kwh(exact, F[k, 1]) - 1))
-    return row
-
-
 def analyse(results, problems: dict, exact=None):
     """One dict per run: indicators against the union front, extent, gaps to ``exact``, checks of every member."""
     results = stats.add_reference_indicators(results)
@@ -120,7 +95,7 @@ def analyse(results, problems: dict, exact=None):
                "gd_ref": run["gd_ref"], "gd_seed": gd_van_veldhuizen(F, refs[run["problem"]]) if len(F) else np.nan,
                "spacing": run.get("spacing", np.nan)}
         if len(F):
-            row.update(front_row(F, problems[run["problem"]].case.planned_time_s, exact))
+            row.update(front_statistics(F, problems[run["problem"]].case.planned_time_s, exact))
             row.update(check_members(problems[run["problem"]], X, F[:, 0], F[:, 1]))
         rows.append(row)
     return results, rows
@@ -145,19 +120,12 @@ def rank_sum(rows, enc: str, key: str, lower_better: bool):
     return p, verdict, f"{100 * ((gr.mean() - base.mean()) / abs(base.mean())):+.3f} %" if base.mean() != 0 else ""
 
 
-def median_run(rows, enc: str, alg: str) -> dict:
-    """The run with the median ``hv_ref`` (the lower seed for an even count)."""
-    runs = sorted((r for r in rows if r["problem"] == enc and r["algorithm"] == alg),
-                  key=lambda r: (-r["hv_ref"] if np.isfinite(r["hv_ref"]) else np.inf, r["seed"]))
-    return runs[(len(runs) - 1) // 2]
-
-
 def punctual_choices(results, rows, problems: dict) -> dict:
     """Per (encoding, algorithm): the most punctual member of the median-HV run, re-simulated."""
     chosen = {}
     for enc in sorted({r["problem"] for r in rows}):
         for alg in (NSGA2_LABEL, GR_LABEL):
-            seed = median_run(rows, enc, alg)["seed"]
+            seed = stats.median_run(rows, enc, alg)["seed"]
             run = results[(results["problem"] == enc) & (results["algorithm"] == alg) & (results["seed"] == seed)].iloc[0]
             F, X = run["F"][run["CV"] <= 0], run["X"][run["CV"] <= 0]
             k = most_punctual(F, problems[enc].case.planned_time_s)

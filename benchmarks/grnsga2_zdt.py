@@ -19,7 +19,7 @@ from pymoo_rail.experiments import Study, algorithm, load_results, problem, run_
 from pymoo_rail.experiments.report import (add_study_options, count_range, fill_template, lower_priority, markdown_rows,
                                            report_runs, significant, write_report)
 from pymoo_rail.experiments.metrics import raw_indicators
-from pymoo_rail.experiments.stats import compare_means
+from pymoo_rail.experiments.stats import compare_means, describe_comparison, signed_percent
 from pymoo_rail.plotting import plot_fronts, representative_runs, save_figure
 from pymoo_rail.plotting.style import new_figure
 
@@ -70,17 +70,6 @@ def run_row(result) -> dict:
             "cpu_s": round(float(result["cpu_time_s"]), 2)}
 
 
-def pct(rel: float) -> str:
-    return f"{rel:+.2f} %" if abs(rel) < 1.0 else f"{rel:+.1f} %"
-
-
-def describe(result) -> str:
-    """``better (-11.5 %, p = 3e-11)`` or ``no significant difference (...)`` of a :func:`compare_means`."""
-    better, rel, pval = result
-    word = "no significant difference" if pval >= 0.05 else "better" if better else "worse"
-    return f"{word} ({pct(rel)}, p = {pval:.2g})"
-
-
 def cell(df, p: str, a: str):
     return df[(df.problem == p) & (df.algorithm == a)]
 
@@ -112,7 +101,7 @@ def in_words(df, problems, algorithms) -> str:
         pairs = [(m, r) for m in ("igd", "hv", "gd", "sp", "delta") if (r := compare(df, p, m, *MAIN_PAIR))]
         for _, r in pairs:
             counts["same" if r[2] >= 0.05 else "better" if r[0] else "worse"] += 1
-        lines.append(f"- {p.upper()}, GR-NSGA-II vs NSGA-II: " + "; ".join(f"{m} {describe(r)}" for m, r in pairs) + ".")
+        lines.append(f"- {p.upper()}, GR-NSGA-II vs NSGA-II: " + "; ".join(f"{m} {describe_comparison(r)}" for m, r in pairs) + ".")
     lines += ["", f"Over {sum(counts.values())} problem-indicator pairs GR-NSGA-II is significantly better in "
               f"{counts['better']}, significantly worse in {counts['worse']} and not significantly different in "
               f"{counts['same']} (rank-sum p < 0.05)."]
@@ -122,9 +111,9 @@ def in_words(df, problems, algorithms) -> str:
             parts = [compare(df, p, "igd", a, b) for a, b in (("GR-NSGA-II", "GR-NSGA-II no LS"),
                                                             ("GR-NSGA-II no LS", "NSGA-II"), ("NSGA-II pm=1/n", "NSGA-II"))]
             if None not in parts:
-                lines.append(f"- {p.upper()}: golden-ratio local search (GR vs GR no LS) {describe(parts[0])}; "
-                             f"adaptive pc/pm alone (GR no LS vs NSGA-II) {describe(parts[1])}; "
-                             f"mutation 1/n instead of 0.01 (NSGA-II pm=1/n vs NSGA-II) {describe(parts[2])}.")
+                lines.append(f"- {p.upper()}: golden-ratio local search (GR vs GR no LS) {describe_comparison(parts[0])}; "
+                             f"adaptive pc/pm alone (GR no LS vs NSGA-II) {describe_comparison(parts[1])}; "
+                             f"mutation 1/n instead of 0.01 (NSGA-II pm=1/n vs NSGA-II) {describe_comparison(parts[2])}.")
     return "\n".join(lines)
 
 
@@ -145,8 +134,8 @@ def table_values(df, problems, algorithms) -> dict:
             better, rel, pval = pair
             a_v, b_v = (cell(df, p, a)[m].dropna() for a in MAIN_PAIR)
             rel_med = (a_v.median() - b_v.median()) / abs(b_v.median()) * 100
-            verdict_rows.append(f"| {p.upper()} | {m} | {'yes' if better else 'no'} | {pct(rel)} | {pct(rel_med)} | "
-                                f"{pval:.2e} | {'yes' if pval < 0.05 else 'no'} |")
+            verdict_rows.append(f"| {p.upper()} | {m} | {'yes' if better else 'no'} | {signed_percent(rel)} | "
+                                f"{signed_percent(rel_med)} | {pval:.2e} | {'yes' if pval < 0.05 else 'no'} |")
     return {"seed_table_rows": "\n".join(seed_rows), "budget_rows": "\n".join(budget_rows),
             "verdict_rows": "\n".join(verdict_rows)}
 

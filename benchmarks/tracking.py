@@ -17,12 +17,11 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.cases import load_case
-from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control import PID, FuzzyPID, Hysteresis, compare_tracking
 from pymoo_rail.experiments import Study, algorithm, best_run, build_problem, load_results, problem, run_study
 from pymoo_rail.experiments.report import fill_template, lower_priority, write_report
 from pymoo_rail.optimal.baselines import constant_cruise
-from pymoo_rail.plotting import save_figure
+from pymoo_rail.plotting import plot_speed_runs, save_figure
 from pymoo_rail.plotting.style import new_figure
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.sim import Simulator, switching_programs
@@ -124,18 +123,12 @@ def metro_report(curves, table, runs, args) -> dict:
 
 def yizhuang_figures(curves, runs, args) -> None:
     """The tracked profiles for each B beside the DE-tracked curve (cf. fig. 5-8), and table 5-7 as a figure."""
-    fig, axes = new_figure(2, 2, figsize=(12, 7.5), sharex=True, sharey=True)
-    ref = curves["DE tracked"][0]
-    for ax, b in zip(axes.ravel(), B_VALUES):
-        tr = runs["DE tracked", "nominal", args.period, b]
-        ax.plot(ref.position_m, ref.speed_kmh, "r-", lw=1.2, label="recommended (ideal run)")
-        ax.plot(tr.position_m, tr.speed_kmh, "b--", lw=1.0, label="tracked")
-        ax.plot(tr.position_m, tr.limit_ms * KMH_PER_MS, "k:", lw=0.8, label="limit")
-        ax.set(title=f"A = {A_KMH:g}, B = {b:g} km/h: {tr.energy.net_kwh:.2f} kWh, {tr.running_time_s:.1f} s",
-               xlabel="position (m)", ylabel="speed (km/h)")
-        ax.grid(alpha=0.3)
-    axes[0, 0].legend(loc="lower center", fontsize=8)
-    save_figure(fig, args.out / "tracking_yizhuang_profiles.png", dpi=110)
+    ref, tracked = curves["DE tracked"][0], {b: runs["DE tracked", "nominal", args.period, b] for b in B_VALUES}
+    panels = [(f"A = {A_KMH:g}, B = {b:g} km/h: {tr.energy.net_kwh:.2f} kWh, {tr.running_time_s:.1f} s",
+               [("recommended (ideal run)", ref.position_m, ref.speed_ms, "r", "-"),
+                ("tracked", tr.position_m, tr.speed_ms, "b", "--"), ("limit", tr.position_m, tr.limit_ms, "k", ":")])
+              for b, tr in tracked.items()]
+    save_figure(plot_speed_runs(panels, figsize=(12, 7.5)), args.out / "tracking_yizhuang_profiles.png", dpi=110)
     fig, axes = new_figure(1, 2, figsize=(11, 4))
     for k, (ax, unit) in enumerate(zip(axes[0], ("net energy (kWh)", "running time (s)"))):
         for n in curves:

@@ -217,9 +217,12 @@ def mean_std(values, digits: int = 4) -> str:
 
 
 # ------------------------------------------------------------------------------------ markdown
-def markdown_rows(header: Sequence, rows: Iterable[Sequence]) -> str:
-    """A GitHub markdown table of already formatted cells (``str`` of each)."""
-    lines = ["| " + " | ".join(map(str, header)) + " |", "|" + "---|" * len(header)]
+def markdown_rows(header: Sequence, rows: Iterable[Sequence], right_from: int | None = None) -> str:
+    """A GitHub markdown table of already formatted cells (``str`` of each); the columns from index
+    ``right_from`` on (none by default) right-aligned, as numbers read best."""
+    right = len(header) if right_from is None else right_from
+    lines = ["| " + " | ".join(map(str, header)) + " |",
+             "|" + "".join("---:|" if i >= right else "---|" for i in range(len(header)))]
     lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
     return "\n".join(lines)
 

@@ -114,6 +114,33 @@ def compare_means(sample: Sequence[float], baseline: Sequence[float],
     return bool(better), float(rel), rank_sum(a, b)[1]
 
 
+def describe_comparison(result: tuple[bool, float, float], alpha: float = 0.05) -> str:
+    """A :func:`compare_means` result in words: ``better (-11.5 %, p = 3e-11)``, ``worse (...)`` or
+    ``no significant difference (...)`` (p >= ``alpha``); differences under 1 % get two decimals."""
+    better, rel, pval = result
+    word = "no significant difference" if pval >= alpha else "better" if better else "worse"
+    return f"{word} ({signed_percent(rel)}, p = {pval:.2g})"
+
+
+def signed_percent(rel: float) -> str:
+    """A relative difference in percent with its sign: two decimals under 1 %, one above."""
+    return f"{rel:+.2f} %" if abs(rel) < 1.0 else f"{rel:+.1f} %"
+
+
+def median_run(rows: Sequence[Mapping], problem: str, algorithm: str, key: str = "hv_ref",
+               lower_better: bool = False) -> Mapping:
+    """The run of ``algorithm`` on ``problem`` with the median ``key``, among per-run dicts.
+
+    Runs are ordered best first (NaN last, ties by seed); for an even count the better of the two
+    middle runs is returned. Each row needs ``problem``, ``algorithm``, ``seed`` and ``key``.
+    """
+    runs = sorted((r for r in rows if r["problem"] == problem and r["algorithm"] == algorithm),
+                  key=lambda r: ((r[key] if lower_better else -r[key]) if np.isfinite(r[key]) else np.inf, r["seed"]))
+    if not runs:
+        raise ValueError(f"rows: no run of algorithm {algorithm!r} on problem {problem!r}")
+    return runs[(len(runs) - 1) // 2]
+
+
 def rank_sum_tests(results: pd.DataFrame, baseline: str, indicators: Sequence[str] | None = None,
                    alpha: float = 0.05) -> pd.DataFrame:
     """Each algorithm against ``baseline`` on each problem and indicator (see :func:`rank_sum`).
@@ -403,7 +430,7 @@ def write_tables(results: pd.DataFrame, directory: str | Path, baseline: str | N
     return written
 
 
-__all__ = ["summarize", "rank_sum", "rank_sum_tests", "indicator_table", "missing_reason", "verdict_counts", "reference_fronts",
+__all__ = ["summarize", "rank_sum", "median_run", "describe_comparison", "signed_percent", "rank_sum_tests", "indicator_table", "missing_reason", "verdict_counts", "reference_fronts",
            "add_reference_indicators", "add_energy_gap", "to_markdown", "write_tables", "nondominated",
            "gd_van_veldhuizen", "friedman_holm", "holm", "RankTest"]
 

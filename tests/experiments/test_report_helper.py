@@ -33,6 +33,7 @@ def test_markdown_formats_float_cells_only(tmp_path):
                                                "| a | 3 | 1.23 |", "| b | 4 | nan |"]
     assert markdown(frame, 1, missing="-").splitlines()[-1] == "| b | 4 | - |"
     assert markdown_rows(["x", "y"], [[1, "z"]]) == "| x | y |\n|---|---|\n| 1 | z |"
+    assert markdown_rows(["x", "y", "w"], [[1, "z", 2]], right_from=1).splitlines()[1] == "|---|---:|---:|"
     path = write_report(tmp_path / "r.md", ["# title", "", "text"])
     assert path.read_text() == "# title\n\ntext\n"
     assert write_report(tmp_path / "s.md", ["a", "b"], newline=False).read_text() == "a\nb"
