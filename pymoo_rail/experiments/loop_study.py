@@ -20,6 +20,7 @@ from typing import Callable, Mapping, Sequence
 
 import pandas as pd
 
+from pymoo_rail.control.closed_loop import LoopDisturbance
 from pymoo_rail.control.controllers import Controller
 from pymoo_rail.control.policy import OptimalPolicy
 from pymoo_rail.control.study import (STUDY_CONTROLLERS, TUNED_CONTROLLERS, draw_loop_disturbances, study_planned_time,
@@ -226,3 +227,39 @@ def tests_markdown(tests: pd.DataFrame) -> str:
              _na(r["median_against"], 3), _na(r["p_value"], 4), r["verdict"]] for _, r in tests.iterrows()]
     return markdown_rows(["case", "controller", "against", "measure", "median", "median of tracking", "p", "verdict"],
                          rows)
+
+
+def disturbance_rows(cases: Sequence[Case], worlds: Mapping[str, LoopDisturbance],
+                     controllers: Sequence[str]) -> pd.DataFrame:
+    """Each case (planned as in the closed-loop study) in single worlds of one disturbance each, driven by
+    every controller (:func:`pymoo_rail.control.study.world_rows`); column ``world`` holds the world's label."""
+    rows = []
+    for case in cases:
+        planned = study_planned_time(case)
+        policy = OptimalPolicy(case, planned)
+        for k, (label, world) in enumerate(worlds.items()):
+            rows += [dict(r, world=label) for r in world_rows(case, k, world, policy, planned, controllers)]
+    return pd.DataFrame(rows)
+
+
+def disturbance_markdown(runs: pd.DataFrame, controllers: Sequence[str]) -> str:
+    """Per case and world, each controller's ``gap_pct`` and lateness, as markdown."""
+    rows = []
+    for (case, label), g in runs.groupby(["case", "world"], sort=False):
+        cells = g.set_index("controller")
+        rows.append([case, label, *(f"{cells.loc[c, 'gap_pct']:.2f} % ({cells.loc[c, 'lateness_s']:+.2f} s)"
+                                    for c in controllers)])
+    return markdown_rows(["case", "disturbance", *controllers], rows)
+
+
+def latency_markdown(rows: Sequence[Mapping]) -> str:
+    """The rows of :func:`pymoo_rail.control.study.replan_latency` as markdown, with fresh solve / warm re-plan."""
+    header = ["case", "km", "re-plans (flat out)", "policy built s", "in the loop median / p90 ms",
+              "warm median / p90 ms", "warm median, first half of the line ms", "warm median, on-time plans only ms",
+              "fresh exact solve s", "fresh / warm median", "fresh / warm first half"]
+    return markdown_rows(header, [
+        [r["case"], f"{r['length_km']:.1f}", f"{r['replans']} ({r['fastest']})", f"{r['build_s']:.2f}",
+         f"{r['loop_median_ms']:.1f} / {r['loop_p90_ms']:.1f}", f"{r['warm_median_ms']:.1f} / {r['warm_p90_ms']:.1f}",
+         f"{r['first_half_ms']:.1f}", f"{r['on_time_plans_ms']:.1f}", f"{r['fresh_s']:.2f}",
+         f"{1000 * r['fresh_s'] / r['warm_median_ms']:.0f}x", f"{1000 * r['fresh_s'] / r['first_half_ms']:.0f}x"]
+        for r in rows])
