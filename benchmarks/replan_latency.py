@@ -26,21 +26,10 @@ import numba
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.control.study import replan_latency, study_planned_time
+from pymoo_rail.experiments.loop_study import latency_markdown
+from pymoo_rail.experiments.report import write_filled
 
-REPORTS = Path(__file__).parent / "reports"
-
-
-def table(rows: list[dict]) -> list[str]:
-    lines = ["| case | km | re-plans (flat out) | policy built s | in the loop median / p90 ms | warm median / p90 ms "
-             "| warm median, first half of the line ms | warm median, on-time plans only ms | fresh exact solve s "
-             "| fresh / warm median | fresh / warm first half |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in rows:
-        lines.append(f"| {r['case']} | {r['length_km']:.1f} | {r['replans']} ({r['fastest']}) | {r['build_s']:.2f} "
-                     f"| {r['loop_median_ms']:.1f} / {r['loop_p90_ms']:.1f} | {r['warm_median_ms']:.1f} / "
-                     f"{r['warm_p90_ms']:.1f} | {r['first_half_ms']:.1f} | {r['on_time_plans_ms']:.1f} | {r['fresh_s']:.2f} "
-                     f"| {1000 * r['fresh_s'] / r['warm_median_ms']:.0f}x | {1000 * r['fresh_s'] / r['first_half_ms']:.0f}x |")
-    return lines
+HERE = Path(__file__).parent
 
 
 def main() -> None:
@@ -55,17 +44,10 @@ def main() -> None:
     for name in args.cases:
         case = load_case(name)
         rows.append(replan_latency(case, study_planned_time(case), args.worlds, args.seed))
-    lines = ["# Re-planning latency", "",
-             f"Produced by `benchmarks/replan_latency.py --cases {' '.join(args.cases)} --worlds {args.worlds} "
-             f"--seed {args.seed}` in {time.process_time() - started:.0f} s of CPU, one Numba thread "
-             f"(load average {os.getloadavg()[0]:.1f}), each case planned as in the closed-loop study "
-             "(`study_planned_time`). CPU time per re-plan (process time), over the states the "
-             "re-planning controller met in closed-loop runs of seeded disturbed worlds; warm: again from the same "
-             "states right after each world's run; a fresh exact solve of the whole run at the planned time (new "
-             "solver) in the same process.", ""] + table(rows)
-    text = "\n".join(lines) + "\n"
-    (REPORTS / "replan_latency.md").write_text(text, encoding="utf-8")
-    print(text)
+    print(write_filled(HERE / "reports" / "replan_latency.md", HERE / "templates" / "replan_latency.md", {
+        "cases": " ".join(args.cases), "worlds": args.worlds, "seed": args.seed,
+        "cpu_s": f"{time.process_time() - started:.0f}", "load": f"{os.getloadavg()[0]:.1f}",
+        "table": latency_markdown(rows)}))
 
 
 if __name__ == "__main__":

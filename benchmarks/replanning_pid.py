@@ -16,15 +16,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import pandas as pd
-
 from pymoo_rail.cases import load_case
-from pymoo_rail.control import OptimalPolicy
 from pymoo_rail.control.closed_loop import LoopDisturbance
-from pymoo_rail.control.study import study_planned_time, world_rows
-from pymoo_rail.experiments.report import lower_priority
+from pymoo_rail.experiments.loop_study import disturbance_markdown, disturbance_rows
+from pymoo_rail.experiments.report import lower_priority, write_filled
 
-REPORTS = Path(__file__).parent / "reports"
+HERE = Path(__file__).parent
 WORLDS = {"none": LoopDisturbance(),
           "speed noise 0.3 km/h": LoopDisturbance(speed_noise_kmh=0.3, noise_seed=1),
           "mass and resistance +10 %, traction lag 0.3 s": LoopDisturbance(mass_factor=1.1, resistance_factor=1.1,
@@ -38,25 +35,9 @@ def main() -> None:
     parser.add_argument("--cases", nargs="+", default=["yizhuang", "metro-a"])
     args = parser.parse_args()
     lower_priority()
-    rows = []
-    for name in args.cases:
-        case = load_case(name)
-        planned = study_planned_time(case)
-        policy = OptimalPolicy(case, planned)
-        for k, (label, world) in enumerate(WORLDS.items()):
-            rows += [dict(r, world=label) for r in world_rows(case, k, world, policy, planned, CONTROLLERS)]
-    runs = pd.DataFrame(rows)
-    lines = ["# Re-planning tracked by a PID, one disturbance at a time", "",
-             f"Produced by `benchmarks/replanning_pid.py --cases {' '.join(args.cases)}`. Energy above the real "
-             "train's exact optimum at the run's own running time (%), lateness in s.", "",
-             "| case | disturbance | " + " | ".join(CONTROLLERS) + " |", "|---|---|" + "---|" * len(CONTROLLERS)]
-    for (case, label), g in runs.groupby(["case", "world"], sort=False):
-        cells = g.set_index("controller")
-        lines.append(f"| {case} | {label} | " + " | ".join(
-            f"{cells.loc[c, 'gap_pct']:.2f} % ({cells.loc[c, 'lateness_s']:+.2f} s)" for c in CONTROLLERS) + " |")
-    text = "\n".join(lines) + "\n"
-    (REPORTS / "replanning_pid.md").write_text(text, encoding="utf-8")
-    print(text)
+    runs = disturbance_rows([load_case(name) for name in args.cases], WORLDS, CONTROLLERS)
+    print(write_filled(HERE / "reports" / "replanning_pid.md", HERE / "templates" / "replanning_pid.md",
+                       {"cases": " ".join(args.cases), "table": disturbance_markdown(runs, CONTROLLERS)}))
 
 
 if __name__ == "__main__":

@@ -16,70 +16,10 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import os
-import tempfile
-import time
-
-import numpy as np
-import pandas as pd
 
 from pymoo_rail.cases import KINDS
-from pymoo_rail.optimal import reference
-from pymoo_rail.suite import get_problem, list_families
-
-N_VARS = (10, 30, 100, 300, 1000)
-BATCH = 100
-
-
-def evaluations_per_s(problem, min_cpu_s: float) -> float:
-    """Evaluations per CPU second of batches of :data:`BATCH` random vectors (first batch untimed: compilation)."""
-    rng = np.random.default_rng(0)
-    X = rng.uniform(problem.xl, problem.xu, (BATCH, problem.n_var))
-    problem.evaluate(X)
-    done, start = 0, time.process_time()
-    while time.process_time() - start < min_cpu_s:
-        problem.evaluate(X)
-        done += BATCH
-    return done / (time.process_time() - start)
-
-
-def throughput_table(families, n_vars, seed: int, min_cpu_s: float) -> pd.DataFrame:
-    """One row per family and n_var: evaluations per CPU second."""
-    rows = []
-    for name in families:
-        for n_var in n_vars:
-            problem = get_problem(name, n_var=n_var, seed=seed)
-            rows.append({"family": name, "n_var": n_var, "evals_per_cpu_s": round(evaluations_per_s(problem, min_cpu_s))})
-            print(rows[-1], flush=True)
-    return pd.DataFrame(rows)
-
-
-def front_cpu_s(name: str, n_var: int, seed: int) -> tuple[float, int]:
-    """CPU seconds of ``pareto_front()`` of an instance and the number of front nodes."""
-    reference.forget_fronts()  # memory off: the disk cache or the solver answers
-    problem = get_problem(name, n_var=n_var, seed=seed)
-    start = time.process_time()
-    problem.pareto_front()
-    return time.process_time() - start, len(problem.certified_front().table)
-
-
-def front_table(kinds, seed: int) -> pd.DataFrame:
-    """Per kind: the front of n_var 300 (seed), of n_var 1000 (seed + 1), both cold, then n_var 1000 of seed cached."""
-    rows = []
-    with tempfile.TemporaryDirectory() as cache:
-        os.environ[reference.CACHE_ENV] = cache  # nothing computed before is served
-        for kind in kinds:
-            name = f"generated-{kind}-bi"
-            for n_var, s, what in ((300, seed, "computed"), (1000, seed + 1, "computed"), (1000, seed, "disk cache")):
-                line_km = get_problem(name, n_var=10, seed=s).case.line.length_m / 1000
-                row = {"family": name, "n_var": n_var, "seed": s, "line_km": round(line_km, 1)}
-                try:
-                    cpu_s, nodes = front_cpu_s(name, n_var, s)
-                    rows.append({**row, "nodes": nodes, "front": what, "cpu_s": round(cpu_s, 2)})
-                except RuntimeError as err:  # the exact solver gives up on this line: say so, go on
-                    rows.append({**row, "nodes": 0, "front": f"failed: {str(err)[:60]}", "cpu_s": float("nan")})
-                print(rows[-1], flush=True)
-    return pd.DataFrame(rows)
+from pymoo_rail.experiments.family_cost import N_VARS, front_table, throughput_table
+from pymoo_rail.suite import list_families
 
 
 def main() -> None:

@@ -19,11 +19,16 @@ instance this code builds is refused: it was computed on another definition.
 
 from __future__ import annotations
 
+import hashlib
+import tarfile
+from dataclasses import replace
+from pathlib import Path
 from typing import Iterable, Sequence
 
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.experiments.spec import Budget
 from pymoo_rail.experiments.stats import friedman_holm
 from pymoo_rail.optimal.reference import certified_gap
 from pymoo_rail.suite import get_problem
@@ -141,5 +146,52 @@ def convergence(records: Iterable[dict], indicator: str = "igd") -> pd.DataFrame
     return pd.DataFrame(rows)
 
 
+def cut_study(study, families=None, ladder=None, seeds: int | None = None, n_eval: int | None = None):
+    """``study`` cut to the families and dimensions (n_var) asked for, seeds 1..``seeds`` and ``n_eval`` per run.
+
+    ``None`` (or empty) keeps the study's own. Raises ``SystemExit`` naming the cut when no problem is left.
+    """
+    problems = [p for p in study.problems if (not families or p.params["family"] in families)
+                and (not ladder or p.params["n_var"] in ladder)]
+    if not problems:
+        raise SystemExit(f"--families {families} --ladder {ladder}: no problem of the study {study.name} left")
+    study = replace(study, problems=tuple(problems))
+    if seeds:
+        study = replace(study, seeds=tuple(range(1, seeds + 1)))
+    return replace(study, budget=Budget("n_eval", n_eval)) if n_eval else study
+
+
+def projected_cpu_h(frame: pd.DataFrame, full) -> tuple[float, str]:
+    """CPU hours of the ``full`` study from measured CPU per evaluation (linear in n_var between measured sizes).
+
+    Per algorithm, the median over the stored runs (all families and seeds) of the CPU seconds per
+    evaluation, taken per n_var and interpolated (held constant outside the measured range), then
+    multiplied by the full study's evaluations, problems and seeds. The median keeps out the first
+    run of a process, which pays the compilation. Returns the hours and the measured sizes.
+    """
+    per_eval = frame.assign(s=frame["cpu_time_s"] / frame["n_eval"]).groupby(["algorithm", "n_var"])["s"].median()
+    total_s = 0.0
+    for a in full.algorithms:
+        if a.display not in per_eval.index.get_level_values(0):
+            raise SystemExit(f"--estimate: no stored run of {a.display}")
+        known = per_eval[a.display]
+        total_s += sum(np.interp(p.params["n_var"], known.index, known.to_numpy()) for p in full.problems)
+    sizes = ", ".join(str(n) for n in sorted(frame["n_var"].unique()))
+    return total_s * full.budget.value * len(full.seeds) / 3600, sizes
+
+
+def archive_records(work: str | Path, path: str | Path, top: str = "suite_baseline") -> str:
+    """Pack the study file and every record of the study folder ``work`` into ``path`` (.tar.gz, under ``top``/).
+
+    Returns the archive's SHA-256 (hex).
+    """
+    work, path = Path(work), Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with tarfile.open(path, "w:gz") as tar:
+        for member in sorted(p for p in work.rglob("*") if p.is_file() and p.suffix in (".json", ".toml")):
+            tar.add(member, arcname=str(Path(top) / member.relative_to(work)))
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
 __all__ = ["INDICATORS", "RANK_INDICATOR", "instance_of", "baseline_indicators", "indicator_frame", "baseline_table",
-           "performance_profile", "convergence"]
+           "performance_profile", "convergence", "cut_study", "projected_cpu_h", "archive_records"]

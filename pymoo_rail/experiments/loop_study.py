@@ -20,9 +20,12 @@ from typing import Callable, Mapping, Sequence
 
 import pandas as pd
 
+from pymoo_rail.control.closed_loop import LoopDisturbance
 from pymoo_rail.control.controllers import Controller
 from pymoo_rail.control.policy import OptimalPolicy
-from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, draw_loop_disturbances, world_rows
+from pymoo_rail.control.study import (STUDY_CONTROLLERS, TUNED_CONTROLLERS, draw_loop_disturbances, study_planned_time,
+                                      world_rows)
+from pymoo_rail.experiments.report import fixed, markdown_rows
 from pymoo_rail.experiments.stats import signed_rank_vs
 from pymoo_rail.experiments.store import ResultStore, record_checksum
 from pymoo_rail.model import Case
@@ -169,3 +172,94 @@ def loop_tests(runs: pd.DataFrame, tracking: Sequence[str]) -> pd.DataFrame:
                              "median": float(a.median()), "median_against": float(b.median()), "p_value": p,
                              "verdict": verdict})
     return pd.DataFrame(rows)
+
+
+def study_items(cases: Sequence[Case], runs: int, runs_long: int, tune: bool,
+                say: Callable[[str], None] = print) -> list[LoopStudyCase]:
+    """Each case with its planned time, worlds (``runs``, ``runs_long`` over 10 km) and, with ``tune``,
+    the PID and fuzzy PID tuned on its plan (:func:`tuned_trackers`)."""
+    items = []
+    for case in cases:
+        planned = study_planned_time(case)
+        n = runs if case.line.length_m <= 10_000 else runs_long
+        tuned = {}
+        if tune:
+            tuned = tuned_trackers(case, OptimalPolicy(case, planned, certify=False).plan)
+            say(f"{case.name}: tuned {tuned}")
+        items.append(LoopStudyCase(case, planned, n, tuned))
+    return items
+
+
+def _na(value, digits: int = 2) -> str:
+    return fixed(value, digits, missing="n/a")
+
+
+def summary_markdown(summary: pd.DataFrame) -> str:
+    """The per case and controller table of :func:`pymoo_rail.control.study.loop_summary`, as markdown."""
+    header = ["case", "controller", "median gap to exact %", "median cost kWh", "median energy kWh",
+              "median lateness s", "on time (of possible)", "late", "median stop error m",
+              "median accel. variation m/s^2", "s per advice change", "ms per re-plan"]
+    rows = [[r["case"], r["controller"], _na(r["median_gap_pct"]), _na(r["median_cost_kwh"], 3),
+             _na(r["median_net_kwh"], 3), _na(r["median_lateness_s"]),
+             f"{_na(100 * r['on_time_share'], 0)} % of {int(r['n_can_be_on_time'])}",
+             f"{_na(100 * r['late_share'], 0)} %",
+             _na(r["median_stop_error_m"], 3), _na(r["median_jerk_ms2"]), _na(r["median_seconds_per_change"], 1),
+             _na(r["median_decision_cpu_ms"], 1)] for _, r in summary.iterrows()]
+    return markdown_rows(header, rows)
+
+
+def advice_markdown(runs: pd.DataFrame) -> str:
+    """Per case, the advised run's ``cost_kwh`` over ``optimal_controls``' in the same worlds (median, 90th
+    percentile, worlds over 1 %), as markdown."""
+    rows = []
+    for case, g in runs.groupby("case", sort=False):
+        adv = g[g["controller"] == "advice"].set_index("run")["cost_kwh"]
+        opt = g[g["controller"] == "optimal_controls"].set_index("run")["cost_kwh"]
+        extra = 100.0 * (adv / opt.reindex(adv.index) - 1.0)
+        rows.append([case, len(extra), f"{extra.median():+.2f} %", f"{extra.quantile(0.9):+.2f} %",
+                     int((extra > 1.0).sum())])
+    return markdown_rows(["case", "worlds", "median extra cost", "90th percentile", "worlds over 1 %"], rows)
+
+
+def tests_markdown(tests: pd.DataFrame) -> str:
+    """The tests of :func:`loop_tests` as markdown."""
+    rows = [[r["case"], r["controller"], r["against"], r["measure"], _na(r["median"], 3),
+             _na(r["median_against"], 3), _na(r["p_value"], 4), r["verdict"]] for _, r in tests.iterrows()]
+    return markdown_rows(["case", "controller", "against", "measure", "median", "median of tracking", "p", "verdict"],
+                         rows)
+
+
+def disturbance_rows(cases: Sequence[Case], worlds: Mapping[str, LoopDisturbance],
+                     controllers: Sequence[str]) -> pd.DataFrame:
+    """Each case (planned as in the closed-loop study) in single worlds of one disturbance each, driven by
+    every controller (:func:`pymoo_rail.control.study.world_rows`); column ``world`` holds the world's label."""
+    rows = []
+    for case in cases:
+        planned = study_planned_time(case)
+        policy = OptimalPolicy(case, planned)
+        for k, (label, world) in enumerate(worlds.items()):
+            rows += [dict(r, world=label) for r in world_rows(case, k, world, policy, planned, controllers)]
+    return pd.DataFrame(rows)
+
+
+def disturbance_markdown(runs: pd.DataFrame, controllers: Sequence[str]) -> str:
+    """Per case and world, each controller's ``gap_pct`` and lateness, as markdown."""
+    rows = []
+    for (case, label), g in runs.groupby(["case", "world"], sort=False):
+        cells = g.set_index("controller")
+        rows.append([case, label, *(f"{cells.loc[c, 'gap_pct']:.2f} % ({cells.loc[c, 'lateness_s']:+.2f} s)"
+                                    for c in controllers)])
+    return markdown_rows(["case", "disturbance", *controllers], rows)
+
+
+def latency_markdown(rows: Sequence[Mapping]) -> str:
+    """The rows of :func:`pymoo_rail.control.study.replan_latency` as markdown, with fresh solve / warm re-plan."""
+    header = ["case", "km", "re-plans (flat out)", "policy built s", "in the loop median / p90 ms",
+              "warm median / p90 ms", "warm median, first half of the line ms", "warm median, on-time plans only ms",
+              "fresh exact solve s", "fresh / warm median", "fresh / warm first half"]
+    return markdown_rows(header, [
+        [r["case"], f"{r['length_km']:.1f}", f"{r['replans']} ({r['fastest']})", f"{r['build_s']:.2f}",
+         f"{r['loop_median_ms']:.1f} / {r['loop_p90_ms']:.1f}", f"{r['warm_median_ms']:.1f} / {r['warm_p90_ms']:.1f}",
+         f"{r['first_half_ms']:.1f}", f"{r['on_time_plans_ms']:.1f}", f"{r['fresh_s']:.2f}",
+         f"{1000 * r['fresh_s'] / r['warm_median_ms']:.0f}x", f"{1000 * r['fresh_s'] / r['first_half_ms']:.0f}x"]
+        for r in rows])

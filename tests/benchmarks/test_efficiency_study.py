@@ -1,9 +1,8 @@
-"""benchmarks/efficiency_study.py: the findings are computed from the table (fast; the study itself
-needs an ms-eetc checkout and minutes: ``python benchmarks/efficiency_study.py --mseetc PATH``)."""
+"""benchmarks/efficiency_study.py and pymoo_rail.experiments.efficiency_study: the findings are
+computed from the table (fast; the study itself needs an ms-eetc checkout and minutes: ``python benchmarks/efficiency_study.py --mseetc PATH``)."""
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 from pathlib import Path
@@ -11,11 +10,14 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from pymoo_rail.experiments.report import fill_template
+
 MSEETC = Path(os.environ.get("MSEETC_CHECKOUT", "/tmp/mseetc"))
 
 
 def test_findings_name_the_ranges_of_the_table():
     from benchmarks import efficiency_study
+    from pymoo_rail.experiments.efficiency_study import findings
 
     rows = []
     for reserve, (own, dyn, ours, replayed, theirs) in {10: (0.2, -0.1, 123.0, 120.0, 120.5),
@@ -24,7 +26,10 @@ def test_findings_name_the_ranges_of_the_table():
                  {"reserve_pct": reserve, "model": "static", "own_diff_pct": 0.1, "dynamic_diff_pct": 0.5},
                  {"reserve_pct": reserve, "model": "dynamic", "own_diff_pct": 2.0, "dynamic_diff_pct": 2.0,
                   "ours_dynamic_kwh": ours, "mseetc_run_in_ours_kwh": replayed, "mseetc_dynamic_kwh": theirs}]
-    text = "\n".join(efficiency_study.findings(pd.DataFrame(rows)))
+    values = findings(pd.DataFrame(rows))
+    assert values["own_within"] == "0.30"  # the largest |own_diff_pct| of the fixed models
+    text = fill_template(efficiency_study.TEMPLATE, {"intervals": 300, "reserves": "10 20", "held": 0,
+                                                     "table": "", **values})
     assert "within 0.30 %" in text  # the largest |own_diff_pct| of the fixed models
     assert "-0.10 to +1.50 %" in text
     assert "-0.41 to +0.00 %" in text  # 120 / 120.5 - 1 and 108 / 108 - 1
@@ -57,12 +62,12 @@ def test_mseetc_study_driver_returns_the_run_and_the_losses():
     """ms-eetc under its dynamic losses at N = 100, with a small loss grid (~30 s)."""
     from benchmarks import efficiency_study as study
     from pymoo_rail.cases import load_case
+    from pymoo_rail.experiments.efficiency_study import mseetc_run
     from pymoo_rail.optimal import efficiency_study as es
 
     case = es.study_case(load_case(study.BASE_CASE))
-    args = argparse.Namespace(mseetc=MSEETC, mseetc_python=sys.executable, intervals=100)
     grid = {"speeds_ms": [10.0, 30.0], "forces_n": [[50e3, -50e3], [50e3, -50e3]]}
-    result = study.mseetc(args, case, es.STUDY_MIN_TIME_S * 1.2, "dynamic", grid)
+    result = mseetc_run(MSEETC, sys.executable, 100, case, es.STUDY_MIN_TIME_S * 1.2, "dynamic", grid)
     assert len(result["loss_w"]) == 2 and all(loss > 27e3 for row in result["loss_w"] for loss in row)
     assert result["position_m"][-1] == pytest.approx(8500.0) and result["speed_ms"][-1] == pytest.approx(100 / 3.6)
     # its midpoint energy and its CVODES-integrated one agree

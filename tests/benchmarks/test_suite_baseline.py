@@ -1,4 +1,5 @@
-"""benchmarks/suite_baseline.py: the study file's size, its reduction options and the records archive."""
+"""benchmarks/suite_baseline.py's study file, its reductions (``pymoo_rail.experiments.baseline.cut_study``),
+the records archive, the CPU projection and the figures."""
 
 from __future__ import annotations
 
@@ -8,16 +9,19 @@ import tarfile
 import pytest
 
 
-def _script():
-    from benchmarks import suite_baseline
+def _study(*cut):
+    """The study file cut to (families, ladder, seeds, n_eval)."""
+    from benchmarks.suite_baseline import STUDY_FILE
+    from pymoo_rail.experiments import read_study
+    from pymoo_rail.experiments.baseline import cut_study
 
-    return suite_baseline
+    return cut_study(read_study(STUDY_FILE), *cut)
 
 
 def test_the_full_study_is_every_bi_family_on_the_ladder_with_seven_algorithms_and_31_seeds():
     from pymoo_rail.suite import list_families
 
-    study = _script().build_study(None, None, None, None)
+    study = _study(None, None, None, None)
     bi = {name for name in list_families() if name.endswith("-bi")}
     assert {p.params["family"] for p in study.problems} == bi
     assert sorted({p.params["n_var"] for p in study.problems}) == [10, 30, 100, 300, 1000]
@@ -28,7 +32,7 @@ def test_the_full_study_is_every_bi_family_on_the_ladder_with_seven_algorithms_a
 
 
 def test_reductions_cut_the_study():
-    study = _script().build_study(["generated-metro-bi"], [10, 30], 5, 2000)
+    study = _study(["generated-metro-bi"], [10, 30], 5, 2000)
     assert [p.display for p in study.problems] == ["generated-metro-bi/10", "generated-metro-bi/30"]
     assert study.seeds == (1, 2, 3, 4, 5)
     assert study.budget.value == 2000
@@ -36,7 +40,7 @@ def test_reductions_cut_the_study():
 
 def test_a_reduction_that_leaves_nothing_says_so():
     with pytest.raises(SystemExit, match="no problem"):
-        _script().build_study(["atlantis-bi"], None, None, None)
+        _study(["atlantis-bi"], None, None, None)
 
 
 def test_the_archive_holds_the_records_and_its_checksum_is_the_files(tmp_path):
@@ -46,7 +50,9 @@ def test_the_archive_holds_the_records_and_its_checksum_is_the_files(tmp_path):
     (work / "study.toml").write_text('name = "x"')
     (work / "runs" / "a.json.lock").write_text("")
     path = tmp_path / "records.tar.gz"
-    digest = _script().archive(work, path)
+    from pymoo_rail.experiments.baseline import archive_records
+
+    digest = archive_records(work, path)
     assert digest == hashlib.sha256(path.read_bytes()).hexdigest()
     with tarfile.open(path) as tar:
         assert sorted(tar.getnames()) == ["suite_baseline/runs/a.json", "suite_baseline/study.toml"]
@@ -55,15 +61,30 @@ def test_the_archive_holds_the_records_and_its_checksum_is_the_files(tmp_path):
 def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
     import pandas as pd
 
-    script = _script()
-    full = script.build_study(["generated-metro-bi"], [10, 30, 100], 2, 1000)
+    from pymoo_rail.experiments.baseline import projected_cpu_h
+
+    full = _study(["generated-metro-bi"], [10, 30, 100], 2, 1000)
     names = [a.display for a in full.algorithms]
     # 1 ms per evaluation at n_var 10, 3 ms at 100: 2 ms at 55 (not asked), 1.4444 ms at 30
     frame = pd.DataFrame([{"family": "generated-metro-bi", "algorithm": name, "n_var": n, "n_eval": 100,
                            "cpu_time_s": 0.1 if n == 10 else 0.3} for name in names for n in (10, 100)])
     # a first run of a process paying the compilation (10 x) does not move the median of three
     frame = pd.concat([frame, frame, frame.assign(cpu_time_s=frame["cpu_time_s"] * 10)], ignore_index=True)
-    hours, sizes = script.projected_cpu_h(frame, full)
+    hours, sizes = projected_cpu_h(frame, full)
     per_algorithm_s = (1e-3 + (1e-3 + 20 / 90 * 2e-3) + 3e-3) * 1000 * 2
     assert hours == pytest.approx(len(names) * per_algorithm_s / 3600)
     assert sizes == "10, 100"
+
+
+def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
+    import pandas as pd
+
+    from pymoo_rail.plotting import plot_cell_convergence, plot_performance_profile
+
+    history = pd.DataFrame([{"family": f, "n_var": n, "algorithm": a, "seed": s, "n_eval": e, "igd": 1.0 / e}
+                            for f in ("x-bi", "y-bi") for n in (10, 30) for a in ("A", "B") for s in (1, 2)
+                            for e in (100, 200)])
+    fig = plot_cell_convergence(history)
+    assert len(fig.axes) == 4 and all(len(ax.get_lines()) == 2 for ax in fig.axes)
+    profile = pd.DataFrame({"A": [0.5, 1.0], "B": [0.0, 1.0]}, index=pd.Index([1.0, 2.0], name="tau"))
+    assert len(plot_performance_profile(profile).axes[0].get_lines()) == 2

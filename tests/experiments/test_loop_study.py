@@ -56,3 +56,38 @@ def test_loop_tests_pair_the_worlds():
     assert gap.loc["better", "verdict"] == "+" and gap.loc["worse", "verdict"] == "-"
     assert gap.loc["tracking_b", "verdict"] == "-"
     assert (tests[tests["measure"] == "lateness_abs_s"]["verdict"] == "=").all()
+
+
+def test_the_advice_table_pairs_the_advised_run_with_the_policys_in_the_same_world():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import pandas as pd
+
+    from pymoo_rail.experiments.loop_study import advice_markdown
+    from pymoo_rail.plotting import plot_gap_lateness
+
+    runs = pd.DataFrame([{"case": "a", "controller": c, "run": r, "cost_kwh": cost, "lateness_s": 1.0, "gap_pct": 2.0}
+                         for r, (adv, opt) in enumerate([(100.5, 100.0), (103.0, 100.0), (99.0, 100.0)])
+                         for c, cost in (("advice", adv), ("optimal_controls", opt))])
+    rows = advice_markdown(runs.iloc[::-1]).splitlines()  # paired by world, not by order
+    assert rows[0] == "| case | worlds | median extra cost | 90th percentile | worlds over 1 % |"
+    assert rows[2] == "| a | 3 | +0.50 % | +2.50 % | 1 |"  # extra costs -1, +0.5, +3 %
+    fig = plot_gap_lateness(runs, ("advice", "optimal_controls"))
+    assert len(fig.axes) == 1 and len(fig.axes[0].collections) == 4  # each controller: its runs and its median
+
+
+def test_the_latency_and_disturbance_tables_say_what_the_rows_hold():
+    import pandas as pd
+
+    from pymoo_rail.experiments.loop_study import disturbance_markdown, latency_markdown
+
+    row = {"case": "a", "length_km": 2.34, "replans": 16, "fastest": 1, "build_s": 0.5, "loop_median_ms": 4.0,
+           "loop_p90_ms": 200.0, "warm_median_ms": 4.0, "warm_p90_ms": 100.0, "first_half_ms": 20.0,
+           "on_time_plans_ms": 3.0, "fresh_s": 0.4}
+    assert latency_markdown([row]).splitlines()[2] == (
+        "| a | 2.3 | 16 (1) | 0.50 | 4.0 / 200.0 | 4.0 / 100.0 | 20.0 | 3.0 | 0.40 | 100x | 20x |")
+    runs = pd.DataFrame([{"case": "a", "world": "none", "controller": c, "gap_pct": g, "lateness_s": late}
+                         for c, g, late in (("pid", 1.234, -0.5), ("policy", 0.1, 1.0))])
+    assert disturbance_markdown(runs, ("policy", "pid")).splitlines() == [
+        "| case | disturbance | policy | pid |", "|---|---|---|---|", "| a | none | 0.10 % (+1.00 s) | 1.23 % (-0.50 s) |"]

@@ -1,4 +1,4 @@
-"""benchmarks/peers.py: the parsing of ms-eetc's output (fast) and a live run when a checkout exists (slow)."""
+"""pymoo_rail.experiments.peers (benchmarks/peers.py's library): the parsing of ms-eetc's output (fast) and a live run when a checkout exists (slow)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ MSEETC_PYTHON = os.environ.get("MSEETC_PYTHON", "/work/venv-mseetc/bin/python")
 
 
 def _script():
-    from benchmarks import peers
+    from pymoo_rail.experiments import peers
 
     return peers
 
