@@ -326,8 +326,7 @@ def map_hold_speed(m, price_w, line_force_n, braking, v_top):
     return 0.5 * (lo + hi)
 
 
-@njit(cache=True)
-def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p):
+def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p) -> None:
     """The speeds at which holding is optimal for the price of time, at every grid node (Pontryagin).
 
     With time priced at ``lambda`` plus the auxiliary power (W), holding by partial traction is
@@ -341,34 +340,62 @@ def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p):
     efficiency map the speeds solve :func:`hold_stationarity` instead, the same condition with the
     map's efficiency and its slopes at the holding force of the cell (so they depend on the gradient).
     """
-    n = m.position_m.shape[0]
-    k_max = n_speeds - 1
-    # an efficiency map (not constant): the stationarity condition at the holding force, per cell
+    # Chosen here, in Python, so that a case without a map never compiles the map's bisections
+    # (about 1.5 s of a first run's compile): Numba compiles both branches of a jitted if.
     map_traction = m.traction_map_values.shape[0] > 0 and not map_is_constant(m.traction_map_values,
                                                                               m.traction_efficiency)
     map_regen = m.regen_map_values.shape[0] > 0 and not map_is_constant(m.regen_map_values, m.regen_efficiency)
+    if map_traction or map_regen:
+        v_hold, v_regen = map_holding_speeds(m, time_price_w, map_traction, map_regen)
+    else:
+        v_hold, v_regen = constant_holding_speeds(m, time_price_w)
+    place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p)
+
+
+@njit(cache=True)
+def constant_holding_speeds(m, time_price_w):
+    """``(V, W)`` per cell (m/s) with constant efficiencies: the closed form of :func:`psi_speed`
+    (``W`` 0 without regeneration or at or below its cut-off speed)."""
+    n_cells = time_price_w.shape[0]
+    v_hold, v_regen = np.zeros(n_cells), np.zeros(n_cells)
+    for i in range(n_cells):
+        price = time_price_w[i]
+        v_hold[i] = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
+        if m.regen_efficiency > 0.0:
+            w = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
+            v_regen[i] = w if w > m.regen_min_speed_ms else 0.0
+    return v_hold, v_regen
+
+
+@njit(cache=True)
+def map_holding_speeds(m, time_price_w, map_traction, map_regen):
+    """``(V, W)`` per cell (m/s) where a map is not constant: the root of :func:`hold_stationarity` at
+    the cell's holding force (the closed form for the side whose map is constant)."""
+    v_hold, v_regen = constant_holding_speeds(m, time_price_w)
+    for i in range(time_price_w.shape[0]):
+        price = time_price_w[i]
+        if map_traction:
+            v_hold[i] = map_hold_speed(m, price, m.line_force_n[i], False, m.envelope_ms[i])
+        if map_regen and m.regen_efficiency > 0.0:
+            w = map_hold_speed(m, price, m.line_force_n[i], True, m.envelope_ms[i])
+            v_regen[i] = w if w > m.regen_min_speed_ms else 0.0
+    return v_hold, v_regen
+
+
+@njit(cache=True)
+def place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p):
+    """Write the holding speeds of each cell into ``sing_v`` / ``sing_p`` (see :func:`singular_speeds`)."""
+    n = m.position_m.shape[0]
+    k_max = n_speeds - 1
     for i in range(n):
         for s in range(2):
             sing_v[i, s] = 0.0
             sing_p[i, s] = -1.0
         if i == n - 1:
             continue
-        price = time_price_w[i]
         top_u = m.envelope_ms[i] ** 2
-        if map_traction:
-            v_hold = map_hold_speed(m, price, m.line_force_n[i], False, m.envelope_ms[i])
-        else:
-            v_hold = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
-        v_regen = 0.0
-        if m.regen_efficiency > 0.0:
-            if map_regen:
-                v_regen = map_hold_speed(m, price, m.line_force_n[i], True, m.envelope_ms[i])
-            else:
-                v_regen = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
-            if v_regen <= m.regen_min_speed_ms:
-                v_regen = 0.0
         for s in range(2):
-            v = v_hold if s == 0 else v_regen
+            v = v_hold[i] if s == 0 else v_regen[i]
             if v <= 0.0 or v * v >= top_u:
                 continue
             p = node_position(top_u, v * v, k_max, bias)

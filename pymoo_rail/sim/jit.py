@@ -30,6 +30,10 @@ PACKAGE = "pymoo_rail"
 # (``no_cpython_wrapper`` would save a little compile, but a call from Python then crashes).
 inlined = njit(cache=True, forceinline=True, _nrt=False)
 """``njit`` for a kernel helper: inlined by LLVM into every caller, no reference counting."""
+called = njit(cache=True, _nrt=False)
+"""``njit`` for a helper off the hot path of a case without it (the efficiency-map lookup): compiled
+once and called, not inlined at every call site (inlined, its two bisections cost 4.4 s of the
+first run's compile, ``benchmarks/first_run.py``); no reference counting, as for :data:`inlined`."""
 NOTICE = ("compiling the simulator (first run only: Numba compiles the kernels once and caches them "
           "on disk; this takes a while on a small machine) ...")
 

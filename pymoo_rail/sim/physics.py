@@ -14,7 +14,7 @@ from numba import njit
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, InfeasibleCaseError, TrackGrid, build_grid
-from pymoo_rail.sim.jit import inlined
+from pymoo_rail.sim.jit import called, inlined
 
 
 class KernelModel(NamedTuple):
@@ -171,7 +171,7 @@ def electric_braking_capped(m, v, brake_n):
     return f
 
 
-@inlined
+@called
 def map_node(nodes, x):
     """Table cell of ``x`` among ascending ``nodes`` and the fraction across it (held at the edges)."""
     n = nodes.shape[0]
@@ -189,7 +189,7 @@ def map_node(nodes, x):
     return lo, (x - nodes[lo]) / (nodes[lo + 1] - nodes[lo])
 
 
-@inlined
+@called
 def map_efficiency(speeds, forces, values, v, f):
     """Bilinear efficiency of a map at speed ``v`` (m/s) and force magnitude ``f`` (N), the edge
     values beyond its nodes (``EfficiencyMap.efficiency`` in SI)."""
