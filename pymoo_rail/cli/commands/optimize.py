@@ -21,7 +21,7 @@ from pymoo_rail.problems.objectives import objectives_help
 ORDER = 20
 
 COMPILE_NOTICE = ("compiling the simulator and the exact solver (first run only: Numba compiles the kernels of the "
-                  "simulation, the batch evaluation and the dynamic programme once, about 15 s of CPU on a 2-core "
+                  "simulation, the batch evaluation and the dynamic programme once, about 18 s of CPU on a 2-core "
                   "machine, and caches them on disk) ...")
 
 DESCRIPTION = textwrap.dedent("""\
