@@ -28,6 +28,7 @@ from typing import Iterable, Sequence
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.experiments.registry import canonical_name
 from pymoo_rail.experiments.spec import Budget
 from pymoo_rail.experiments.stats import friedman_holm
 from pymoo_rail.optimal.reference import certified_gap
@@ -42,7 +43,7 @@ RANK_INDICATOR = "igd_plus"
 def instance_of(record: dict):
     """The suite family instance of a study record, refused when its checksum is not the record's."""
     params = record["problem"]
-    if params.get("problem") not in ("suite_family", "suite-family"):
+    if canonical_name(str(params.get("problem", ""))) != "suite_family":
         raise ValueError(f"record {record.get('run_id')}: problem {params.get('problem')!r} is not a suite family instance")
     problem = get_problem(params["family"], n_var=params.get("n_var"), seed=params.get("seed"))
     stored = record.get("inputs", {}).get("problem instance checksum")

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+from pymoo_rail.experiments.registry import canonical_name
 from pymoo_rail.experiments.spec import AlgorithmSpec, ProblemSpec, RunSpec, canonical_json
 
 # fingerprint keys that describe the code rather than the data of a run (see ``code_only``)
@@ -105,7 +106,7 @@ def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
         digest = _module_digest(spec.name)
         if digest is not None:
             out[f"{kind} module {spec.name.partition(':')[0]}"] = digest
-    if kind == "problem" and spec.name.replace("-", "_") == "suite_family":
+    if kind == "problem" and canonical_name(spec.name) == "suite_family":
         out["problem instance checksum"] = _instance_checksum(spec.params)
     for key, value in spec.params.items():
         if not isinstance(value, str):
