@@ -175,4 +175,4 @@ def test_line_variants_are_kept_within_bounds(metro, policy):
     for k in range(MAX_LINES_KEPT + 2):
         policy.replan(300.0, 15.0, 25.0, mass_t=metro.train.mass_t * (1.0 + 0.01 * (k + 1)))
     assert len(policy._lines) <= MAX_LINES_KEPT
-    assert (metro.train.mass_t, 1.0, None) in policy._lines  # the case's own line stays
+    assert (metro.train.mass_t, 1.0, 1.0, None) in policy._lines  # the case's own line stays
