@@ -226,7 +226,8 @@ class AdvisedDriving:
             return np.interp(x, x_run, v_run)
 
         resistance = self.estimator.factor if self.estimator is not None else None
-        board = fit_arrival(board, state, self.policy, self.speed_band_kmh, resistance)
+        board = fit_arrival(board, state, self.policy, self.speed_band_kmh, resistance, self.reaction_s - self.lead_s,
+                            speed_at)
         self.boards[-1] = (state.elapsed_s, state.position_m, board)
         now = current_advice(board, state.position_m)
         steps = [Advice(state.position_m, now.action, now.speed_kmh, now.final)]
@@ -262,15 +263,18 @@ class AdvisedDriving:
 
 
 def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_band_kmh: float = 3.0,
-                resistance_factor: float | None = None) -> tuple:
+                resistance_factor: float | None = None, reaction_s: float = 0.0, speed_at=None) -> tuple:
     """Move the switch into the last coast of ``board`` so that following it arrives at the planned time.
 
     Merging short regimes away (the short pulls a late train's re-plan asks for) changes the
     arrival; the switch from the last "power" or "hold" into coasting is moved to make up for it
     (by bisection on its position, simulated on the planner's model). A board that only coasts
     from here gets a "hold" of the speed now in front, ended where the time is met.
-    ``resistance_factor``: the planner's running resistance (:meth:`OptimalPolicy.replan`).
+    ``resistance_factor``: the planner's running resistance (:meth:`OptimalPolicy.replan`);
+    ``reaction_s`` and ``speed_at``: the driver's delay and the planned speed by position
+    (:func:`advice_program`), so that the switch is fitted for the driver who follows it late.
     """
+    speed_at = (lambda x: 0.0) if speed_at is None else speed_at
     if state.elapsed_s >= policy.planned_time_s:
         return board
     model = policy.model_ahead(state.position_m, state.speed_ms, state.restriction, state.mass_t,
@@ -281,7 +285,7 @@ def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_ban
     items = [Advice(state.position_m, now.action, now.speed_kmh, now.final)] + [
         a for a in board if a.start_m > state.position_m]
     coasts = [k for k in range(1, len(items)) if items[k].action == "coast" and items[k - 1].action in ("power", "hold")]
-    as_shown = advice_program(tuple(items), lambda x: 0.0, 0.0, length)
+    as_shown = advice_program(tuple(items), speed_at, reaction_s, length)
     out = sk.simulate_batch_serial(model, as_shown[None])[0]
     if out[sk.OUT_REACHED] > 0 and abs(out[sk.OUT_RUNNING_TIME_S] - remaining) <= ARRIVAL_TOL_S:
         return board  # on time as it is: no change to show
@@ -297,7 +301,7 @@ def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_ban
 
     def arrival(switch_m: float) -> float:
         trial = tuple(items[:k]) + (Advice(switch_m, "coast", items[k].speed_kmh),) + tuple(items[k + 1:])
-        program = advice_program(trial, lambda x: 0.0, 0.0, length)
+        program = advice_program(trial, speed_at, reaction_s, length)
         out = sk.simulate_batch_serial(model, program[None])[0]
         return out[sk.OUT_RUNNING_TIME_S] if out[sk.OUT_REACHED] > 0 else math.inf
 
