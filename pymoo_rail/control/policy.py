@@ -409,13 +409,11 @@ class OptimalPolicy:
             price_w = (1.0 - share) * price_w + share * self._price(k + 1)
             sing_v, sing_p, sing_val = np.zeros_like(sing_v), np.full_like(sing_p, -1.0), np.zeros_like(sing_val)
         n = model.position_m.shape[0]
-        modes = np.zeros(n - 1, dtype=np.int64)
-        targets = np.zeros(n - 1)
-        speeds = np.zeros(n)
         price = np.full(n - 1, price_w + model.aux_power_w)
-        done = dp.forward_rollout(model, price, np.ascontiguousarray(value), self.max_targets, self.bias, self.tie_j,
-                                  modes, targets, speeds, np.ascontiguousarray(sing_v), np.ascontiguousarray(sing_p),
-                                  np.ascontiguousarray(sing_val))[0]
+        # part-power traction among the controls where the train has a varying traction efficiency map
+        modes, targets, _, done, *_ = dp.forward_run(model, price, np.ascontiguousarray(value), self.max_targets,
+                                                     self.bias, self.tie_j, np.ascontiguousarray(sing_v),
+                                                     np.ascontiguousarray(sing_p), np.ascontiguousarray(sing_val))
         if done < n - 1:
             raise FieldError("speed_ms", speed_ms, f"leaves no way to the platform from {model.position_m[0]:.1f} m")
         return np.column_stack([model.position_m[1:], modes.astype(float), targets])

@@ -250,6 +250,15 @@ def closest_run(solver: OptimalSolver, slow: Solve | None, fast: Solve | None, t
     return best
 
 
+def replaced_rows(program: np.ndarray, rows: slice, mode: int) -> np.ndarray:
+    """A copy of ``program`` whose ``rows`` say ``mode`` (no target; full traction where the program
+    has a fourth column, the traction share of part-power rows)."""
+    p = program.copy()
+    p[rows, 1:3] = (mode, 0.0)
+    p[rows, 3:] = 1.0
+    return p
+
+
 def move_last_switch(solver: OptimalSolver, solution: Solve, target: float) -> Solve | None:
     """Move the run's last switch into the final coast until it takes the requested time.
 
@@ -272,16 +281,12 @@ def move_last_switch(solver: OptimalSolver, solution: Solve, target: float) -> S
         slow_end, fast_end = 0, n_cells - 1 - last
 
         def moved(j):
-            p = program.copy()
-            p[last + 1:last + 1 + j, 1:] = (mode, 0.0)
-            return p
+            return replaced_rows(program, slice(last + 1, last + 1 + j), mode)
     else:  # cut short: coast earlier
         slow_end, fast_end = last + 1, 0
 
         def moved(j):
-            p = program.copy()
-            p[last + 1 - j:last + 1, 1:] = (MODE_COAST, 0.0)
-            return p
+            return replaced_rows(program, slice(last + 1 - j, last + 1), MODE_COAST)
 
     def run(j):
         p = moved(j)
