@@ -19,6 +19,7 @@ import numpy as np
 
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import InfeasibleCaseError
+from pymoo_rail.sim.drivers import replaced_rows
 from pymoo_rail.sim.kernel import (
     MODE_COAST,
     MODE_HOLD,
@@ -248,15 +249,6 @@ def closest_run(solver: OptimalSolver, slow: Solve | None, fast: Solve | None, t
             raise ValueError(f"running_time_s = {target}: longer than the slowest run the speed grid represents "
                              f"({best.time_s:.1f} s at lambda = {best.lambda_w:.3g} W)")
     return best
-
-
-def replaced_rows(program: np.ndarray, rows: slice, mode: int) -> np.ndarray:
-    """A copy of ``program`` whose ``rows`` say ``mode`` (no target; full traction where the program
-    has a fourth column, the traction share of part-power rows)."""
-    p = program.copy()
-    p[rows, 1:3] = (mode, 0.0)
-    p[rows, 3:] = 1.0
-    return p
 
 
 def move_last_switch(solver: OptimalSolver, solution: Solve, target: float) -> Solve | None:
