@@ -34,6 +34,10 @@ def test_findings_name_the_ranges_of_the_table():
     assert "-0.10 to +1.50 %" in text
     assert "-0.41 to +0.00 %" in text  # 120 / 120.5 - 1 and 108 / 108 - 1
     assert "+2.50 to +3.70 %" in text  # 123 / 120 - 1 and 112 / 108 - 1
+    assert "+2.00 to +2.00 %" in text  # the dynamic rows' own_diff_pct
+    rows[2].update(ours_part_power_km=3.21, mseetc_part_power_km=4.0)
+    rows[5].update(ours_part_power_km=2.0, mseetc_part_power_km=2.5)
+    assert findings(pd.DataFrame(rows))["part_power"] == "3.2 / 4.0 km at 10 %, 2.0 / 2.5 km at 20 %"
 
 
 def test_sampled_maps_reproduce_the_loss_function_they_come_from():

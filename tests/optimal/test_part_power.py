@@ -119,3 +119,18 @@ def test_a_case_without_a_map_compiles_no_part_power_kernel():
             "print(sum(len(getattr(dp, n).signatures) for n in names))\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "0"
+
+
+def test_part_power_distance_of_a_profile_from_its_points(falling_case):
+    from pymoo_rail.optimal.efficiency_study import part_power_km
+
+    sim = Simulator(falling_case, dx_m=1.0)
+    program = np.array([[3000.0, k.MODE_TOWARD, 80.0 / KMH_PER_MS, 0.5], [5000.0, k.MODE_COAST, 0.0, 1.0]])
+    gentle = sim.run(program)
+    program[0, 3] = 1.0
+    full = sim.run(program)
+    # every 10th point: another solver's coarser points
+    gentle_km = part_power_km(falling_case, gentle.position_m[::10], gentle.speed_ms[::10])
+    pulling = (gentle.force_n[:-1] > 0) & (np.diff(gentle.speed_ms) > 0)
+    assert gentle_km == pytest.approx(pulling.sum() / 1000.0, rel=0.02) and gentle_km > 0.5
+    assert part_power_km(falling_case, full.position_m[::10], full.speed_ms[::10]) < 0.02
