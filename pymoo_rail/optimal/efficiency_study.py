@@ -103,13 +103,15 @@ def profile_forces_n(case: Case, position_m, speed_ms) -> tuple[np.ndarray, np.n
     return force, v_mid, d
 
 
-def part_power_km(case: Case, position_m, speed_ms, below: float = 0.95) -> float:
-    """How far a speed profile accelerates at part power (km): intervals pulling (force > 0), gaining speed,
-    with a force below ``below`` x the traction curve at their mean speed (:func:`profile_forces_n`)."""
+def part_power_km(case: Case, position_m, speed_ms, below: float = 0.95, min_accel_ms2: float = 0.02) -> float:
+    """How far a speed profile accelerates at part power (km): intervals pulling with a force below ``below``
+    x the traction curve at their mean speed (:func:`profile_forces_n`) and accelerating at least at
+    ``min_accel_ms2`` (not holding a speed: a solver's holding arc gains or loses a little speed)."""
     force, v_mid, d = profile_forces_n(case, position_m, speed_ms)
     curve_n = case.train.traction.force_kn(v_mid * KMH_PER_MS) * 1000.0
-    gaining = np.diff(np.asarray(speed_ms, dtype=float)) > 0.0
-    return float(d[(force > 0.0) & gaining & (force < below * curve_n)].sum() / 1000.0)
+    v = np.asarray(speed_ms, dtype=float)
+    accelerating = (v[1:] ** 2 - v[:-1] ** 2) / (2.0 * d) >= min_accel_ms2
+    return float(d[(force > 0.0) & accelerating & (force < below * curve_n)].sum() / 1000.0)
 
 
 def profile_energy_kwh(case: Case, position_m, speed_ms, time_s) -> float:

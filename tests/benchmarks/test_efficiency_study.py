@@ -76,3 +76,11 @@ def test_mseetc_study_driver_returns_the_run_and_the_losses():
     assert result["position_m"][-1] == pytest.approx(8500.0) and result["speed_ms"][-1] == pytest.approx(100 / 3.6)
     # its midpoint energy and its CVODES-integrated one agree
     assert result["dynamic_energy_kwh"] == pytest.approx(result["energy_kwh"], rel=5e-3)
+
+
+def test_the_command_line_help_prints():
+    import subprocess
+
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "efficiency_study.py"
+    out = subprocess.run([sys.executable, str(script), "--help"], capture_output=True, text=True, check=True)
+    assert "--mseetc" in out.stdout and "time reserves (%)" in out.stdout
