@@ -12,7 +12,9 @@ Controls of one cell are exactly the simulator's driving modes (``pymoo_rail.sim
 maximum traction, coasting, maximum braking, holding the entry speed (by partial traction, or by
 partial regenerative-first braking where coasting would accelerate), and ``toward`` a target
 speed, which lands exactly on a speed node of the next position by partial traction (or partial
-braking). Each transition is computed by the simulator's own step functions, including its
+braking); where the train has a varying traction efficiency map, also traction at a share of the
+maximum force (``toward`` rows with the simulator's fourth program column, :func:`part_power_shares`).
+Each transition is computed by the simulator's own step functions, including its
 braking-envelope override (``clamp_to_envelope``), so a control sequence chosen here replays bit
 for bit in the simulator. The cost of a cell is the simulator's own accounting
 (``complete_cell``): ``traction work / eta_traction - eta_regen * electric braking work +
