@@ -14,12 +14,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pymoo_rail.cases import load_train, write_case
+from pymoo_rail.cases import generate_case, load_train, write_case
 from pymoo_rail.cases.ttobench import from_ttobench, read_train
 from pymoo_rail.cases.ttobench_efficiency import loss_table_rows, map_from_loss_table, max_force_kn
 from pymoo_rail.cases.ttobench_writer import to_ttobench, train_to_json
 from pymoo_rail.model import CaseError, EfficiencyMap
+from pymoo_rail.optimal import optimal_profile
 from pymoo_rail.sim import Simulator
+from pymoo_rail.sim.checks import check_run
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 LOCO = DATA / "ttobench" / "superseded" / "00_Loco_Dyn.json"
@@ -203,3 +205,16 @@ def test_one_table_and_one_scalar_efficiency():
     back = read_train(train_to_json(train, "x")).train
     assert back.regen_efficiency == 0.8 and back.regen_efficiency_map is None
     _assert_same_map(train.traction_efficiency_map, back.traction_efficiency_map)
+
+
+@pytest.mark.slow
+def test_the_dynamic_locomotive_runs_optimally_and_its_map_costs_more_than_its_peak():
+    train = load_train(LOCO)
+    case = replace(generate_case(0, "suburban"), train=train, initial_speed_ms=0.0, final_speed_ms=0.0)
+    fastest = Simulator(case).flat_out()
+    optimal = optimal_profile(case, 1.15 * fastest.running_time_s)
+    assert check_run(optimal, case).passes() and abs(optimal.running_time_s - 1.15 * fastest.running_time_s) <= 0.5
+    assert optimal.energy.net_kwh < fastest.energy.net_kwh
+    # the map is at most its peak everywhere: the same train at the constant peak needs less
+    peak = replace(case, train=replace(train, traction_efficiency_map=None, regen_efficiency_map=None))
+    assert optimal_profile(peak, 1.15 * fastest.running_time_s).energy.net_kwh < optimal.energy.net_kwh
