@@ -136,7 +136,7 @@ def _check_edge(efficiency_map: EfficiencyMap, direction: str) -> None:
                         "TTOBench states losses, which carry no efficiency at 0 km/h: the row at 0 km/h must "
                         "equal the next row (the value held below the lowest speed)")
     if efficiency_map.forces_kn[0] == 0.0 and (values.shape[1] == 1 or np.any(values[:, 0] != values[:, 1])):
-        raise CaseError(f"{field}.values[][0]", list(values[:, 0]),
+        raise CaseError(f"{field}.forces_kn[0]", list(values[:, 0]),
                         "TTOBench states losses, which carry no efficiency at 0 kN: the column at 0 kN must "
                         "equal the next column (the value held below the lowest force)")
 

@@ -218,3 +218,12 @@ def test_the_dynamic_locomotive_runs_optimally_and_its_map_costs_more_than_its_p
     # the map is at most its peak everywhere: the same train at the constant peak needs less
     peak = replace(case, train=replace(train, traction_efficiency_map=None, regen_efficiency_map=None))
     assert optimal_profile(peak, 1.15 * fastest.running_time_s).energy.net_kwh < optimal.energy.net_kwh
+
+
+def test_a_column_at_zero_force_must_be_the_held_edge():
+    traction = load_train(LOCO).traction_efficiency_map
+    zero = EfficiencyMap(traction.speeds_kmh, (0.0,) + traction.forces_kn,
+                         tuple((0.5,) + row for row in traction.values))
+    with pytest.raises(CaseError, match="no efficiency at 0 kN") as err:
+        loss_table_rows(zero, "traction", 380.0, 5500.0, 36.5)
+    assert err.value.field == "train.traction_efficiency_map.forces_kn[0]"
