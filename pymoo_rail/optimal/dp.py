@@ -1014,11 +1014,8 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     n = m.position_m.shape[0]
     v = m.initial_speed_ms
     speeds[0] = v
-    energy = 0.0
-    time = 0.0
-    tie_cost = 0.0
-    previous = MODE_TRACTION
-    previous_share = 1.0
+    energy = time = tie_cost = 0.0
+    previous, previous_share = MODE_TRACTION, 1.0  # the control of the cell before
     for i in range(n - 1):
         price = time_price_w[i]
         cost, mode, target = best_control(m, i, v, price, value[i + 1], max_targets, bias, sing_v[i + 1],
