@@ -339,8 +339,7 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
     filter_ab = filter_params(getattr(controller, "speed_filter", None))
     carry = np.zeros(ck.N_CARRY)  # the low-level controller, carried from one reference to the next
     node, v, t = 0, float(model.initial_speed_ms), float(d.departure_delay_s)
-    known: SpeedRestriction | None = None
-    pending = d.restriction is not None
+    known, pending = None, d.restriction is not None  # the restriction as the controller knows it
     parts: list[tuple] = []
     decisions: list[float] = []
     event = "departure"
