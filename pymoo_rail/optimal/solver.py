@@ -133,7 +133,6 @@ class OptimalSolver:
         self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
         self._swept = None  # (price, shape, floor) of the cost-to-go in _value and _sing
         n_nodes = self.simulator.grid.n_nodes
-        self._sing = (np.empty((n_nodes, 2)), np.empty((n_nodes, 2)), np.empty((n_nodes, 2)))  # dp.solve's
         self._min_time_s: float | None = None
         self.n_solves = 0  # DP solves so far (for benchmarks)
         # the parts of the last certificate (kWh): grid, moved run, kept regimes, untied run (for benchmarks)
@@ -146,6 +145,10 @@ class OptimalSolver:
         # the arrival speeds the case asks for: (lo, hi), lo = hi = the final speed unless it gives a window
         self.end_speed_ms = case.end_speed_window_ms()
         self._terminal_j = dp.terminal_cost(self.simulator.model, self.n_speeds, self.top_bias, self.end_speed_ms[0])
+        # the coast curves into the envelope's corners and the end speed: kinks of the cost-to-go, held as states
+        self._arrival = dp.coast_curves(self.simulator.model, float(self.end_speed_ms[0]), self.n_speeds,
+                                        self.top_bias)
+        self._sing = tuple(np.empty((n_nodes, dp.N_SINGULAR + self._arrival[0].shape[1])) for _ in range(3))
         self.speed_floor_ms: np.ndarray | None = None
         self._floor_k: np.ndarray | None = None
         self.set_speed_floor(speed_floor_ms)
@@ -226,7 +229,8 @@ class OptimalSolver:
         # the cost-to-go of the last sweep still holds at its price and settings: only the forward run
         key = (lambda_w, id(self.price_shape), id(self._floor_k))
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, tie_j,
-                       self._value, self._floor_k, self._terminal_j, self.singular, self._sing, self._swept == key)
+                       self._value, self._floor_k, self._terminal_j, self.singular, self._sing, self._swept == key,
+                       self._arrival)
         self._swept = key
         return run
 
