@@ -56,10 +56,15 @@ def test_start_curve_is_the_full_traction_run():
 
 
 def test_no_curve_into_a_standstill():
-    """A platform stop ends the envelope at 0: no coast curve into it, and a start from rest has none either."""
+    """A platform stop ends the envelope at 0 and the level line has one limit: no coast curve, only the
+    start at full traction from rest."""
     m = Simulator(level_case()).model
     curve_v, curve_p = dp.coast_curves(m, 0.0, 200, 0.5)
-    assert not np.any(curve_p >= 0.0)
+    start = np.zeros(m.position_m.shape[0])
+    end = dp.traction_curve(m, start)
+    assert curve_v.shape[1] == 1
+    np.testing.assert_array_equal(curve_v[:end, 0], start[:end])
+    assert not np.any(curve_p[end:, 0] >= 0.0)
 
 
 def test_value_of_a_moving_end_matches_its_run(moving_end_case):
