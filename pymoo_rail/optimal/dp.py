@@ -494,10 +494,11 @@ def coast_curves(model, end_lo_ms: float, n_speeds: int, bias: float, max_curves
     share of a node spacing at every cell, and a run's final coast lies on the kink: measured on a
     generated line ending at 72 km/h, the DP's value above the energy + lambda x time of its own run by
     0.53 kWh at 200 nodes and 0.26 at 400, and the run 0.24 kWh (0.5 %) above the continuous optimum.
-    So each curve is one more state at every node it reaches (like the singular speeds). And the run at
-    full traction from the initial speed (:func:`traction_curve`): at a start at walking pace the first
-    speed node above it lies metres per second away, and the cost-to-go, strongly convex there, was
-    overstated by 0.31 kWh over the first kilometre of a generated line (seed 5).
+    So each curve is one more state at every node it reaches (like the singular speeds). And, from a
+    moving start, the run at full traction from the initial speed (:func:`traction_curve`): at a start at
+    walking pace the first speed node above it lies metres per second away, and the cost-to-go, strongly
+    convex there, was overstated by 0.31 kWh over the first kilometre of a generated line (seed 5). A
+    start from rest is the first node itself.
 
     Returns ``(curve_v, curve_p)`` (n_nodes, n_columns): speeds and fractional node indices (-1: none);
     curves that do not overlap share a column, at most ``max_curves`` columns (the nearest corners ahead
@@ -513,7 +514,9 @@ def coast_curves(model, end_lo_ms: float, n_speeds: int, bias: float, max_curves
     curve_v = np.zeros((n, max_curves))
     curve_p = np.full((n, max_curves), -1.0)
     work = np.zeros(n)
-    for i_end, v_end in corners + [(-1, 0.0)]:
+    # a start from rest is a node: only a moving start needs its run at full traction as states
+    start_curve = [(-1, 0.0)] if model.initial_speed_ms > 0.0 else []
+    for i_end, v_end in corners + start_curve:
         if i_end < 0:  # the start at full traction, last: it lies before every corner
             start, i_end = 0, traction_curve(model, work)
         elif v_end <= 0.0:
