@@ -45,7 +45,7 @@ from pymoo_rail.optimal.price_search import (
 )
 from pymoo_rail.sim import Simulator, Trajectory
 
-SOLVER_VERSION = "3"
+SOLVER_VERSION = "4"
 """Version of the solver's answers: bump it whenever a run the solver returns for a case can change
 (DP, search, certificate, or the simulator that replays the run), so on-disk caches of its runs
 (:func:`pymoo_rail.optimal.reference.exact_points`, :func:`pymoo_rail.journeys.section_fronts`)
@@ -54,7 +54,9 @@ stop serving the old rows; bump ``pymoo_rail.optimal.reference.FRONT_VERSION`` w
 as states and the end speed an equality (the shipped fronts of version 6, rest to rest, move by at
 most 0.0045 kWh, 0.005 %, within their certificates: not recomputed); 3: the certificate's floor at
 least 5e-4 of the run's traction energy, runs unchanged (fronts recomputed as version 7 for their
-certificates)."""
+certificates); 4: the coast curves into the braking envelope's corners and the end speed, and the
+full-traction start, as states of the DP (``dp.coast_curves``; runs change where they coast into a
+lower limit or a moving end, fronts recomputed as version 8)."""
 DEFAULT_N_SPEEDS = 200
 DEFAULT_MAX_TARGETS = 16
 DEFAULT_TIME_TOL_S = 0.05
