@@ -81,10 +81,6 @@ def main(argv=None) -> int:
                         help="print the whole study's CPU time projected from the stored runs' CPU per evaluation")
     args = parser.parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")
-    # runs made in this process (--workers 1) get one Numba thread, as each worker of the pool has:
-    # the kernel's second thread saves little wall time and its spin-waits count as CPU of the run
-    # (twice the kernel's CPU, ten times the history's, measured by suite_baseline_profile.py)
-    numba.set_num_threads(1)
     study = cut_study(read_study(STUDY_FILE), args.families, args.ladder, args.seeds, args.n_eval)
     if not args.report_only:
         run_study(study, args.work, workers=args.workers, scheduler="local" if args.dask else None, seed_major=True)
@@ -106,4 +102,8 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
+    # runs made in this process (--workers 1) get one Numba thread, as each worker of the pool has:
+    # the kernel's second thread saves little wall time and its spin-waits count as CPU of the run
+    # (twice the kernel's CPU, ten times the history's, measured by suite_baseline_profile.py)
+    numba.set_num_threads(1)
     raise SystemExit(main())

@@ -39,7 +39,15 @@ def main(argv=None) -> int:
     parser.add_argument("--threads", type=int, default=1,
                         help="Numba threads of the kernel (default 1, as each worker of the study's pool)")
     args = parser.parse_args(argv)
+    previous = numba.get_num_threads()
     numba.set_num_threads(args.threads)
+    try:
+        return _profile(args)
+    finally:
+        numba.set_num_threads(previous)
+
+
+def _profile(args) -> int:
     study = cut_study(read_study(STUDY_FILE), args.families, args.ladder, 1, args.n_eval)
     runs = [r for r in study.runs() if not args.algorithms or r.algorithm.display in args.algorithms]
     if not runs:
