@@ -23,7 +23,7 @@ point, and ``HV(certified front)`` plus the scaled distance of the nearest point
 before. Infeasible evaluations count as evaluations and never enter the archive; before the first
 feasible point the indicator is infinite and written as :data:`INFINITE_VALUE`, the value COCO's
 own loggers write for an infinite one (cocopp needs every run to start at evaluation 1). The function is the problem (:func:`function_id`), the dimension ``n_var``, the instance
-a family instance's seed (1 for a named problem).
+a family instance's seed.
 
 cocopp knows only COCO's own suites; :func:`register_cocopp_suite` adds this one
 (:data:`COCO_SUITE`) to a running ``cocopp`` before it reads the data, as cocopp's own message asks.
@@ -37,7 +37,6 @@ from pathlib import Path
 import numpy as np
 
 from pymoo_rail.suite.families import FAMILIES, list_families
-from pymoo_rail.suite.problems import list_problems
 from pymoo_rail.suite.run_log import EvaluationLogger, HVArchive
 
 COCO_SUITE = "pymoo-rail-biobj"
@@ -52,30 +51,27 @@ COCO_FORMAT_VERSION = "2.8.2"
 """The ``coco_version`` written in the headers: the version of COCO whose ``bbob-biobj`` files these follow."""
 INFINITE_VALUE = 3e21
 """What is written for an infinite indicator (no feasible point yet), as COCO's loggers write infinity."""
-NAMED_FUNCTION_OFFSET = 100
-"""Function numbers of the named problems start after this (families are 1, 2, ...)."""
 
 
 def function_id(problem) -> int:
-    """The COCO function number of a suite problem.
+    """The COCO function number of a family instance: its family's position in
+    :data:`~pymoo_rail.suite.families.FAMILIES` plus 1 (1-10).
 
-    A family's position in :data:`~pymoo_rail.suite.families.FAMILIES` plus 1 (1-10), or
-    :data:`NAMED_FUNCTION_OFFSET` plus 1 plus a named problem's position in
-    :func:`~pymoo_rail.suite.list_problems` (101-121).
+    Raises ``ValueError`` naming the problem for any other problem: the named suite problems have
+    no fixed HV reference point, which COCO's indicator needs.
     """
     family = getattr(problem, "family", None)
     if family in list_families():
         return list_families().index(family) + 1
-    name = getattr(problem, "suite_name", None)
-    if name in list_problems():
-        return NAMED_FUNCTION_OFFSET + 1 + list_problems().index(name)
-    raise ValueError(f"COCOLogger: problem {name or type(problem).__name__!r} is not a suite problem "
-                     "(pymoo_rail.suite.get_problem); COCO needs its function number")
+    name = getattr(problem, "suite_name", None) or type(problem).__name__
+    raise ValueError(f"COCOLogger: problem {name!r} is not a family instance (pymoo_rail.suite.get_problem("
+                     "'generated-<kind>-bi', n_var=..., seed=...)); COCO needs its function number and the "
+                     "family's fixed HV reference point")
 
 
 def function_name(problem) -> str:
-    """The problem's name in the logs: its family, or a named problem's name."""
-    return str(getattr(problem, "family", None) or problem.suite_name)
+    """The problem's name in the logs: its family."""
+    return str(problem.family)
 
 
 def evaluation_triggers(dimension: int, budget: int) -> set[int]:
@@ -110,8 +106,8 @@ class COCOLogger(EvaluationLogger):
 
     Notes
     -----
-    Bi-objective problems with a certified front and ``hv_reference_point()`` only: every
-    ``-bi`` family instance and named ``-bi`` problem (:func:`function_id`). Call :meth:`close`
+    The ``-bi`` family instances only (:func:`function_id`): two objectives, a certified front and
+    a fixed ``hv_reference_point()``. Call :meth:`close`
     (or use the logger as a context manager) after the last run: a run is written when it ends.
     Read the data with ``cocopp`` after :func:`register_cocopp_suite`.
     """
@@ -234,12 +230,11 @@ def register_cocopp_suite() -> str:
 
     base = testbedsettings.GECCOBiObjBBOBTestbed
     names = {i + 1: entry.name for i, entry in enumerate(FAMILIES)}
-    names.update({NAMED_FUNCTION_OFFSET + 1 + i: name for i, name in enumerate(list_problems())})
     settings = dict(base.settings, name=COCO_SUITE, short_names=names,
                     dimensions_to_display=(10, 30, 100, 300, 1000), goto_dimension=100,
                     rldDimsOfInterest=(10, 100), tabDimsOfInterest=(10, 100),
                     functions_with_legend=(1, len(FAMILIES)), first_function_number=1,
-                    last_function_number=NAMED_FUNCTION_OFFSET + len(list_problems()),
+                    last_function_number=len(FAMILIES),
                     reference_values_hash_dimensions=[], instancesOfInterest=None,
                     reference_algorithm_filename="", reference_algorithm_displayname="",
                     plots_on_main_html_page=[f"pprldmany_{d:02d}D_noiselessall.svg" for d in (10, 30, 100, 300, 1000)])

@@ -81,8 +81,9 @@ class EvaluationLogger(Callback):
         if algorithm is not self._algorithm:
             if self._algorithm is not None:
                 self.end_run()
+                self._algorithm = None
+            self.start_run(algorithm.problem)  # may refuse the problem: then no run is open
             self._algorithm, self._n_eval = algorithm, 0
-            self.start_run(algorithm.problem)
         batch = algorithm.off
         n_new = algorithm.evaluator.n_eval - self._n_eval
         if n_new == 0:

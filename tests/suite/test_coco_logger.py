@@ -168,10 +168,15 @@ def test_problems_coco_cannot_hold_are_refused(tmp_path):
     with pytest.raises(ValueError, match="n_obj = 1"):
         minimize(get_problem("generated-metro-single", n_var=6, seed=1), NSGA2(pop_size=8), ("n_gen", 1),
                  callback=COCOLogger(tmp_path, "GA"))
-    with pytest.raises(ValueError, match="'ZDT1' is not a suite problem"):
+    with pytest.raises(ValueError, match="'ZDT1' is not a family instance"):
         function_id(pymoo_problem("zdt1"))
     assert function_id(get_problem("generated-metro-bi", n_var=10, seed=1)) == 1
-    assert function_id(get_problem("yizhuang-bi")) > 100
+    # a named problem has no fixed HV reference point: refused at the first generation, no run left open
+    logger = COCOLogger(tmp_path, "named")
+    with pytest.raises(ValueError, match="'yizhuang-bi' is not a family instance"):
+        minimize(get_problem("yizhuang-bi"), NSGA2(pop_size=8), ("n_gen", 1), callback=logger)
+    logger.close()
+    assert not (tmp_path / "named").exists()
 
 
 @pytest.mark.slow
