@@ -18,6 +18,7 @@ from pymoo_rail.suite.families import (
     list_families,
 )
 from pymoo_rail.suite.fronts_io import best_known_front, compute_best_known_front, verify
+from pymoo_rail.suite.coco_logger import COCOLogger
 from pymoo_rail.suite.ioh_logger import IOHLogger
 from pymoo_rail.suite.problems import (
     CASES,
@@ -29,6 +30,6 @@ from pymoo_rail.suite.problems import (
 )
 
 __all__ = ["get_problem", "list_problems", "list_families", "Family", "FamilyProblem", "FAMILIES", "FAMILY_VERSION",
-           "IOHLogger",
+           "IOHLogger", "COCOLogger",
            "suite_case", "tolerance_s", "CASES", "SUITE_VERSION", "SuiteCase",
            "verify", "best_known_front", "compute_best_known_front", "CertifiedFront", "NoExactFrontError"]

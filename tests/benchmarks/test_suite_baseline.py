@@ -88,3 +88,21 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
     assert len(fig.axes) == 4 and all(len(ax.get_lines()) == 2 for ax in fig.axes)
     profile = pd.DataFrame({"A": [0.5, 1.0], "B": [0.0, 1.0]}, index=pd.Index([1.0, 2.0], name="tau"))
     assert len(plot_performance_profile(profile).axes[0].get_lines()) == 2
+
+
+def test_the_profile_script_splits_a_run_and_leaves_the_thread_count(capsys):
+    import numba
+
+    from benchmarks.suite_baseline_profile import main
+
+    before = numba.get_num_threads()
+    assert main(["--ladder", "10", "--families", "generated-metro-bi", "--algorithms", "random",
+                 "--n-eval", "300", "--threads", "1"]) == 0
+    assert numba.get_num_threads() == before
+    lines = capsys.readouterr().out.splitlines()
+    run = next(line for line in lines if line.startswith("generated-metro-bi/10"))
+    values = [float(v) for v in run.split()[2:]]
+    assert len(values) == 10 and values[-2] > 0  # 8 parts, the total, ms per evaluation
+    assert values[8] == pytest.approx(sum(values[:8]), abs=6e-3)  # printed to 3 decimals
+    with pytest.raises(SystemExit, match="none of the study's"):
+        main(["--ladder", "10", "--algorithms", "no-such-algorithm"])
