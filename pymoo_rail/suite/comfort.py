@@ -194,8 +194,7 @@ def cached_inner_points(problem) -> np.ndarray:
     if path.is_file():
         return pd.read_csv(path)[list(COMFORT_OBJECTIVES)].to_numpy(dtype=float)
     X, F = inner_points(problem)
-    table = pd.DataFrame(F, columns=list(COMFORT_OBJECTIVES))
-    table[[f"x{j}" for j in range(X.shape[1])]] = X
+    table = pd.DataFrame(np.column_stack([F, X]), columns=[*COMFORT_OBJECTIVES, *(f"x{j}" for j in range(X.shape[1]))])
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(path, table.to_csv(index=False, float_format="%.17g"))
     return F
