@@ -30,7 +30,10 @@ and the closed walk of accelerations from 0 through ``A`` and ``-D`` back to 0 h
 code is at least the floor, above 0), so ``A >= a_launch``, the first cell's acceleration
 (:func:`launch_accel_ms2`); with ``A`` unbounded the same area argument then asks
 ``D >= 2 R / T^2`` (``R <= h T / 2``) or ``D >= h^2 / (2 (h T - R))``, ``R`` the metres beyond
-``u T`` and ``h = V - u``. The floor is the larger of the two.
+``u T`` and ``h = V - u``. Runs that end at rest land on the platform: their last cell decelerates
+by ``v^2 / (2 dx)``, ``v`` the speed one cell before, which the braking envelope and one kernel step
+bound from below (:func:`landing_decel_ms2`), so ``D >= landing`` and, symmetrically, ``A`` obeys the
+one-sided bound. The floor is the largest of ``A + D`` over these cases, doubled.
 """
 
 from __future__ import annotations
@@ -42,7 +45,9 @@ import numpy as np
 import pandas as pd
 
 from pymoo_rail.atomic import atomic_write_text
+from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.optimal.reference import CertifiedFront, cache_dir
+from pymoo_rail.sim import kernel
 from pymoo_rail.suite.identity import HV_MARGIN
 
 COMFORT_OBJECTIVES = ("energy", "running_time", "accel_variation")
@@ -58,7 +63,7 @@ N_SUB = 8
 
 
 def comfort_floor_ms2(running_time_s, length_m: float, boundary_speed_ms: float, top_speed_ms: float,
-                      launch_ms2: float = 0.0) -> np.ndarray:
+                      launch_ms2: float = 0.0, landing_ms2: float = 0.0) -> np.ndarray:
     """Least total variation of acceleration (m/s^2) of any run covering ``length_m`` in ``running_time_s``.
 
     Parameters
@@ -73,12 +78,14 @@ def comfort_floor_ms2(running_time_s, length_m: float, boundary_speed_ms: float,
         Speed the run never exceeds (m/s): the line's highest limit, or the train's top speed.
     launch_ms2 : float
         An acceleration every run reaches (the launch from rest at full traction); 0 if none.
+    landing_ms2 : float
+        A deceleration every run reaches (the last cell onto the platform); 0 if none.
 
     Returns
     -------
     numpy.ndarray
-        ``2 max(s_min(T), launch + D_min(T))`` (see the module docstring); ``inf`` where no run
-        can cover the distance in that time.
+        ``2 max(s_min(T), launch + D_min(T), A_min(T) + landing, launch + landing)`` (see the module
+        docstring); ``inf`` where no run can cover the distance in that time.
     """
     t = np.atleast_1d(np.asarray(running_time_s, dtype=float))
     if np.any(~np.isfinite(t)) or np.any(t <= 0):
@@ -92,9 +99,10 @@ def comfort_floor_ms2(running_time_s, length_m: float, boundary_speed_ms: float,
         # largest k = 1/A + 1/D whose area reaches `rest`: the triangle (peak under h) or the trapezoid
         k_max = np.where(rest <= h * t / 2.0, t * t / (2.0 * rest), 2.0 * (h * t - rest) / (h * h))
         symmetric = np.where(rest > 0.0, 4.0 / k_max, 0.0)
-        # with A unbounded, area(D) = D T^2 / 2 while D T <= h, else h T - h^2 / (2 D)
-        braking = np.where(rest <= h * t / 2.0, 2.0 * rest / (t * t), h * h / (2.0 * (h * t - rest)))
-    floor = 2.0 * np.maximum(symmetric, launch_ms2 + braking)
+        # one side unbounded, area(D) = D T^2 / 2 while D T <= h, else h T - h^2 / (2 D) (and so for A)
+        one_side = np.where(rest <= h * t / 2.0, 2.0 * rest / (t * t), h * h / (2.0 * (h * t - rest)))
+    floor = 2.0 * np.maximum.reduce([symmetric, launch_ms2 + one_side, one_side + landing_ms2,
+                                     np.full_like(t, launch_ms2 + landing_ms2)])
     return np.where(rest >= h * t, np.inf, floor)
 
 
@@ -110,6 +118,32 @@ def launch_accel_ms2(problem) -> float:
     return max(float(trajectory.accel_ms2[0]), 0.0)
 
 
+def landing_decel_ms2(problem, n_speeds: int = 201) -> float:
+    """A deceleration the last cell of every feasible run of ``problem`` reaches (m/s^2); 0 when the
+    run need not end at rest.
+
+    The last cell ends on the platform at rest, so its acceleration is ``-v^2 / (2 dx)`` with ``v``
+    the speed one cell before. That speed is the envelope's there, or what one kernel step reaches
+    from any speed the envelope allows a cell earlier: full traction (the train is below its code)
+    or coasting (at or above it, so at least the floor code). The least of these over
+    ``n_speeds`` speeds, less 0.1 % (the grid and the kernel's rounding brake), bounds it.
+    """
+    if problem.case.end_speed_window_ms()[1] > 0.0 or problem.stop_tolerance_m is None:
+        return 0.0
+    m = problem.simulator.model
+    env, n = m.envelope_ms, m.position_m.shape[0]
+    if n < 4:
+        return 0.0
+    floor_ms = float(problem.xl[-1]) / KMH_PER_MS  # the last section's lowest code
+    cell = n - 3
+    u1 = [env[n - 2] ** 2]
+    u1 += [kernel.full_step(m, v, cell, kernel.KIND_TRACTION)[0] for v in np.linspace(0.0, env[cell], n_speeds)]
+    if env[cell] >= floor_ms:
+        u1 += [kernel.full_step(m, v, cell, kernel.KIND_COAST)[0] for v in np.linspace(floor_ms, env[cell], n_speeds)]
+    least = min(u1)
+    return 0.999 * least / (2.0 * m.dx_m) if least > 0.0 else 0.0
+
+
 def floor_settings(problem) -> dict:
     """The keyword arguments of :func:`comfort_floor_ms2` for an instance (its line, limits, tolerance, launch)."""
     case = problem.case
@@ -117,7 +151,7 @@ def floor_settings(problem) -> dict:
     tolerance_m = problem.stop_tolerance_m or 0.0
     return dict(length_m=case.line.length_m - tolerance_m,
                 boundary_speed_ms=max(case.initial_speed_ms, case.end_speed_window_ms()[1]),
-                top_speed_ms=top_ms, launch_ms2=launch_accel_ms2(problem))
+                top_speed_ms=top_ms, launch_ms2=launch_accel_ms2(problem), landing_ms2=landing_decel_ms2(problem))
 
 
 def outer_points(front: CertifiedFront, window_s: tuple[float, float], floor: dict,
@@ -255,6 +289,6 @@ def bound_front(outer: np.ndarray, inner: np.ndarray, ref_point: np.ndarray) -> 
                         epsilon_by_objective=dict(zip(COMFORT_OBJECTIVES, shift.tolist())))
 
 
-__all__ = ["COMFORT_OBJECTIVES", "COMFORT_FRONT_VERSION", "BoundedFront", "comfort_floor_ms2", "launch_accel_ms2", "floor_settings",
+__all__ = ["COMFORT_OBJECTIVES", "COMFORT_FRONT_VERSION", "BoundedFront", "comfort_floor_ms2", "launch_accel_ms2", "landing_decel_ms2", "floor_settings",
            "outer_points", "inner_points", "uniform_points", "uniform_vectors", "feasible_objectives", "cached_inner_points", "bound_front",
            "additive_epsilon"]

@@ -29,6 +29,9 @@ def test_floor_is_the_closed_form_of_a_symmetric_run_from_rest():
     assert comfort_floor_ms2(T, L, 0.0, h, launch_ms2=1.5)[0] == pytest.approx(2.0 * (1.5 + h**2 / (2 * (h * T - L))))
     assert comfort_floor_ms2(T, L, 0.0, h, launch_ms2=1.0)[0] == pytest.approx(2.0 * 4.0 / k)  # the larger of the two
     assert comfort_floor_ms2(200.0, L, 0.0, h, launch_ms2=1.0)[0] == pytest.approx(2.0 * (1.0 + 2 * L / 200.0**2))
+    # a landing every run makes, symmetric to the launch; both together
+    assert comfort_floor_ms2(T, L, 0.0, h, landing_ms2=1.5)[0] == pytest.approx(2.0 * (1.5 + h**2 / (2 * (h * T - L))))
+    assert comfort_floor_ms2(300.0, 100.0, 0.0, h, launch_ms2=1.0, landing_ms2=0.8)[0] == pytest.approx(3.6)
     # cruising at the boundary speed covers the line: no acceleration needed; too far to reach: infinite
     assert comfort_floor_ms2(100.0, 900.0, 10.0, 20.0)[0] == 0.0
     assert comfort_floor_ms2(100.0, 5000.0, 0.0, 20.0)[0] == np.inf
@@ -125,13 +128,20 @@ def test_no_run_of_a_quick_nsga3_falls_below_the_outer_bound(metro):
     assert np.all(F[:, 2] >= comfort.comfort_floor_ms2(F[:, 1], **comfort.floor_settings(problem)))
 
 
-def test_every_run_from_rest_launches_at_the_same_acceleration(metro):
-    problem, _ = metro
-    launch = comfort.launch_accel_ms2(problem)
-    assert launch > 0.5
+@pytest.mark.parametrize("kind", ["metro", "intercity"])
+def test_every_run_from_rest_launches_and_lands_as_the_floor_says(kind):
+    problem = get_problem(f"generated-{kind}-3obj", n_var=12, seed=1)
+    launch, landing = comfort.launch_accel_ms2(problem), comfort.landing_decel_ms2(problem)
+    assert launch > 0.3 and landing > 0.3
     rng = np.random.default_rng(0)
-    for x in rng.uniform(problem.xl, problem.xu, (5, problem.n_var)):
-        assert problem.trajectory(x).accel_ms2[0] == pytest.approx(launch, rel=1e-12)
+    X = np.vstack([problem.xl, problem.xu, rng.uniform(problem.xl, problem.xu, (6, problem.n_var))])
+    for x in X:
+        trajectory = problem.trajectory(x)
+        if trajectory.stop_error_m > problem.stop_tolerance_m:
+            continue  # infeasible: the floor speaks of runs that stop at the platform
+        assert trajectory.accel_ms2[0] == pytest.approx(launch, rel=1e-12)
+        last = trajectory.accel_ms2[len(trajectory.accel_ms2) - 2]  # the last cell (the last node holds 0)
+        assert last <= -landing
 
 
 def test_only_the_3obj_form_has_a_bounded_front():
