@@ -46,6 +46,7 @@ import pandas as pd
 
 from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.constants import KMH_PER_MS
+from pymoo_rail.model import END_SPEED_TOL_MS
 from pymoo_rail.optimal.reference import CertifiedFront, cache_dir
 from pymoo_rail.sim import kernel
 from pymoo_rail.suite.identity import HV_MARGIN
@@ -134,7 +135,7 @@ def landing_decel_ms2(problem, n_speeds: int = 201) -> float:
     env, n = m.envelope_ms, m.position_m.shape[0]
     if n < 4:
         return 0.0
-    floor_ms = float(problem.xl[-1]) / KMH_PER_MS  # the last section's lowest code
+    floor_ms = float(np.min(problem.xl)) / KMH_PER_MS  # no code is lower
     cell = n - 3
     u1 = [env[n - 2] ** 2]
     u1 += [kernel.full_step(m, v, cell, kernel.KIND_TRACTION)[0] for v in np.linspace(0.0, env[cell], n_speeds)]
@@ -149,8 +150,9 @@ def floor_settings(problem) -> dict:
     case = problem.case
     top_ms = float(problem.simulator.grid.limit_ms.max())  # the line's limits, capped by the train's top speed
     tolerance_m = problem.stop_tolerance_m or 0.0
-    return dict(length_m=case.line.length_m - tolerance_m,
-                boundary_speed_ms=max(case.initial_speed_ms, case.end_speed_window_ms()[1]),
+    end_ms = case.end_speed_window_ms()[1]
+    end_ms += END_SPEED_TOL_MS if end_ms > 0.0 else 0.0  # a moving end is met within the tolerance
+    return dict(length_m=case.line.length_m - tolerance_m, boundary_speed_ms=max(case.initial_speed_ms, end_ms),
                 top_speed_ms=top_ms, launch_ms2=launch_accel_ms2(problem), landing_ms2=landing_decel_ms2(problem))
 
 

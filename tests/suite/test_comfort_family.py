@@ -147,3 +147,14 @@ def test_every_run_from_rest_launches_and_lands_as_the_floor_says(kind):
 def test_only_the_3obj_form_has_a_bounded_front():
     with pytest.raises(ValueError, match="only the -3obj families"):
         get_problem("generated-metro-bi", n_var=10, seed=1).bounded_front()
+
+
+def test_a_line_with_moving_ends_has_neither_launch_nor_landing_and_its_runs_respect_the_floor():
+    problem = get_problem("generated-suburban-3obj", n_var=10, seed=4)  # enters and leaves at 36 km/h
+    floor = comfort.floor_settings(problem)
+    assert floor["launch_ms2"] == 0.0 and floor["landing_ms2"] == 0.0
+    assert floor["boundary_speed_ms"] == pytest.approx(problem.case.initial_speed_ms + 0.01)
+    X = np.random.default_rng(2).uniform(problem.xl, problem.xu, (40, problem.n_var))
+    out = problem.evaluate(X, return_values_of=["F", "G"], return_as_dictionary=True)
+    F = out["F"][np.all(out["G"] <= 0, axis=1)]
+    assert len(F) >= 5 and np.all(F[:, 2] >= comfort_floor_ms2(F[:, 1], **floor))
