@@ -97,9 +97,17 @@ def test_bad_ctaea_parameters_name_the_field(params, field):
         check_parameters(algorithm("ctaea", **params), "algorithms[0]")
 
 
+@pytest.fixture(scope="module")
+def front_cache(tmp_path_factory):
+    """One fresh cache for the module: the 3-objective instance's inner front is computed there once."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("PYMOO_RAIL_CACHE_DIR", str(tmp_path_factory.mktemp("fronts")))
+    yield
+    mp.undo()
+
+
 @pytest.mark.parametrize("name", ["nsga3", "ctaea"])
-def test_a_tiny_study_runs_nsga3_and_ctaea_on_a_constrained_3obj_instance(tmp_path, monkeypatch, name):
-    monkeypatch.setenv("PYMOO_RAIL_CACHE_DIR", str(tmp_path))  # the instance's inner front is computed here
+def test_a_tiny_study_runs_nsga3_and_ctaea_on_a_constrained_3obj_instance(front_cache, name):
     spec = problem("suite_family", family="generated-metro-3obj", n_var=10, seed=1)
     record = execute_run(RunSpec(spec, algorithm(name, pop_size=15), 2, Budget("n_eval", 150)))
     # the budget is counted in evaluations, one generation of pop_size offspring at a time

@@ -1,6 +1,7 @@
 """The 3-objective families (energy, running time, comfort): kinematic comfort floor, bounded front, identity."""
 
 import numpy as np
+import pandas as pd
 import pytest
 from pymoo.algorithms.moo.nsga3 import NSGA3
 from pymoo.core.callback import Callback
@@ -86,8 +87,10 @@ def metro(tmp_path_factory):
 
 def test_inner_points_are_feasible_nondominated_runs(metro):
     problem, bounded = metro
-    X, F = comfort.inner_points(problem)
-    np.testing.assert_array_equal(F, bounded.inner)  # the cache holds what the recipe computes
+    cached = pd.read_csv(comfort.inner_path(problem))  # the recipe's runs, kept with their decisions
+    X, F = cached.filter(regex=r"^x\d+$").to_numpy(), cached[list(COMFORT_OBJECTIVES)].to_numpy()
+    np.testing.assert_array_equal(F, bounded.inner)
+    assert X.shape == (len(F), problem.n_var)
     out = problem.evaluate(X, return_values_of=["F", "G"], return_as_dictionary=True)
     assert np.all(out["G"] <= 0.0)
     np.testing.assert_allclose(out["F"], F, rtol=1e-12)
