@@ -169,6 +169,9 @@ class FamilyProblem(SpeedProfileProblem):
         Taken from the case's bi-objective front in the planner's window (energy kWh, running time s),
         restricted to this problem's objectives: the single-objective form's point is the energy of
         the fastest optimal run plus the margin of the front's energy range.
+        The 3-objective form's comfort coordinate runs from the comfort floor at the window's slow end to
+        the nadir of the inner (best-known) points (:func:`pymoo_rail.suite.comfort.cached_inner_points`):
+        comfort has no window, and smooth uniform-code runs need far less than the runs an optimiser finds.
         """
         front = self.certified_front()
         lo, hi = front.clip(self.bi_window_s)
@@ -177,7 +180,7 @@ class FamilyProblem(SpeedProfileProblem):
         nadir = {"energy": float(energy.max()), "running_time": hi}
         if "accel_variation" in self.objectives:
             ideal["accel_variation"] = float(comfort.comfort_floor_ms2(hi, **comfort.floor_settings(self))[0])
-            nadir["accel_variation"] = float(comfort.uniform_points(self)[:, 2].max())
+            nadir["accel_variation"] = float(comfort.cached_inner_points(self)[:, 2].max())
         return np.array([nadir[o] + HV_MARGIN * (nadir[o] - ideal[o]) for o in self.objectives])
 
     def bounded_front(self) -> comfort.BoundedFront:
