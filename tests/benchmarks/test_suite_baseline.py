@@ -18,16 +18,17 @@ def _study(*cut):
     return cut_study(read_study(STUDY_FILE), *cut)
 
 
-def test_the_full_study_is_every_bi_family_on_the_ladder_with_seven_algorithms_and_31_seeds():
+def test_the_full_study_is_every_multi_objective_family_on_the_ladder_with_nine_algorithms_and_31_seeds():
     from pymoo_rail.suite import list_families
 
     study = _study(None, None, None, None)
-    bi = {name for name in list_families() if name.endswith("-bi")}
-    assert {p.params["family"] for p in study.problems} == bi
+    multi = {name for name in list_families() if name.endswith(("-bi", "-3obj"))}
+    assert {p.params["family"] for p in study.problems} == multi
     assert sorted({p.params["n_var"] for p in study.problems}) == [10, 30, 100, 300, 1000]
-    assert len(study.problems) == 5 * len(bi)
-    assert {a.name for a in study.algorithms} == {"nsga2", "sms-emoa", "moead", "age-moea", "moabc", "grnsga2",
-                                                  "random"}
+    assert len(study.problems) == 5 * len(multi) == 40
+    assert {a.name for a in study.algorithms} == {"nsga2", "sms-emoa", "nsga3", "ctaea", "moead", "age-moea", "moabc",
+                                                  "grnsga2", "random"}
+    assert {a.params.get("pop_size") for a in study.algorithms if a.name in ("nsga3", "ctaea")} == {100}
     assert len(study.seeds) == 31
 
 
