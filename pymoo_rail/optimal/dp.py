@@ -405,21 +405,6 @@ def place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p):
             sing_p[i, s] = p
 
 
-@inlined
-def control_cost(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, time_price_w,
-                 v_next, top_u, bias, sing_p, sing_val):
-    """Cell cost plus interpolated cost-to-go of one control from ``v0`` (:func:`cell_outcome`, :func:`cell_cost`).
-
-    Infinite when the train stops inside the cell; the cost-to-go ``v_next`` is spread over
-    ``[0, top_u]``, with the next position's singular speeds as further nodes (:func:`interp_aug`).
-    """
-    u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-    cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
-    if cost < INF:
-        cost += interp_aug(v_next, value_position(top_u, u1, v_next.shape[0] - 1, bias), sing_p, sing_val)
-    return cost
-
-
 # traction, coast, brake, hold. Holding is ``hold_brake``: where coasting decelerates it is ``hold``
 # (partial traction), and where coasting accelerates ``hold`` would only coast, which the coast
 # control already is, while ``hold_brake`` holds the speed by partial (regenerative-first) braking.
@@ -468,12 +453,13 @@ def _n_targets(k_lo, k_hi, max_targets):
 def _table_entry(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, top_u, k_max, bias,
                  table, p):
     """Write one control's outcome from ``v0`` as entry ``p`` of a control table (:func:`control_table`)."""
-    modes, targets, pos, energy, dt = table
+    modes, targets, pos, energy, dt, u1s = table
     u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-    # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`table_minimum` adds the price as ``cell_cost`` does
+    # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost`` does
     e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
     modes[p] = mode
     targets[p] = target
+    u1s[p] = u1
     energy[p] = e
     dt[p] = d
     pos[p] = value_position(top_u, u1, k_max, bias) if e < INF else -1.0
@@ -483,12 +469,13 @@ def _table_entry(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
 def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
 
-    ``table`` is ``(modes, targets, positions, energies, times)``, arrays of at least
+    ``table`` is ``(modes, targets, positions, energies, times, u1)``, arrays of at least
     ``N_FIXED + sing_v.shape[0] + max_targets`` entries: per control its mode and target speed, the
     node position it reaches among the next position's ``k_max + 1`` speed nodes
     (:func:`value_position`; -1 where the train stops in the cell), its net energy without the price
-    of time (infinite where it stops) and its time. The controls: the fixed ones (holding needs a speed
-    to hold), ``toward`` each of the next position's singular speeds ``sing_v`` (where ``sing_p`` >= 0:
+    of time (infinite where it stops), its time and the ``u = v^2`` it reaches (the simulator's
+    ``cell_outcome`` and ``cell_cost``). The controls: the fixed ones, entries ``0 .. N_FIXED - 1``
+    in the order of :func:`_fixed_mode` (holding, the last, needs a speed to hold), ``toward`` each of the next position's singular speeds ``sing_v`` (where ``sing_p`` >= 0:
     landing on them and holding them exactly), and ``toward`` speed nodes of the next position in
     reach by partial traction (or braking). They depend on the kind of the cell (:func:`cell_types`),
     ``v0`` and the next position's singular speeds, not on the price of time or the cost-to-go.
@@ -521,43 +508,38 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
 
 
 @inlined
-def table_minimum(table, n_entries, time_price_w, v_next, sing_p, sing_val):
-    """The entry of a control table (:func:`control_table`) minimising its cost plus the interpolated
-    cost-to-go, and that total: ``(total, entry)``, entry -1 if every control stops in the cell.
+def entry_cost(table, p, time_price_w, v_next, sing_p, sing_val):
+    """Cost of entry ``p`` of a control table (:func:`control_table`) plus the cost-to-go it reaches.
 
-    ``control_cost``'s arithmetic: the cell priced as ``cell_cost`` prices it, then the cost-to-go
-    (``v_next`` with the next position's singular speeds as further nodes, :func:`interp_aug`).
+    The cell priced as ``cell_cost`` prices it, then the cost-to-go interpolated in ``v_next`` with the
+    next position's singular speeds as further nodes (:func:`interp_aug`); infinite where the train
+    stops in the cell.
     """
-    _, _, pos, energy, dt = table
+    e = table[3][p]
+    if e < INF:
+        cost = e + time_price_w * table[4][p]
+        cost += interp_aug(v_next, table[2][p], sing_p, sing_val)
+        return cost
+    return INF
+
+
+@inlined
+def table_minimum(table, n_entries, time_price_w, v_next, sing_p, sing_val):
+    """The entry of a control table (:func:`control_table`) of least :func:`entry_cost`, and that cost:
+    ``(cost, entry)``, entry -1 (cost infinite) if every control stops in the cell; the first of equals.
+
+    With the next position's singular speeds ``sing_v``, ``sing_p``, ``sing_val`` (:func:`singular_speeds`)
+    as further nodes of the cost-to-go and, in the table, further ``toward`` targets, a run lands on
+    them and holds them exactly. A cost at least ``PENALTY_J``: no control can reach the platform.
+    """
     best = INF
     best_p = -1
     for p in range(n_entries):
-        e = energy[p]
-        if e < INF:
-            cost = e + time_price_w * dt[p]
-            cost += interp_aug(v_next, pos[p], sing_p, sing_val)
-            if cost < best:
-                best = cost
-                best_p = p
+        cost = entry_cost(table, p, time_price_w, v_next, sing_p, sing_val)
+        if cost < best:
+            best = cost
+            best_p = p
     return best, best_p
-
-
-@njit(cache=True)
-def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias, sing_v, sing_p, sing_val, table):
-    """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
-
-    ``sing_v``, ``sing_p``, ``sing_val`` are the next position's singular speeds, their node
-    indices and cost-to-go (:func:`singular_speeds`): further nodes of the cost-to-go and further
-    ``toward`` targets, so that a run lands on them and holds them exactly. ``table``: room for one
-    control table (:func:`control_table`), overwritten.
-    Returns ``(total_cost, mode, target_ms)``; ``total_cost`` is at least ``PENALTY_J`` when no
-    control can reach the platform.
-    """
-    n_entries = control_table(m, cell, v0, sing_v, sing_p, v_next.shape[0] - 1, max_targets, bias, table)
-    best, p = table_minimum(table, n_entries, time_price_w, v_next, sing_p, sing_val)
-    if p < 0:
-        return best, np.int64(MODE_COAST), 0.0
-    return best, table[0][p], table[1][p]
 
 
 def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
@@ -679,11 +661,12 @@ def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v,
                    memo_n, memo):
     """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them.
 
-    :func:`best_control`'s minimum, from control tables (:func:`control_table`) kept per kind of cell
-    ``t`` and singular speed ``s``, row ``t * n_singular + s`` of ``memo``: a cell of the kind last
+    The least :func:`entry_cost` of their control tables (:func:`control_table`), kept per kind of cell
+    ``t`` and singular speed ``s`` in row ``t * n_singular + s`` of ``memo``: a cell of the kind last
     tabulated from the same singular speed with the same next singular speeds (``memo_key``) reuses the
     table, the same numbers bit for bit, so a sweep pays the simulator's steps once per kind of cell
-    rather than once per cell and price of time (51 against 35 ms a sweep on a 38 km line).
+    rather than once per cell and price of time (74 against 35 ms a sweep on a 38 km line, 30 ms
+    without the singular speeds).
     """
     sp_next = sing_p[i + 1]
     sv_next = sing_val[i + 1]
@@ -694,7 +677,7 @@ def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v,
             continue
         v0 = sing_v[i, s]
         row = t * n_sing + s
-        table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row])
+        table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row], memo[5][row])
         # the table's key: the speed held and the next position's singular targets (-1: none there)
         key = memo_key[row]
         same = key[0] == v0
@@ -726,7 +709,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
 
     The singular speeds (:func:`singular_speeds`: ``sing_v``, ``sing_p``, both (n_nodes, 2)) are
     further states: their cost-to-go ``sing_val`` (n_nodes, 2) is found by evaluating every control
-    from them with the simulator's steps (:func:`best_control`, as in the forward run, prices
+    from them with the simulator's steps (:func:`control_table`, as in the forward run, prices
     ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
     through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
     them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone.
@@ -747,7 +730,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     memo_n = np.zeros(n_rows, dtype=np.int64)
     size = N_FIXED + n_sing + max_targets
     memo = (np.empty((n_rows, size), dtype=np.int64), np.empty((n_rows, size)), np.empty((n_rows, size)),
-            np.empty((n_rows, size)), np.empty((n_rows, size)))
+            np.empty((n_rows, size)), np.empty((n_rows, size)), np.empty((n_rows, size)))
     for i in range(n - 2, -1, -1):
         v_next = value[i + 1]
         sp_next = sing_p[i + 1]
@@ -797,8 +780,10 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         sv_all = sing_v
         sp_all = sing_p
         sval_all = sing_val
-    size = N_FIXED + sp_all.shape[1] + max_targets
-    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size))
+    size = N_FIXED + sp_all.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
     energy = 0.0
@@ -806,30 +791,32 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     tie_cost = 0.0
     previous = MODE_TRACTION
     for i in range(n - 1):
-        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias, sv_all[i + 1],
-                                          sp_all[i + 1], sval_all[i + 1], table)
+        v_next, sp_next, sval_next = value[i + 1], sp_all[i + 1], sval_all[i + 1]
+        n_entries = control_table(m, i, v, sv_all[i + 1], sp_next, k_max, max_targets, bias, table)
+        cost, p = table_minimum(table, n_entries, time_price_w[i], v_next, sp_next, sval_next)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
-        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
-        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
-        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
+        mode, target = table[0][p], table[1][p]
         if i > 0 and mode != previous and tie_j > 0.0:
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
-                c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias, sp_all[i + 1],
-                                      sval_all[i + 1])
+                # the fixed controls are the table's first entries; holding from a standstill is traction
+                c = 0
+                while c < N_FIXED - 1 and _fixed_mode(c) != keep:
+                    c += 1
+                if c == N_FIXED - 1 and v <= 0.0:
+                    c = 0
+                c_keep = entry_cost(table, c, time_price_w[i], v_next, sp_next, sval_next)
                 if c_keep < INF and c_keep <= cost + tie_j:
                     tie_cost += c_keep - cost
-                    mode, target = keep, 0.0
-        u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
-        energy += c_energy
-        time += dt
+                    mode, target, p = keep, 0.0, c
+        # the chosen control's cell, as ``cell_cost`` prices it with the auxiliary power alone
+        energy += table[3][p] + m.aux_power_w * table[4][p]
+        time += table[4][p]
         modes[i] = mode
         targets[i] = target
         previous = mode
-        v = math.sqrt(u1)
+        v = math.sqrt(table[5][p])
         speeds[i + 1] = v
     return n - 1, energy, time, tie_cost
 
