@@ -491,9 +491,13 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
                      k_max, bias, table, p)
         p += 1
     for s in range(sing_v.shape[0]):
+        target = sing_v[s]
         if sing_p[s] < 0.0:
             continue
-        _table_entry(m, v0, cell, np.int64(MODE_TOWARD), sing_v[s], tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f,
+        # out of reach (``cell_outcome``'s rule): ``toward`` is the traction or coast step, entries already
+        if (tr_u <= target * target) if v0 < target else (co_u >= target * target):
+            continue
+        _table_entry(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f,
                      br_w, top_u, k_max, bias, table, p)
         p += 1
     if top_u > 0.0 and k_max > 0:
