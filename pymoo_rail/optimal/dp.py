@@ -459,22 +459,6 @@ def _n_targets(k_lo, k_hi, max_targets):
     return (count + stride - 1) // stride, stride
 
 
-@inlined
-def _table_entry(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, top_u, k_max, bias,
-                 table, p):
-    """Write one control's outcome from ``v0`` as entry ``p`` of a control table (:func:`control_table`)."""
-    modes, targets, pos, energy, dt, u1s = table
-    u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-    # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost`` does
-    e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
-    modes[p] = mode
-    targets[p] = target
-    u1s[p] = u1
-    energy[p] = e
-    dt[p] = d
-    pos[p] = value_position(top_u, u1, k_max, bias) if e < INF else -1.0
-
-
 @njit(cache=True)
 def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
@@ -485,39 +469,49 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     (:func:`value_position`; -1 where the train stops in the cell), its net energy without the price
     of time (infinite where it stops), its time and the ``u = v^2`` it reaches (the simulator's
     ``cell_outcome`` and ``cell_cost``). The controls: the fixed ones, entries ``0 .. N_FIXED - 1``
-    in the order of :func:`_fixed_mode` (holding, the last, needs a speed to hold), ``toward`` each of the next position's singular speeds ``sing_v`` (where ``sing_p`` >= 0:
-    landing on them and holding them exactly), and ``toward`` speed nodes of the next position in
-    reach by partial traction (or braking). They depend on the kind of the cell (:func:`cell_types`),
+    in the order of :func:`_fixed_mode` (holding, the last, needs a speed to hold), ``toward`` each
+    of the next position's singular speeds ``sing_v`` in reach (where ``sing_p`` >= 0: landing on
+    them and holding them exactly), and ``toward`` speed nodes of the next position in reach by
+    partial traction (or braking). They depend on the kind of the cell (:func:`cell_types`),
     ``v0`` and the next position's singular speeds, not on the price of time or the cost-to-go.
     """
+    modes, targets, pos, energy, dt, u1s = table
     top_u = m.envelope_ms[cell + 1] ** 2
     tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
     co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
     br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
-    p = 0
     n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
-    for c in range(n_fixed):
-        _table_entry(m, v0, cell, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, top_u,
-                     k_max, bias, table, p)
-        p += 1
-    for s in range(sing_v.shape[0]):
-        target = sing_v[s]
-        if sing_p[s] < 0.0:
-            continue
-        # out of reach (``cell_outcome``'s rule): ``toward`` is the traction or coast step, entries already
-        if (tr_u <= target * target) if v0 < target else (co_u >= target * target):
-            continue
-        _table_entry(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f,
-                     br_w, top_u, k_max, bias, table, p)
-        p += 1
+    n_sing = sing_v.shape[0]
+    k_lo, stride, n_nodes = 1, 1, 0
     if top_u > 0.0 and k_max > 0:
         k_lo, k_hi = _target_range(top_u, k_max, v0 * v0, tr_u, co_u, bias)
-        stride = _n_targets(k_lo, k_hi, max_targets)[1]
-        for k in range(k_lo, k_hi + 1, stride):
-            target = math.sqrt(node_u(top_u, k, k_max, bias))
-            _table_entry(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f,
-                         br_w, top_u, k_max, bias, table, p)
-            p += 1
+        n_nodes, stride = _n_targets(k_lo, k_hi, max_targets)
+    p = 0
+    for c in range(n_fixed + n_sing + n_nodes):
+        if c < n_fixed:
+            mode = _fixed_mode(c)
+            target = 0.0
+        elif c < n_fixed + n_sing:
+            mode = MODE_TOWARD
+            target = sing_v[c - n_fixed]
+            if sing_p[c - n_fixed] < 0.0:
+                continue
+            # out of reach (``cell_outcome``'s rule): ``toward`` is the traction or coast step, entries already
+            if (tr_u <= target * target) if v0 < target else (co_u >= target * target):
+                continue
+        else:  # partial traction (or braking) landing exactly on a speed node of the next position
+            mode = MODE_TOWARD
+            target = math.sqrt(node_u(top_u, k_lo + (c - n_fixed - n_sing) * stride, k_max, bias))
+        u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+        # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost`` does
+        e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
+        modes[p] = mode
+        targets[p] = target
+        u1s[p] = u1
+        energy[p] = e
+        dt[p] = d
+        pos[p] = value_position(top_u, u1, k_max, bias) if e < INF else -1.0
+        p += 1
     return p
 
 
