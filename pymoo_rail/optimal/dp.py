@@ -817,9 +817,9 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
                 # the fixed controls are the table's first entries; holding from a standstill is traction
-                c = 0
-                while c < N_FIXED - 1 and _fixed_mode(c) != keep:
-                    c += 1
+                for c in range(N_FIXED):
+                    if _fixed_mode(c) == keep:
+                        break
                 if c == N_FIXED - 1 and v <= 0.0:
                     c = 0
                 c_keep = entry_cost(table, c, time_price_w[i], v_next, sp_next, sval_next)
