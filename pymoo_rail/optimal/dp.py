@@ -789,6 +789,18 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
                 split[int(sp_next[s])] = False
 
 
+@inlined
+def _fixed_entry(mode, v0):
+    """The entry of a fixed control ``mode`` in a control table from ``v0`` (:func:`control_table`): the
+    fixed controls come first, in the order of :func:`_fixed_mode`; holding from a standstill is traction."""
+    for c in range(N_FIXED):
+        if _fixed_mode(c) == mode:
+            break
+    if c == N_FIXED - 1 and v0 <= 0.0:
+        c = 0
+    return c
+
+
 @njit(cache=True)
 def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds, sing_v=None,
                     sing_p=None, sing_val=None):
@@ -832,12 +844,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         if i > 0 and mode != previous and tie_j > 0.0:
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
-                # the fixed controls are the table's first entries; holding from a standstill is traction
-                for c in range(N_FIXED):
-                    if _fixed_mode(c) == keep:
-                        break
-                if c == N_FIXED - 1 and v <= 0.0:
-                    c = 0
+                c = _fixed_entry(keep, v)
                 c_keep = entry_cost(table, c, time_price_w[i], v_next, sp_next, sval_next)
                 if c_keep < INF and c_keep <= cost + tie_j:
                     tie_cost += c_keep - cost
@@ -1033,7 +1040,7 @@ def part_power_transitions(m, n_speeds: int, bias: float, first_cell: np.ndarray
 
 @njit(cache=True)
 def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_p, sing_val):
-    """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`control_cost`'s sum)."""
+    """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`entry_cost`'s sum)."""
     u1, f, w0 = part_power_outcome(m, v0, cell, share)
     cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
     if cost < INF:
@@ -1094,26 +1101,29 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     as :func:`forward_rollout` does, a part-power cell its share. Returns what :func:`forward_rollout` does.
     """
     n = m.position_m.shape[0]
+    size = N_FIXED + sing_v.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
     energy = time = tie_cost = 0.0
     previous, previous_share = MODE_TRACTION, 1.0  # the control of the cell before
     for i in range(n - 1):
         price = time_price_w[i]
-        cost, mode, target = best_control(m, i, v, price, value[i + 1], max_targets, bias, sing_v[i + 1],
-                                          sing_p[i + 1], sing_val[i + 1])
+        n_entries = control_table(m, i, v, sing_v[i + 1], sing_p[i + 1], k_max, max_targets, bias, table)
+        cost, p = table_minimum(table, n_entries, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
+        mode, target = table[0][p], table[1][p]
         share = 1.0
         pp_cost, pp_share = best_part_power(m, i, v, price, value[i + 1], bias, sing_p[i + 1], sing_val[i + 1],
                                             shares)
         if pp_cost < cost:
             cost, mode, target, share = pp_cost, MODE_TOWARD, part_power_target(m, i), pp_share
-        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
-        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
-        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
         if i > 0 and tie_j > 0.0 and (mode != previous or share != previous_share):
             top_u = m.envelope_ms[i + 1] ** 2
+            c = p
             if previous_share < 1.0:  # keep pulling at the previous share
                 c_keep = part_power_cost(m, v, i, previous_share, price, value[i + 1], top_u, bias, sing_p[i + 1],
                                          sing_val[i + 1])
@@ -1123,16 +1133,16 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
                 keep_target = 0.0
                 c_keep = INF
                 if keep != mode or share < 1.0:
-                    c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                          price, value[i + 1], top_u, bias, sing_p[i + 1], sing_val[i + 1])
+                    c = _fixed_entry(keep, v)
+                    c_keep = entry_cost(table, c, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
             if c_keep < INF and c_keep <= cost + tie_j:
                 tie_cost += c_keep - cost
-                mode, target, share = keep, keep_target, previous_share
+                mode, target, share, p = keep, keep_target, previous_share, c
         if share < 1.0:
             u1, f, w0 = part_power_outcome(m, v, i, share)
-        else:
-            u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+            c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+        else:  # the table's entry, as ``cell_cost`` prices it with the auxiliary power alone
+            u1, c_energy, dt = table[5][p], table[3][p] + m.aux_power_w * table[4][p], table[4][p]
         energy += c_energy
         time += dt
         modes[i] = mode
