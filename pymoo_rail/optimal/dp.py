@@ -242,7 +242,7 @@ def interp_aug(v_next, p, sing_p, sing_val):
 def interp_split(v_next, p, split, sing_p, sing_val):
     """:func:`interp_aug` where ``split[k]`` says whether a singular speed lies inside the interval
     ``(k, k + 1)`` of the speed nodes: the others take :func:`interp_at`, the same arithmetic without
-    the search for one (a sweep 30 % faster)."""
+    the search for one: ``benchmarks/dp_sweep.py``, a sweep of generated seed 21 35 -> 27 ms)."""
     if p >= 0.0 and not split[int(p)]:
         return interp_at(v_next, p)
     return interp_aug(v_next, p, sing_p, sing_val)
@@ -544,9 +544,9 @@ def table_minimum(table, n_entries, time_price_w, v_next, sing_p, sing_val):
     """The entry of a control table (:func:`control_table`) of least :func:`entry_cost`, and that cost:
     ``(cost, entry)``, entry -1 (cost infinite) if every control stops in the cell; the first of equals.
 
-    With the next position's singular speeds ``sing_v``, ``sing_p``, ``sing_val`` (:func:`singular_speeds`)
-    as further nodes of the cost-to-go and, in the table, further ``toward`` targets, a run lands on
-    them and holds them exactly. A cost at least ``PENALTY_J``: no control can reach the platform.
+    ``sing_p``, ``sing_val``: the next position's singular speeds (:func:`singular_speeds`), further
+    nodes of the cost-to-go (and, in the table, further ``toward`` targets: a run lands on them and
+    holds them exactly). A cost at least ``PENALTY_J``: no control can reach the platform.
     """
     best = INF
     best_p = -1
@@ -689,8 +689,8 @@ def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v,
     ``t`` and singular speed ``s`` in row ``t * n_singular + s`` of ``memo``: a cell of the kind last
     tabulated from the same singular speed with the same next singular speeds (``memo_key``) reuses the
     table, the same numbers bit for bit, so a sweep pays the simulator's steps once per kind of cell
-    rather than once per cell and price of time (74 against 35 ms a sweep on a 38 km line, 30 ms
-    without the singular speeds).
+    rather than once per cell and price of time (``benchmarks/dp_sweep.py``: with :func:`interp_split`, a
+    sweep of the 32 km generated line of seed 21 takes 27 ms against 74 ms, 22 ms without them).
     """
     sp_next = sing_p[i + 1]
     sv_next = sing_val[i + 1]
