@@ -242,7 +242,7 @@ def interp_aug(v_next, p, sing_p, sing_val):
 def interp_split(v_next, p, split, sing_p, sing_val):
     """:func:`interp_aug` where ``split[k]`` says whether a singular speed lies inside the interval
     ``(k, k + 1)`` of the speed nodes: the others take :func:`interp_at`, the same arithmetic without
-    the search for one: ``benchmarks/dp_sweep.py``, a sweep of generated seed 21 35 -> 27 ms)."""
+    the search for one: ``benchmarks/peers.py --sweep-cpu``, a sweep of generated seed 21 35 -> 27 ms)."""
     if p >= 0.0 and not split[int(p)]:
         return interp_at(v_next, p)
     return interp_aug(v_next, p, sing_p, sing_val)
@@ -689,7 +689,7 @@ def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v,
     ``t`` and singular speed ``s`` in row ``t * n_singular + s`` of ``memo``: a cell of the kind last
     tabulated from the same singular speed with the same next singular speeds (``memo_key``) reuses the
     table, the same numbers bit for bit, so a sweep pays the simulator's steps once per kind of cell
-    rather than once per cell and price of time (``benchmarks/dp_sweep.py``: with :func:`interp_split`, a
+    rather than once per cell and price of time (``benchmarks/peers.py --sweep-cpu``: with :func:`interp_split`, a
     sweep of the 32 km generated line of seed 21 takes 27 ms against 74 ms, 22 ms without them).
     """
     sp_next = sing_p[i + 1]
