@@ -238,6 +238,16 @@ def interp_aug(v_next, p, sing_p, sing_val):
     return lv + (p - lp) / (rp - lp) * (rv - lv)
 
 
+@inlined
+def interp_split(v_next, p, split, sing_p, sing_val):
+    """:func:`interp_aug` where ``split[k]`` says whether a singular speed lies inside the interval
+    ``(k, k + 1)`` of the speed nodes: the others take :func:`interp_at`, the same arithmetic without
+    the search for one: ``benchmarks/peers.py --sweep-cpu``, a sweep of generated seed 21 35 -> 27 ms)."""
+    if p >= 0.0 and not split[int(p)]:
+        return interp_at(v_next, p)
+    return interp_aug(v_next, p, sing_p, sing_val)
+
+
 @njit(cache=True)
 def interp_value(v_next, top_u, u, bias):
     """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
@@ -413,19 +423,138 @@ def place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p):
             sing_p[i, s] = p
 
 
-@inlined
-def control_cost(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, time_price_w,
-                 v_next, top_u, bias, sing_p, sing_val):
-    """Cell cost plus interpolated cost-to-go of one control from ``v0`` (:func:`cell_outcome`, :func:`cell_cost`).
+# The extra states (``sing_*`` arrays) begin with the two singular speeds (:func:`singular_speeds`);
+# the coast curves (:func:`coast_curves`) follow in the further columns
+N_SINGULAR = 2
 
-    Infinite when the train stops inside the cell; the cost-to-go ``v_next`` is spread over
-    ``[0, top_u]``, with the next position's singular speeds as further nodes (:func:`interp_aug`).
+
+@njit(cache=True)
+def coast_curve(m, i_end, v_end, curve_v):
+    """The speeds from which coasting lands exactly on ``v_end`` at node ``i_end``, backwards from it.
+
+    Writes ``curve_v[i]`` for the nodes ``i < i_end`` the curve reaches: each the inverse of the
+    simulator's own coast step over cell ``i`` (its envelope clamp included), by bisection on the
+    entry speed. The curve stops where it leaves the braking envelope (no state there coasts onto
+    it) or reaches a stop (every state does). Returns the first node written (``i_end``: none).
     """
-    u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-    cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
-    if cost < INF:
-        cost += interp_aug(v_next, value_position(top_u, u1, v_next.shape[0] - 1, bias), sing_p, sing_val)
-    return cost
+    target_u = v_end * v_end
+    for i in range(i_end - 1, -1, -1):
+        top = m.envelope_ms[i]
+        cap = m.envelope_ms[i + 1] ** 2
+        if top <= 0.0 or min(full_step(m, top, i, KIND_COAST)[0], cap) < target_u:
+            return i + 1
+        if full_step(m, 1e-6, i, KIND_COAST)[0] >= target_u:
+            return i + 1
+        lo_v, hi_v = 0.0, top
+        for _ in range(100):
+            mid = 0.5 * (lo_v + hi_v)
+            if min(full_step(m, mid, i, KIND_COAST)[0], cap) < target_u:
+                lo_v = mid
+            else:
+                hi_v = mid
+            if hi_v - lo_v <= 1e-13 * hi_v:
+                break
+        curve_v[i] = 0.5 * (lo_v + hi_v)
+        target_u = curve_v[i] * curve_v[i]
+    return 0
+
+
+@njit(cache=True)
+def place_curve(m, curve_v, start, stop, n_speeds, bias, out_v, out_p):
+    """Write a coast curve's speeds over nodes ``start:stop`` and their fractional node indices (-1 at or above
+    the braking envelope, where the top node is the state, or within 1e-3 of a regular node)."""
+    k_max = n_speeds - 1
+    for i in range(start, stop):
+        out_v[i] = curve_v[i]
+        top_u = m.envelope_ms[i] ** 2
+        u = curve_v[i] * curve_v[i]
+        if u < top_u:
+            p = node_position(top_u, u, k_max, bias)
+            if abs(p - round(p)) >= 1e-3:
+                out_p[i] = p
+
+
+def envelope_corners(m) -> np.ndarray:
+    """The feet of the braking curves (n_corners,): the nodes where the braking envelope stops falling.
+
+    The ends of descents held at a limit by braking are corners of the same kind in principle (a run
+    along the envelope stops braking there); taken as well, they made the answer on one generated line
+    worse (seed 5 at 1.5 x the minimum time, +0.44 % of traction energy above ms-eetc, against +0.10 %
+    without): the run rode their curve while the cost-to-go still overstates other runs, at low speed.
+    """
+    env = m.envelope_ms
+    return np.flatnonzero((env[:-2] > env[1:-1]) & (env[1:-1] <= env[2:])) + 1
+
+
+@njit(cache=True)
+def traction_curve(m, curve_v):
+    """The run at full traction from the case's initial speed, up to the braking envelope: writes
+    ``curve_v[i]`` for the nodes below it and returns the first node it reaches the envelope at."""
+    n = m.position_m.shape[0]
+    v = m.initial_speed_ms
+    for i in range(n - 1):
+        if v <= 0.0 and i > 0 or v >= m.envelope_ms[i]:
+            return i
+        curve_v[i] = v
+        v = math.sqrt(max(full_step(m, v, i, KIND_TRACTION)[0], 0.0))
+    return n - 1
+
+
+def coast_curves(model, end_lo_ms: float, n_speeds: int, bias: float, max_curves: int = 6) -> tuple:
+    """The coast curves into the corners of the braking envelope and into the end speed: kinks of the cost-to-go.
+
+    At a corner (a node where the envelope stops falling: the foot of a braking curve at a lower
+    limit, or the end of the line) the cost-to-go has a kink along the coasting run that arrives
+    there exactly at the envelope: a state above it brakes its surplus away (``eta_regen`` back per
+    joule of kinetic energy), a state below keeps it or pulls for it later (``1 / eta_traction``). The
+    same at the end speed asked for (or the lower end of its window), below which the end costs
+    traction. Interpolating across such a kink between speed nodes overestimates the cost-to-go by a
+    share of a node spacing at every cell, and a run's final coast lies on the kink: measured on a
+    generated line ending at 72 km/h, the DP's value above the energy + lambda x time of its own run by
+    0.53 kWh at 200 nodes and 0.26 at 400, and the run 0.24 kWh (0.5 %) above the continuous optimum.
+    So each curve is one more state at every node it reaches (like the singular speeds). And, from a
+    moving start, the run at full traction from the initial speed (:func:`traction_curve`): at a start at
+    walking pace the first speed node above it lies metres per second away, and the cost-to-go, strongly
+    convex there, was overstated by 0.31 kWh over the first kilometre of a generated line (seed 5). A
+    start from rest is the first node itself.
+
+    Returns ``(curve_v, curve_p)`` (n_nodes, n_columns): speeds and fractional node indices (-1: none);
+    curves that do not overlap share a column, at most ``max_curves`` columns (the nearest corners ahead
+    of the end first).
+    """
+    env = model.envelope_ms
+    n = env.shape[0]
+    corners = [(n - 1, float(env[-1]))]
+    if 0.0 < end_lo_ms < env[-1]:
+        corners.append((n - 1, float(end_lo_ms)))
+    corners += [(int(i), float(env[i])) for i in envelope_corners(model)[::-1]]
+    columns: list[int] = []  # the first node each column is taken from
+    curve_v = np.zeros((n, max_curves))
+    curve_p = np.full((n, max_curves), -1.0)
+    work = np.zeros(n)
+    # a start from rest is a node: only a moving start needs its run at full traction as states
+    start_curve = [(-1, 0.0)] if model.initial_speed_ms > 0.0 else []
+    for i_end, v_end in corners + start_curve:
+        if i_end < 0:  # the start at full traction, last: it lies before every corner
+            start, i_end = 0, traction_curve(model, work)
+        elif v_end <= 0.0:
+            continue
+        else:
+            start = coast_curve(model, i_end, v_end, work)
+        if start >= i_end:
+            continue
+        free = [c for c, first in enumerate(columns) if first >= i_end]
+        if free:
+            col = free[0]
+        elif len(columns) < max_curves:
+            col = len(columns)
+            columns.append(n)
+        else:
+            continue
+        place_curve(model, work, start, i_end, n_speeds, bias, curve_v[:, col], curve_p[:, col])
+        columns[col] = start
+    k = len(columns)
+    return np.ascontiguousarray(curve_v[:, :k]), np.ascontiguousarray(curve_p[:, :k])
 
 
 # traction, coast, brake, hold. Holding is ``hold_brake``: where coasting decelerates it is ``hold``
@@ -473,55 +602,94 @@ def _n_targets(k_lo, k_hi, max_targets):
 
 
 @njit(cache=True)
-def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias, sing_v, sing_p, sing_val):
-    """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
+def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
+    """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
 
-    ``sing_v``, ``sing_p``, ``sing_val`` are the next position's singular speeds, their node
-    indices and cost-to-go (:func:`singular_speeds`): further nodes of the cost-to-go and further
-    ``toward`` targets, so that a run lands on them and holds them exactly.
-    Returns ``(total_cost, mode, target_ms)``; ``total_cost`` is at least ``PENALTY_J`` when no
-    control can reach the platform.
+    ``table`` is ``(modes, targets, positions, energies, times, u1)``, arrays of at least
+    ``N_FIXED + sing_v.shape[0] + max_targets`` entries: per control its mode and target speed, the
+    node position it reaches among the next position's ``k_max + 1`` speed nodes
+    (:func:`value_position`; -1 where the train stops in the cell), its net energy without the price
+    of time (infinite where it stops), its time and the ``u = v^2`` it reaches (the simulator's
+    ``cell_outcome`` and ``cell_cost``). The controls: the fixed ones, entries ``0 .. N_FIXED - 1``
+    in the order of :func:`_fixed_mode` (holding, the last, needs a speed to hold), ``toward`` each
+    of the next position's singular speeds ``sing_v`` in reach (where ``sing_p`` >= 0: landing on
+    them and holding them exactly), and ``toward`` speed nodes of the next position in reach by
+    partial traction (or braking). They depend on the kind of the cell (:func:`cell_types`),
+    ``v0`` and the next position's singular speeds, not on the price of time or the cost-to-go.
     """
+    modes, targets, pos, energy, dt, u1s = table
     top_u = m.envelope_ms[cell + 1] ** 2
-    k_max = v_next.shape[0] - 1
     tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
     co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
     br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
-    best = INF
-    best_mode = MODE_COAST
-    best_target = 0.0
     n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
-    for c in range(n_fixed):
-        mode = _fixed_mode(c)
-        cost = control_cost(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                            time_price_w, v_next, top_u, bias, sing_p, sing_val)
-        if cost < best:
-            best = cost
-            best_mode = mode
-            best_target = 0.0
-    for s in range(sing_v.shape[0]):  # land exactly on a singular speed (holding it, from it)
-        if sing_p[s] < 0.0:
-            continue
-        target = sing_v[s]
-        cost = control_cost(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                            br_u, br_f, br_w, time_price_w, v_next, top_u, bias, sing_p, sing_val)
-        if cost < best:
-            best = cost
-            best_mode = MODE_TOWARD
-            best_target = target
-    # partial traction (or braking) landing exactly on a speed node of the next position
+    n_sing = sing_v.shape[0]
+    k_lo, stride, n_nodes = 1, 1, 0
     if top_u > 0.0 and k_max > 0:
         k_lo, k_hi = _target_range(top_u, k_max, v0 * v0, tr_u, co_u, bias)
-        stride = _n_targets(k_lo, k_hi, max_targets)[1]
-        for k in range(k_lo, k_hi + 1, stride):
-            target = math.sqrt(node_u(top_u, k, k_max, bias))
-            cost = control_cost(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                br_u, br_f, br_w, time_price_w, v_next, top_u, bias, sing_p, sing_val)
-            if cost < best:
-                best = cost
-                best_mode = MODE_TOWARD
-                best_target = target
-    return best, best_mode, best_target
+        n_nodes, stride = _n_targets(k_lo, k_hi, max_targets)
+    p = 0
+    for c in range(n_fixed + n_sing + n_nodes):
+        if c < n_fixed:
+            mode = _fixed_mode(c)
+            target = 0.0
+        elif c < n_fixed + n_sing:
+            mode = MODE_TOWARD
+            target = sing_v[c - n_fixed]
+            if sing_p[c - n_fixed] < 0.0:
+                continue
+            # out of reach (``cell_outcome``'s rule): ``toward`` is the traction or coast step, entries already
+            if (tr_u <= target * target) if v0 < target else (co_u >= target * target):
+                continue
+        else:  # partial traction (or braking) landing exactly on a speed node of the next position
+            mode = MODE_TOWARD
+            target = math.sqrt(node_u(top_u, k_lo + (c - n_fixed - n_sing) * stride, k_max, bias))
+        u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+        # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost`` does
+        e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
+        modes[p] = mode
+        targets[p] = target
+        u1s[p] = u1
+        energy[p] = e
+        dt[p] = d
+        pos[p] = value_position(top_u, u1, k_max, bias) if e < INF else -1.0
+        p += 1
+    return p
+
+
+@inlined
+def entry_cost(table, p, time_price_w, v_next, sing_p, sing_val):
+    """Cost of entry ``p`` of a control table (:func:`control_table`) plus the cost-to-go it reaches.
+
+    The cell priced as ``cell_cost`` prices it, then the cost-to-go interpolated in ``v_next`` with the
+    next position's singular speeds as further nodes (:func:`interp_aug`); infinite where the train
+    stops in the cell.
+    """
+    e = table[3][p]
+    if e < INF:
+        cost = e + time_price_w * table[4][p]
+        cost += interp_aug(v_next, table[2][p], sing_p, sing_val)
+        return cost
+    return INF
+
+
+@inlined
+def table_minimum(table, n_entries, time_price_w, v_next, sing_p, sing_val):
+    """The entry of a control table (:func:`control_table`) of least :func:`entry_cost`, and that cost:
+    ``(cost, entry)``, entry -1 (cost infinite) if every control stops in the cell; the first of equals.
+
+    ``sing_p``, ``sing_val``: the next position's singular speeds (:func:`singular_speeds`), further
+    nodes of the cost-to-go (and, in the table, further ``toward`` targets: a run lands on them and
+    holds them exactly). A cost at least ``PENALTY_J``: no control can reach the platform.
+    """
+    best = INF
+    best_p = -1
+    for p in range(n_entries):
+        cost = entry_cost(table, p, time_price_w, v_next, sing_p, sing_val)
+        if cost < best:
+            best = cost
+            best_p = p
+    return best, best_p
 
 
 def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
@@ -647,14 +815,39 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
 
 
 @njit(cache=True)
-def _singular_rows(m, i, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val):
-    """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them."""
-    for s in range(sing_v.shape[1]):
+def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val, memo_key,
+                   memo_n, memo):
+    """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them.
+
+    The least :func:`entry_cost` of their control tables (:func:`control_table`), kept per kind of cell
+    ``t`` and singular speed ``s`` in row ``t * n_singular + s`` of ``memo``: a cell of the kind last
+    tabulated from the same singular speed with the same next singular speeds (``memo_key``) reuses the
+    table, the same numbers bit for bit, so a sweep pays the simulator's steps once per kind of cell
+    rather than once per cell and price of time (``benchmarks/peers.py --sweep-cpu``: with :func:`interp_split`, a
+    sweep of the 32 km generated line of seed 21 takes 27 ms against 74 ms, 22 ms without them).
+    """
+    sp_next = sing_p[i + 1]
+    sv_next = sing_val[i + 1]
+    n_sing = sing_v.shape[1]
+    for s in range(n_sing):
         sing_val[i, s] = PENALTY_J
         if sing_p[i, s] < 0.0 or sing_p[i, s] < floor_k:
             continue
-        best = best_control(m, i, sing_v[i, s], price_w, v_next, max_targets, bias, sing_v[i + 1], sing_p[i + 1],
-                            sing_val[i + 1])[0]
+        v0 = sing_v[i, s]
+        row = t * n_sing + s
+        table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row], memo[5][row])
+        # the table's key: the speed held and the next position's singular targets (-1: none there)
+        key = memo_key[row]
+        same = key[0] == v0
+        for q in range(n_sing):
+            same = same and key[q + 1] == (sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0)
+        if not same:
+            memo_n[row] = control_table(m, i, v0, sing_v[i + 1], sp_next, v_next.shape[0] - 1, max_targets, bias,
+                                        table)
+            key[0] = v0
+            for q in range(n_sing):
+                key[q + 1] = sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0
+        best = table_minimum(table, memo_n[row], price_w, v_next, sp_next, sv_next)[0]
         sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
 
 
@@ -674,7 +867,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
 
     The singular speeds (:func:`singular_speeds`: ``sing_v``, ``sing_p``, both (n_nodes, 2)) are
     further states: their cost-to-go ``sing_val`` (n_nodes, 2) is found by evaluating every control
-    from them with the simulator's steps (:func:`best_control`, as in the forward run, prices
+    from them with the simulator's steps (:func:`control_table`, as in the forward run, prices
     ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
     through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
     them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone.
@@ -687,30 +880,59 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
         value[n - 1, j] = terminal_j[j] if j >= floor_k[n - 1] else PENALTY_J
     for s in range(sing_val.shape[1]):
         sing_val[n - 1, s] = PENALTY_J
+    # the singular speeds' control tables, one per kind of cell and singular speed, filled as the sweep
+    # meets them (:func:`_singular_rows`); a key of NaN matches nothing
+    n_sing = sing_v.shape[1]
+    n_rows = (offsets.shape[0] - 1) // n_speeds * n_sing
+    memo_key = np.full((n_rows, 1 + n_sing), np.nan)
+    split = np.zeros(n_speeds, dtype=np.bool_)  # :func:`interp_split`
+    memo_n = np.zeros(n_rows, dtype=np.int64)
+    size = N_FIXED + n_sing + max_targets
+    memo = (np.empty((n_rows, size), dtype=np.int64), np.empty((n_rows, size)), np.empty((n_rows, size)),
+            np.empty((n_rows, size)), np.empty((n_rows, size)), np.empty((n_rows, size)))
     for i in range(n - 2, -1, -1):
         v_next = value[i + 1]
         sp_next = sing_p[i + 1]
         sv_next = sing_val[i + 1]
         t = cell_type[i]
-        _singular_rows(m, i, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
-                       sing_val)
+        for s in range(n_sing):  # the intervals of the next position's nodes a singular speed splits
+            q = sp_next[s]
+            if q >= 0.0 and q != math.floor(q):
+                split[int(q)] = True
+        _singular_rows(m, i, t, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
+                       sing_val, memo_key, memo_n, memo)
         for j in range(n_speeds):
             best = INF
             for c in range(fixed_e.shape[2]):  # N_FIXED, and the part-power shares where the train has them
                 e = fixed_e[t, j, c]
                 if e < INF:
-                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_aug(v_next, fixed_u1[t, j, c], sp_next,
-                                                                                 sv_next)
+                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_split(v_next, fixed_u1[t, j, c], split,
+                                                                                   sp_next, sv_next)
                     if cost < best:
                         best = cost
             s = t * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_aug(v_next, tgt_u1[p], sp_next, sv_next)
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_split(v_next, tgt_u1[p], split, sp_next, sv_next)
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
+        for s in range(n_sing):
+            if sp_next[s] >= 0.0:
+                split[int(sp_next[s])] = False
+
+
+@inlined
+def _fixed_entry(mode, v0):
+    """The entry of a fixed control ``mode`` in a control table from ``v0`` (:func:`control_table`): the
+    fixed controls come first, in the order of :func:`_fixed_mode`; holding from a standstill is traction."""
+    for c in range(N_FIXED):
+        if _fixed_mode(c) == mode:
+            break
+    if c == N_FIXED - 1 and v0 <= 0.0:
+        c = 0
+    return c
 
 
 @njit(cache=True)
@@ -736,6 +958,10 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         sv_all = sing_v
         sp_all = sing_p
         sval_all = sing_val
+    size = N_FIXED + sp_all.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
     energy = 0.0
@@ -743,30 +969,27 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     tie_cost = 0.0
     previous = MODE_TRACTION
     for i in range(n - 1):
-        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias, sv_all[i + 1],
-                                          sp_all[i + 1], sval_all[i + 1])
+        v_next, sp_next, sval_next = value[i + 1], sp_all[i + 1], sval_all[i + 1]
+        n_entries = control_table(m, i, v, sv_all[i + 1], sp_next, k_max, max_targets, bias, table)
+        cost, p = table_minimum(table, n_entries, time_price_w[i], v_next, sp_next, sval_next)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
-        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
-        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
-        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
+        mode, target = table[0][p], table[1][p]
         if i > 0 and mode != previous and tie_j > 0.0:
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
-                c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias, sp_all[i + 1],
-                                      sval_all[i + 1])
+                c = _fixed_entry(keep, v)
+                c_keep = entry_cost(table, c, time_price_w[i], v_next, sp_next, sval_next)
                 if c_keep < INF and c_keep <= cost + tie_j:
                     tie_cost += c_keep - cost
-                    mode, target = keep, 0.0
-        u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
-        energy += c_energy
-        time += dt
+                    mode, target, p = keep, 0.0, c
+        # the chosen control's cell, as ``cell_cost`` prices it with the auxiliary power alone
+        energy += table[3][p] + m.aux_power_w * table[4][p]
+        time += table[4][p]
         modes[i] = mode
         targets[i] = target
         previous = mode
-        v = math.sqrt(u1)
+        v = math.sqrt(table[5][p])
         speeds[i + 1] = v
     return n - 1, energy, time, tie_cost
 
@@ -793,7 +1016,7 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
 
 def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray,
           floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None, singular: bool = True,
-          sing: tuple | None = None, reuse: bool = False):
+          sing: tuple | None = None, reuse: bool = False, arrival: tuple | None = None):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
@@ -810,14 +1033,17 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
     energy, and the tables already hold it.
 
-    ``sing``: arrays ``(sing_v, sing_p, sing_val)`` (each (n_nodes, 2)) to hold the singular speeds and
+    ``sing``: arrays ``(sing_v, sing_p, sing_val)`` (each (n_nodes, 2), or more columns with ``arrival``) to hold the singular speeds and
     their cost-to-go (default: new ones). ``reuse``: ``value`` and ``sing`` still hold the sweep of an
     earlier solve at the same price and settings: only the forward run is made (the certificate's run
-    without the tie rule reuses the chosen run's sweep).
+    without the tie rule reuses the chosen run's sweep). ``arrival``: ``(curve_v, curve_p)`` of
+    :func:`coast_curves`, the coast curves as further states (the columns of ``sing`` after the first
+    ``N_SINGULAR``; with ``singular`` only).
     """
     n = model.position_m.shape[0]
     if sing is None:
-        sing = (np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2)))
+        n_extra = N_SINGULAR + (0 if arrival is None else arrival[0].shape[1])
+        sing = tuple(np.empty((n, n_extra)) for _ in range(3))
     sing_v, sing_p, sing_val = sing
     if reuse:
         return _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, sing_val)
@@ -829,6 +1055,8 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     price = prices + model.aux_power_w
     if singular:
         singular_speeds(model, price, value.shape[1], float(bias), sing_v, sing_p)
+        if arrival is not None:
+            sing_v[:, N_SINGULAR:], sing_p[:, N_SINGULAR:] = arrival
     else:
         sing_v[:] = 0.0
         sing_p[:] = -1.0
@@ -951,7 +1179,7 @@ def part_power_transitions(m, n_speeds: int, bias: float, first_cell: np.ndarray
 
 @njit(cache=True)
 def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_p, sing_val):
-    """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`control_cost`'s sum)."""
+    """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`entry_cost`'s sum)."""
     u1, f, w0 = part_power_outcome(m, v0, cell, share)
     cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
     if cost < INF:
@@ -1012,26 +1240,29 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     as :func:`forward_rollout` does, a part-power cell its share. Returns what :func:`forward_rollout` does.
     """
     n = m.position_m.shape[0]
+    size = N_FIXED + sing_v.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
     energy = time = tie_cost = 0.0
     previous, previous_share = MODE_TRACTION, 1.0  # the control of the cell before
     for i in range(n - 1):
         price = time_price_w[i]
-        cost, mode, target = best_control(m, i, v, price, value[i + 1], max_targets, bias, sing_v[i + 1],
-                                          sing_p[i + 1], sing_val[i + 1])
+        n_entries = control_table(m, i, v, sing_v[i + 1], sing_p[i + 1], k_max, max_targets, bias, table)
+        cost, p = table_minimum(table, n_entries, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
+        mode, target = table[0][p], table[1][p]
         share = 1.0
         pp_cost, pp_share = best_part_power(m, i, v, price, value[i + 1], bias, sing_p[i + 1], sing_val[i + 1],
                                             shares)
         if pp_cost < cost:
             cost, mode, target, share = pp_cost, MODE_TOWARD, part_power_target(m, i), pp_share
-        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
-        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
-        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
         if i > 0 and tie_j > 0.0 and (mode != previous or share != previous_share):
             top_u = m.envelope_ms[i + 1] ** 2
+            c = p
             if previous_share < 1.0:  # keep pulling at the previous share
                 c_keep = part_power_cost(m, v, i, previous_share, price, value[i + 1], top_u, bias, sing_p[i + 1],
                                          sing_val[i + 1])
@@ -1041,16 +1272,16 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
                 keep_target = 0.0
                 c_keep = INF
                 if keep != mode or share < 1.0:
-                    c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                          price, value[i + 1], top_u, bias, sing_p[i + 1], sing_val[i + 1])
+                    c = _fixed_entry(keep, v)
+                    c_keep = entry_cost(table, c, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
             if c_keep < INF and c_keep <= cost + tie_j:
                 tie_cost += c_keep - cost
-                mode, target, share = keep, keep_target, previous_share
+                mode, target, share, p = keep, keep_target, previous_share, c
         if share < 1.0:
             u1, f, w0 = part_power_outcome(m, v, i, share)
-        else:
-            u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+            c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+        else:  # the table's entry, as ``cell_cost`` prices it with the auxiliary power alone
+            u1, c_energy, dt = table[5][p], table[3][p] + m.aux_power_w * table[4][p], table[4][p]
         energy += c_energy
         time += dt
         modes[i] = mode
