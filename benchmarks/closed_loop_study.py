@@ -11,9 +11,7 @@ it, with Wilcoxon rank-sum tests of every controller against the best curve-trac
 
 The worlds are computed by :func:`pymoo_rail.experiments.loop_study.run_loop_study`: one record per world
 in a result store (``out/closed_loop_study/store``), in chunks handed to a process pool
-(``--workers``), so a stopped study resumes where it was when run again; each record carries the
-fingerprint of the code that computed it (:func:`pymoo_rail.experiments.loop_study.loop_code`) and
-worlds of other code are set aside and computed again. With the tuned trackers
+(``--workers``), so a stopped study resumes where it was when run again (by the same code). With the tuned trackers
 (default), each case's PID and fuzzy PID are first tuned on its plan by pymoo's DE
 (:func:`pymoo_rail.experiments.loop_study.tuned_trackers`).
 
@@ -39,8 +37,7 @@ from pymoo_rail.cases import load_case
 from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, loop_summary
 from pymoo_rail.experiments.loop_study import (
     advice_markdown,
-    load_loop_rows,
-    loop_code,
+    load_loop_rows, loop_code,
     loop_tests,
     run_loop_study,
     study_items,
