@@ -11,7 +11,7 @@ it, with Wilcoxon rank-sum tests of every controller against the best curve-trac
 
 The worlds are computed by :func:`pymoo_rail.experiments.loop_study.run_loop_study`: one record per world
 in a result store (``out/closed_loop_study/store``), in chunks handed to a process pool
-(``--workers``), so a stopped study resumes where it was when run again. With the tuned trackers
+(``--workers``), so a stopped study resumes where it was when run again (by the same code). With the tuned trackers
 (default), each case's PID and fuzzy PID are first tuned on its plan by pymoo's DE
 (:func:`pymoo_rail.experiments.loop_study.tuned_trackers`).
 
@@ -37,7 +37,7 @@ from pymoo_rail.cases import load_case
 from pymoo_rail.control.study import STUDY_CONTROLLERS, TUNED_CONTROLLERS, loop_summary
 from pymoo_rail.experiments.loop_study import (
     advice_markdown,
-    load_loop_rows,
+    load_loop_rows, loop_code,
     loop_tests,
     run_loop_study,
     study_items,
@@ -65,7 +65,7 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
     per_case = worlds.groupby(level=0, sort=False)
     return write_filled(REPORTS / "closed_loop_study.md", TEMPLATE, {
         "runs": args.runs, "runs_long": args.runs_long, "seed": args.seed,
-        "world_cpu_s": f"{worlds.sum():.0f}",
+        "world_cpu_s": f"{worlds.sum():.0f}", "code": loop_code()["pymoo-rail code"],
         "tuning": f", {seconds:.0f} s in the main process (the tuning)." if seconds else ".",
         "worlds": ", ".join(f"{c} {n}" for c, n in per_case.size().items()),
         "world_cpu": ", ".join(f"{c} {v:.1f} s" for c, v in per_case.median().items()),

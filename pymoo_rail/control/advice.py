@@ -21,6 +21,7 @@ import pandas as pd
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control.closed_loop import DEFAULT_DECIDE_EVERY_S, LoopState, plan_for
+from pymoo_rail.control.estimation import ResistanceEstimator
 from pymoo_rail.control.policy import ARRIVAL_TOL_S, OptimalPolicy
 from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.sim import Trajectory
@@ -172,6 +173,8 @@ class AdvisedDriving:
     switch_band_m, speed_band_kmh : float
         Hysteresis: a re-plan whose advice differs by less than this is not shown (the switch
         band only where advice is listed, :meth:`shown`).
+    estimator : ResistanceEstimator or None
+        The running resistance the planner uses, estimated from the run so far (None: the case's).
 
     Attributes
     ----------
@@ -189,6 +192,7 @@ class AdvisedDriving:
     speed_band_kmh: float = 3.0
     name: str = "advice"
     tracker: None = None
+    estimator: ResistanceEstimator | None = field(default_factory=ResistanceEstimator)
     boards: list = field(default_factory=list)
     _first_seen: dict = field(default_factory=dict)
 
@@ -201,7 +205,7 @@ class AdvisedDriving:
 
     def program(self, state: LoopState) -> np.ndarray:
         """Re-plan, update the advice shown (with hysteresis), and drive it with the reaction delay."""
-        rest = plan_for(self.policy, state)
+        rest = plan_for(self.policy, state, self.estimator)
         fresh = advice_from_run(rest, self.min_duration_s, self.speed_band_kmh)
         shown = self.boards[-1][2] if self.boards else ()
         before = current_advice(shown, state.position_m)
@@ -221,7 +225,9 @@ class AdvisedDriving:
         def speed_at(x):
             return np.interp(x, x_run, v_run)
 
-        board = fit_arrival(board, state, self.policy, self.speed_band_kmh)
+        resistance = self.estimator.factor if self.estimator is not None else None
+        board = fit_arrival(board, state, self.policy, self.speed_band_kmh, resistance, self.reaction_s - self.lead_s,
+                            speed_at)
         self.boards[-1] = (state.elapsed_s, state.position_m, board)
         now = current_advice(board, state.position_m)
         steps = [Advice(state.position_m, now.action, now.speed_kmh, now.final)]
@@ -256,25 +262,30 @@ class AdvisedDriving:
         return max(len(self.seen(run)) - 1, 0)
 
 
-def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_band_kmh: float = 3.0) -> tuple:
+def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_band_kmh: float = 3.0,
+                resistance_factor: float | None = None, reaction_s: float = 0.0, speed_at=None) -> tuple:
     """Move the switch into the last coast of ``board`` so that following it arrives at the planned time.
 
     Merging short regimes away (the short pulls a late train's re-plan asks for) changes the
     arrival; the switch from the last "power" or "hold" into coasting is moved to make up for it
     (by bisection on its position, simulated on the planner's model). A board that only coasts
     from here gets a "hold" of the speed now in front, ended where the time is met.
+    ``resistance_factor``: the planner's running resistance (:meth:`OptimalPolicy.replan`);
+    ``reaction_s`` and ``speed_at``: the driver's delay and the planned speed by position
+    (:func:`advice_program`), so that the switch is fitted for the driver who follows it late.
     """
+    speed_at = (lambda x: 0.0) if speed_at is None else speed_at
     if state.elapsed_s >= policy.planned_time_s:
         return board
     model = policy.model_ahead(state.position_m, state.speed_ms, state.restriction, state.mass_t,
-                               state.adhesion_factor)
+                               state.adhesion_factor, resistance_factor)
     length = float(model.position_m[-1])
     remaining = policy.planned_time_s - state.elapsed_s
     now = current_advice(board, state.position_m)
     items = [Advice(state.position_m, now.action, now.speed_kmh, now.final)] + [
         a for a in board if a.start_m > state.position_m]
     coasts = [k for k in range(1, len(items)) if items[k].action == "coast" and items[k - 1].action in ("power", "hold")]
-    as_shown = advice_program(tuple(items), lambda x: 0.0, 0.0, length)
+    as_shown = advice_program(tuple(items), speed_at, reaction_s, length)
     out = sk.simulate_batch_serial(model, as_shown[None])[0]
     if out[sk.OUT_REACHED] > 0 and abs(out[sk.OUT_RUNNING_TIME_S] - remaining) <= ARRIVAL_TOL_S:
         return board  # on time as it is: no change to show
@@ -290,7 +301,7 @@ def fit_arrival(board: tuple, state: LoopState, policy: OptimalPolicy, speed_ban
 
     def arrival(switch_m: float) -> float:
         trial = tuple(items[:k]) + (Advice(switch_m, "coast", items[k].speed_kmh),) + tuple(items[k + 1:])
-        program = advice_program(trial, lambda x: 0.0, 0.0, length)
+        program = advice_program(trial, speed_at, reaction_s, length)
         out = sk.simulate_batch_serial(model, program[None])[0]
         return out[sk.OUT_RUNNING_TIME_S] if out[sk.OUT_REACHED] > 0 else math.inf
 

@@ -33,9 +33,11 @@ import numpy as np
 
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.control import kernel as ck
-from pymoo_rail.control.controllers import PID, Controller, check_controller
+from pymoo_rail.control.controllers import PID, Controller, SpeedFilter, check_controller, filter_params
 from pymoo_rail.control.disturbances import Disturbance, adhesion_limited, disturbed_tracker
-from pymoo_rail.control.policy import OptimalPolicy, SpeedRestriction, model_from, restricted_model, run_trace
+from pymoo_rail.control.estimation import ResistanceEstimator, RunMeasurements
+from pymoo_rail.control.policy import (OptimalPolicy, SpeedRestriction, model_from, resistance_scaled, restricted_model,
+                                      run_trace)
 from pymoo_rail.control.tracking import DEFAULT_CONTROL_PERIOD_S
 from pymoo_rail.model import Case
 from pymoo_rail.model.errors import FieldError, check_number
@@ -87,10 +89,8 @@ def as_loop_disturbance(disturbance: Disturbance | None) -> LoopDisturbance:
 def real_model(case: Case, disturbance: LoopDisturbance, dx_m: float | None = None) -> KernelModel:
     """The kernels' model of the real train: disturbed mass, adhesion, resistance, regeneration, restriction."""
     model = disturbed_tracker(case, PID(), disturbance, dx_m=dx_m).simulator.model
-    f = disturbance.resistance_factor
-    model = model._replace(davis_a_n=model.davis_a_n * f, davis_b_nsm=model.davis_b_nsm * f,
-                           davis_c_ns2m2=model.davis_c_ns2m2 * f,
-                           regen_efficiency=min(model.regen_efficiency * disturbance.regen_factor, 1.0),
+    model = resistance_scaled(model, float(disturbance.resistance_factor))
+    model = model._replace(regen_efficiency=min(model.regen_efficiency * disturbance.regen_factor, 1.0),
                            regen_map_values=np.minimum(model.regen_map_values * disturbance.regen_factor, 1.0))
     if disturbance.restriction is not None:
         disturbance.restriction.check_on(case)
@@ -104,7 +104,8 @@ class LoopState:
 
     ``event`` is ``"departure"``, ``"period"`` or ``"announcement"``; ``mass_t`` is the train's
     measured mass (weighed at departure), ``adhesion_factor`` the rail's adhesion as the ATP knows it
-    (its braking curves, and so the real train's braking envelope, use it).
+    (its braking curves, and so the real train's braking envelope, use it); ``measured`` the run so
+    far as the train's sensors saw it (for an estimator, :mod:`pymoo_rail.control.estimation`).
     """
 
     position_m: float
@@ -114,6 +115,7 @@ class LoopState:
     mass_t: float
     event: str
     adhesion_factor: float = 1.0
+    measured: RunMeasurements | None = None
 
 
 class LoopController(Protocol):
@@ -122,6 +124,8 @@ class LoopController(Protocol):
     Instead of ``reference`` (followed by ``tracker``), a controller may give ``program(state)``:
     a driving program (``end_m, mode, target_ms`` rows, absolute positions) that drives the real
     train itself until the next decision, as a driver following advice or the optimal controls do.
+    An optional ``speed_filter`` (:class:`~pymoo_rail.control.controllers.SpeedFilter`) filters the
+    speed the tracker sees (absent or None: the sensor's reading as it is).
     """
 
     name: str
@@ -140,6 +144,7 @@ class CurveTracking:
     tracker: Controller
     name: str = "tracking"
     decide_every_s: float = math.inf
+    speed_filter: SpeedFilter | None = field(default_factory=SpeedFilter)
 
     def reference(self, state: LoopState) -> Trajectory:
         """The offline curve, whatever happens."""
@@ -155,11 +160,13 @@ class Replanning:
     decide_every_s: float = DEFAULT_DECIDE_EVERY_S
     name: str = "replanning"
     cpu_s: list = field(default_factory=list)
+    estimator: ResistanceEstimator | None = field(default_factory=ResistanceEstimator)
+    speed_filter: SpeedFilter | None = field(default_factory=SpeedFilter)
 
     def reference(self, state: LoopState) -> Trajectory:
         """The policy's optimal rest of the run, or the fastest run once the plan's time is past."""
         started = _time.process_time()
-        ref = plan_for(self.policy, state)
+        ref = plan_for(self.policy, state, self.estimator)
         self.cpu_s.append(_time.process_time() - started)
         return ref
 
@@ -173,6 +180,7 @@ class Recovery:
     tracker: Controller
     decide_every_s: float = DEFAULT_DECIDE_EVERY_S
     name: str = "recovery"
+    speed_filter: SpeedFilter | None = field(default_factory=SpeedFilter)
 
     def reference(self, state: LoopState) -> Trajectory:
         """The plan when on time; else flat out, coast down onto the plan's curve, then the plan."""
@@ -214,20 +222,31 @@ class OptimalControls:
     decide_every_s: float = DEFAULT_DECIDE_EVERY_S
     name: str = "optimal controls"
     tracker: Controller | None = None
+    estimator: ResistanceEstimator | None = field(default_factory=ResistanceEstimator)
 
     def program(self, state: LoopState) -> np.ndarray:
         """The driving program of the policy's optimal rest of the run from ``state``."""
-        plan_for(self.policy, state)
+        plan_for(self.policy, state, self.estimator)
         return self.policy.last_program
 
 
-def plan_for(policy: OptimalPolicy, state: LoopState) -> Trajectory:
+def planner_train(policy: OptimalPolicy, state: LoopState, estimator: ResistanceEstimator | None = None) -> tuple:
+    """The planner's train for ``state``: (restriction, mass, adhesion, resistance factor), the last
+    updated by ``estimator`` from ``state.measured`` (None: the case's resistance)."""
+    resistance = None
+    if estimator is not None and state.measured is not None:
+        resistance = estimator.update(policy.line_model(None, state.mass_t, state.adhesion_factor), state.measured)
+    return state.restriction, state.mass_t, state.adhesion_factor, resistance
+
+
+def plan_for(policy: OptimalPolicy, state: LoopState, estimator: ResistanceEstimator | None = None) -> Trajectory:
     """The policy's rest of the run from a loop state: :meth:`~OptimalPolicy.replan`, or the fastest run once the plan's time is past.
 
-    The planner's train may be less able than the real one (a resistance error): a state above its
-    braking envelope is taken at the envelope.
+    With ``estimator``, the planner's running resistance is the one estimated from the run so far
+    (:func:`planner_train`). The planner's train may be less able than the real one (a resistance
+    error): a state above its braking envelope is taken at the envelope.
     """
-    train = (state.restriction, state.mass_t, state.adhesion_factor)
+    train = planner_train(policy, state, estimator)
     speed = min(state.speed_ms, policy.envelope_ms(state.position_m, *train))
     if state.elapsed_s >= policy.planned_time_s:
         return policy.fastest(state.position_m, speed, state.elapsed_s, *train)
@@ -317,10 +336,10 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
     n = model.position_m.shape[0]
     noise = np.ascontiguousarray(d.noise_ms())
     code, params = int(tracker.code()), np.ascontiguousarray(tracker.params(), dtype=float)
+    filter_ab = filter_params(getattr(controller, "speed_filter", None))
     carry = np.zeros(ck.N_CARRY)  # the low-level controller, carried from one reference to the next
     node, v, t = 0, float(model.initial_speed_ms), float(d.departure_delay_s)
-    known: SpeedRestriction | None = None
-    pending = d.restriction is not None
+    known, pending = None, d.restriction is not None  # the restriction as the controller knows it
     parts: list[tuple] = []
     decisions: list[float] = []
     event = "departure"
@@ -329,7 +348,8 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
         if pending and d.announce_m <= float(model.position_m[node]):  # announced before departure
             known, pending = d.restriction, False
         state = LoopState(float(model.position_m[node]), v, t, known, case.train.mass_t * d.mass_factor, event,
-                          d.adhesion_factor)
+                          d.adhesion_factor, measurements(parts, float(model.position_m[node]), v, t, noise,
+                                                          float(control_period_s)))
         decisions.append(state.position_m)
         ahead = model_from(model, node, v)
         x_end = float(d.announce_m) if pending and d.announce_m > state.position_m else math.inf
@@ -344,7 +364,7 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
             previous = ref
             out, x, vs, ts, a, f, r, _ = ck.track_trace(ahead, v_ref, float(x_start), float(x_stop), code, params,
                                                         float(control_period_s), noise, float(d.traction_lag_s),
-                                                        carry, every_s, x_end)
+                                                        filter_ab, carry, every_s, x_end)
             carry[ck.C_RESUME] = 1.0
             count = x.shape[0]
             finished = out[sk.OUT_REACHED] == 0.0 or count == ahead.position_m.shape[0]
@@ -359,6 +379,29 @@ def closed_loop(case: Case, controller: LoopController, disturbance: Disturbance
         node += count - 1
         v, t = float(vs[-1]), float(ts[-1] + t)
     return _assemble(model, parts, d, planned, decisions, n)
+
+
+def measurements(parts: list, position_m: float, speed_ms: float, time_s: float, noise_ms: np.ndarray,
+                 period_s: float) -> RunMeasurements | None:
+    """The run so far (``parts`` of the closed loop, then the train at its current state) as its sensors saw it.
+
+    Sampled every ``period_s`` from departure (the speed sensor's instants, with the run's own
+    sensor noise ``noise_ms`` in turn), and at the current state; the work of the applied force
+    sums each grid cell's force times its length. None before the first leg.
+    """
+    if not parts:
+        return None
+    x = np.concatenate([p[0] for p in parts] + [[position_m]])
+    v = np.concatenate([p[1] for p in parts] + [[speed_ms]])
+    t = np.concatenate([p[2] for p in parts] + [[time_s]])
+    f = np.concatenate([p[4] for p in parts])
+    work = np.concatenate([[0.0], np.cumsum(f * np.diff(x))])
+    instants = np.append(np.arange(t[0], t[-1], period_s), t[-1])
+    noise = (noise_ms[np.arange(instants.shape[0]) % noise_ms.shape[0]] if noise_ms.size
+             else np.zeros(instants.shape[0]))
+    noise[0] = 0.0  # standing at departure: the reading is exact
+    return RunMeasurements(instants, np.interp(instants, t, x), np.interp(instants, t, v) + noise,
+                           np.interp(instants, t, work))
 
 
 def _assemble(model: KernelModel, parts: list, d: LoopDisturbance, planned: float, decisions: list,

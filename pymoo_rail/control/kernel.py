@@ -52,7 +52,40 @@ _S_MODE, _S_INTEGRAL, _S_PREV_E, _S_HAS_PREV = 0, 1, 2, 3
 # What a run carries over to the next call that continues it (a closed loop changes the reference
 # at decision instants): the controller state, then these slots
 C_COMMAND, C_TO_NEXT, C_SINCE_LAST, C_INSTANT, C_RESUME, C_PHASE = 4, 5, 6, 7, 8, 9
-N_CARRY = 10
+# the speed filter's estimate: speed (m/s), acceleration (m/s^2), whether it has a first reading,
+# the true speed at the last reading (what an accelerometer integrates from)
+C_FILTER_V, C_FILTER_A, C_FILTER_ON, C_FILTER_LAST = 10, 11, 12, 13
+N_CARRY = 14
+
+
+@njit(cache=True)
+def filter_speed(carry, v_meas, v_true, dt_s, params):
+    """One step of the speed filter ``params = (alpha, beta, accelerometer)``; returns the filtered speed (m/s).
+
+    Predict the speed at this reading: with ``accelerometer`` > 0, the estimate plus the speed
+    change the train's accelerometer integrated since the last reading (taken as exact: ``v_true``
+    now minus then); else ``v + a dt`` with the filter's own acceleration estimate (an alpha-beta
+    filter). Then correct the speed by ``alpha`` and the acceleration by ``beta / dt`` times the
+    residual. The first reading is taken as it is; ``(1, 0, 0)`` passes the measurement through.
+    The estimate lives in ``carry`` (``C_FILTER_*``).
+    """
+    alpha, beta, accelerometer = params[0], params[1], params[2] > 0.0
+    if carry[C_FILTER_ON] == 0.0 or dt_s <= 0.0:
+        if carry[C_FILTER_ON] == 0.0:
+            carry[C_FILTER_V] = v_meas
+            carry[C_FILTER_A] = 0.0
+            carry[C_FILTER_ON] = 1.0
+            carry[C_FILTER_LAST] = v_true
+        return carry[C_FILTER_V]
+    if accelerometer:
+        predicted = carry[C_FILTER_V] + (v_true - carry[C_FILTER_LAST])
+    else:
+        predicted = carry[C_FILTER_V] + carry[C_FILTER_A] * dt_s
+    carry[C_FILTER_LAST] = v_true
+    residual = v_meas - predicted
+    carry[C_FILTER_V] = predicted + alpha * residual
+    carry[C_FILTER_A] += beta * residual / dt_s
+    return carry[C_FILTER_V]
 
 
 # ---------------------------------------------------------------- controllers
@@ -234,7 +267,7 @@ def reference_phases(x, regime, count):
 
 @njit(cache=True)
 def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record,
-              tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, tr_u, noise_ms, lag_s, carry, t_end_s, x_end_m):
+              tr_x, tr_v, tr_t, tr_a, tr_f, tr_r, tr_u, noise_ms, lag_s, filter_ab, carry, t_end_s, x_end_m):
     """One tracked run; writes the ``OUT_*`` summary into ``out`` and, if ``record``, the trace.
 
     The run starts at the model's first node at its ``initial_speed_ms`` (0 for a run from the
@@ -250,7 +283,8 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
     Disturbances of the controlled part: ``noise_ms`` is added to the measured speed at the
     successive control instants (cycled; empty: none); the applied command follows the
     controller's through a first-order lag of time constant ``lag_s`` (0: at once), the delayed
-    response of the traction and brake equipment.
+    response of the traction and brake equipment. The controller sees the measured speed through
+    the filter ``filter_ab = (alpha, beta, accelerometer)`` (:func:`filter_speed`; ``(1, 0, 0)``: none).
     Returns the number of trace nodes written.
     """
     n = m.position_m.shape[0]
@@ -272,6 +306,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
         k_instant = int(carry[C_INSTANT])
     else:
         state[:] = 0.0
+        carry[C_FILTER_ON] = 0.0
     v = m.initial_speed_ms
     t = 0.0
     reached = n > 0  # a run-time True, not the literal: one compiled close_cell for every caller
@@ -296,6 +331,7 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
             if n_noise > 0:
                 v_meas = v + noise_ms[k_instant % n_noise]
                 k_instant += 1
+            v_meas = filter_speed(carry, v_meas, v, t - t_last, filter_ab)
             u_cmd = controller_command(code, params, state, (v_ref[i] - v_meas) * KMH_PER_MS, t - t_last)
             t_last = t
             while t_next <= t + 1e-12:
@@ -348,7 +384,8 @@ def track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record
 
 
 @njit(cache=True)
-def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms, lag_s, carry, t_end_s, x_end_m):
+def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms, lag_s, filter_ab, carry, t_end_s,
+                x_end_m):
     """One tracked run with its trace: (summary, x, v, t, a, force, regime, command), trimmed (see :func:`track_run`)."""
     n = m.position_m.shape[0]
     out = np.empty(N_OUT)
@@ -356,7 +393,7 @@ def track_trace(m, v_ref, x_start_m, x_stop_m, code, params, period_s, noise_ms,
     u = np.empty(n)
     record = n >= 0  # run-time booleans, not literals: one compiled track_run / run_program each
     count = track_run(m, v_ref, x_start_m, x_stop_m, code, params, period_s, out, record, x, v, t, a, f, r, u,
-                      noise_ms, lag_s, carry, t_end_s, x_end_m)
+                      noise_ms, lag_s, filter_ab, carry, t_end_s, x_end_m)
     return out, x[:count], v[:count], t[:count], a[:count], f[:count], r[:count], u[:count]
 
 
@@ -383,6 +420,6 @@ def track_programs(m, programs, code, params, period_s):
         v[count:] = 0.0
         x_start, x_stop = reference_phases(x, r, count)
         track_run(m, v, x_start, x_stop, code, params, period_s, out[j], no_record,
-                  empty, empty, empty, empty, empty, empty_r, empty, empty, 0.0,
+                  empty, empty, empty, empty, empty, empty_r, empty, empty, 0.0, np.array([1.0, 0.0, 0.0]),
                   np.zeros(N_CARRY), math.inf, math.inf)
     return out

@@ -7,7 +7,7 @@ import numpy as np
 
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.control import kernel as ck
-from pymoo_rail.control.controllers import Controller, check_controller
+from pymoo_rail.control.controllers import Controller, SpeedFilter, check_controller, filter_params
 from pymoo_rail.model import Case
 from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.sim import Simulator, Trajectory
@@ -64,7 +64,7 @@ class Tracker:
         return self.simulator.case
 
     def run(self, reference: Trajectory, speed_noise_ms: np.ndarray | None = None,
-            traction_lag_s: float = 0.0) -> Trajectory:
+            traction_lag_s: float = 0.0, speed_filter: SpeedFilter | None = None) -> Trajectory:
         """The tracked run of one reference curve (any :class:`Trajectory` of this line).
 
         The summary has the simulator's keys plus the speed error (speed minus reference at the
@@ -74,7 +74,8 @@ class Tracker:
 
         ``speed_noise_ms`` (m/s, added to the measured speed at successive control instants) and
         ``traction_lag_s`` (time constant of a first-order lag between command and force) disturb
-        the controlled part; see :class:`pymoo_rail.control.Disturbance`.
+        the controlled part; see :class:`pymoo_rail.control.Disturbance`. ``speed_filter`` filters the
+        measured speed before the controller (None: the measurement as it is).
         """
         _check_reference(reference)
         noise = np.zeros(0) if speed_noise_ms is None else np.ascontiguousarray(speed_noise_ms, dtype=float)
@@ -90,7 +91,8 @@ class Tracker:
         x_start, x_stop = ck.reference_phases(np.ascontiguousarray(x_ref), regime, x_ref.shape[0])
         out, x, v, t, a, f, r, u = ck.track_trace(self.simulator.model, v_ref, float(x_start), float(x_stop),
                                                  self._code, self._params, self.control_period_s,
-                                                 noise, float(traction_lag_s), np.zeros(ck.N_CARRY),
+                                                 noise, float(traction_lag_s),
+                                                 filter_params(speed_filter), np.zeros(ck.N_CARRY),
                                                  np.inf, np.inf)
         summary = summary_dict(out)
         err_kmh = (v - np.interp(x, x_ref, v_ref_ms, right=0.0)) * KMH_PER_MS

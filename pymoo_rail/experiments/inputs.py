@@ -125,33 +125,40 @@ def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
     return dict(resolve_spec(spec).fingerprint)
 
 
-@functools.lru_cache(maxsize=1)
-def package_digest() -> str:
+@functools.lru_cache(maxsize=8)
+def package_digest(parts: tuple[str, ...] | None = None) -> str:
     """A digest of pymoo-rail's own source and data files (path and bytes of each, in path order).
 
     Computed once per process: a change to the code with the same version string still changes
-    every fingerprint, so no record computed by other code is taken as current.
+    every fingerprint, so no record computed by other code is taken as current. ``parts`` limits
+    it to these subpackages or files (paths relative to the package, e.g. ``("control", "sim")``).
     """
     import pymoo_rail
 
     root = Path(pymoo_rail.__file__).resolve().parent
     sha = hashlib.sha256()
+
+    def inside(path: Path) -> bool:
+        rel = path.relative_to(root).as_posix()
+        return parts is None or any(rel == part or rel.startswith(part.rstrip("/") + "/") for part in parts)
+
     for path in sorted(p for p in root.rglob("*") if p.suffix in _PACKAGE_SUFFIXES and p.is_file()
-                       and "__pycache__" not in p.parts):
+                       and "__pycache__" not in p.parts and inside(p)):
         sha.update(path.relative_to(root).as_posix().encode() + b"\0")
         sha.update(hashlib.sha256(path.read_bytes()).digest())
     return "sha256:" + sha.hexdigest()[:32]
 
 
-def versions_input() -> dict[str, str]:
-    """The code that computes a result: the package's source digest and the library versions."""
+def versions_input(parts: tuple[str, ...] | None = None) -> dict[str, str]:
+    """The code that computes a result: the package's source digest (of ``parts`` only, if given:
+    :func:`package_digest`) and the library versions."""
     import numba
     import numpy
     import pymoo
 
     import pymoo_rail
 
-    return {"pymoo-rail code": package_digest(), "pymoo-rail version": pymoo_rail.__version__,
+    return {"pymoo-rail code": package_digest(parts), "pymoo-rail version": pymoo_rail.__version__,
             "pymoo version": pymoo.__version__, "numpy version": numpy.__version__,
             "numba version": numba.__version__}
 

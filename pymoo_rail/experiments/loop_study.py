@@ -25,9 +25,10 @@ from pymoo_rail.control.controllers import Controller
 from pymoo_rail.control.policy import OptimalPolicy
 from pymoo_rail.control.study import (STUDY_CONTROLLERS, TUNED_CONTROLLERS, draw_loop_disturbances, study_planned_time,
                                       world_rows)
+from pymoo_rail.experiments.inputs import versions_input
 from pymoo_rail.experiments.report import fixed, markdown_rows
 from pymoo_rail.experiments.stats import signed_rank_vs
-from pymoo_rail.experiments.store import ResultStore, record_checksum
+from pymoo_rail.experiments.store import STALE_DIR, ResultStore, record_checksum
 from pymoo_rail.model import Case
 from pymoo_rail.model.errors import FieldError
 from pymoo_rail.problems.controller_tuning import tune_controller
@@ -35,6 +36,15 @@ from pymoo_rail.sim import Trajectory
 
 # One record of the result store holds the rows of one world of one case
 LOOP_RECORD_FORMAT = "pymoo-rail/loop-world/1"
+# The package parts a world's rows are computed by (the fingerprint of a record, :func:`loop_code`):
+# a change elsewhere in the package (another engineer's study, the CLI) keeps the stored worlds
+LOOP_CODE_PARTS = ("control", "optimal", "sim", "model", "cases", "constants.py", "problems/controller_tuning.py",
+                   "experiments/loop_study.py")
+
+
+def loop_code() -> dict[str, str]:
+    """The fingerprint of the code computing a world: the digest of :data:`LOOP_CODE_PARTS` and library versions."""
+    return versions_input(LOOP_CODE_PARTS)
 
 
 def tuned_trackers(case: Case, plan: Trajectory, seed: int = 1) -> dict[str, Controller]:
@@ -79,28 +89,47 @@ def _loop_chunk(item: LoopStudyCase, runs: list[int], seed: int, directory: str,
             world_cpu_s = _time.process_time() - started  # every controller and the exact optima
             rows = [dict(row, world_cpu_s=world_cpu_s) for row in rows]
             store.write({"format": LOOP_RECORD_FORMAT, "run_id": run_id, "case": item.case.name, "seed": seed,
-                         "planned_time_s": planned, "controllers": list(controllers), "rows": rows})
+                         "planned_time_s": planned, "controllers": list(controllers), "code": loop_code(),
+                         "rows": rows})
             done += 1
         finally:
             lock.release()
     return done
 
 
-def load_loop_rows(directory: str | Path) -> pd.DataFrame:
-    """Every world stored by :func:`run_loop_study` in ``directory``, one row per world and controller.
-
-    A record whose checksum does not match its content is a :class:`FieldError` naming the file.
-    """
-    store = ResultStore(directory)
-    rows = []
+def _loop_records(store: ResultStore):
+    """(path, record) of every stored world, checked; a record whose checksum does not match is a FieldError."""
     for path in sorted(store.runs_dir.glob("*.json")) if store.runs_dir.is_dir() else []:
         record = json.loads(path.read_text(encoding="utf-8"))
         checksum = record.pop("checksum", None)
         if record.get("format") != LOOP_RECORD_FORMAT or checksum != record_checksum(record):
             raise FieldError("record", str(path), "is not a checked closed-loop record (altered or damaged): "
                                                   "delete it and run the study again")
-        rows += record["rows"]
+        yield path, record
+
+
+def load_loop_rows(directory: str | Path) -> pd.DataFrame:
+    """Every world stored by :func:`run_loop_study` in ``directory`` by the current code (:func:`loop_code`),
+    one row per world and controller.
+
+    A record whose checksum does not match its content is a :class:`FieldError` naming the file;
+    a record of other code is left out (:func:`run_loop_study` sets it aside and computes it again).
+    """
+    code = loop_code()
+    rows = []
+    for _, record in _loop_records(ResultStore(directory)):
+        if record.get("code") == code:
+            rows += record["rows"]
     return pd.DataFrame(rows)
+
+
+def set_aside_stale(store: ResultStore) -> int:
+    """Move the worlds computed by other code than the current (:func:`loop_code`) to ``stale/``; returns how many."""
+    code = loop_code()
+    stale = [path.stem for path, record in _loop_records(store) if record.get("code") != code]
+    for run_id in stale:
+        store.set_aside(run_id, STALE_DIR)
+    return len(stale)
 
 
 def run_loop_study(items: Sequence[LoopStudyCase], seed: int, directory: str | Path, workers: int = 1,
@@ -108,8 +137,10 @@ def run_loop_study(items: Sequence[LoopStudyCase], seed: int, directory: str | P
                    say: Callable[[str], None] = print) -> pd.DataFrame:
     """The closed-loop study of several cases, resumable: one record per world in a result store.
 
-    Worlds already stored in ``directory`` are not computed again, so a study stopped at any time
-    goes on where it was by running it again. Work is handed out in chunks of ``chunk`` worlds of
+    Worlds already stored in ``directory`` by the current code (:func:`loop_code`: the package parts
+    of :data:`LOOP_CODE_PARTS` and the library versions) are not computed again, so a study stopped
+    at any time goes on where it was by running it again; worlds of other code are set aside
+    (:func:`set_aside_stale`) and computed again. Work is handed out in chunks of ``chunk`` worlds of
     one case (a chunk builds its case's policy once), chunk by chunk across the cases, so that a
     study stopped early has about as many worlds of every case; ``workers`` processes of a pool.
     Returns :func:`load_loop_rows` of the directory.
@@ -120,6 +151,9 @@ def run_loop_study(items: Sequence[LoopStudyCase], seed: int, directory: str | P
         raise FieldError("chunk", chunk, "must be a positive integer")
     store = ResultStore(directory)
     store.prepare()
+    stale = set_aside_stale(store)
+    if stale:
+        say(f"{stale} worlds computed by other code set aside in {store.directory / STALE_DIR}")
     done = store.done_ids()
     tasks = []
     for first in range(0, max(item.n_runs for item in items), chunk):

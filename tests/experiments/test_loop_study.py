@@ -91,3 +91,39 @@ def test_the_latency_and_disturbance_tables_say_what_the_rows_hold():
                          for c, g, late in (("pid", 1.234, -0.5), ("policy", 0.1, 1.0))])
     assert disturbance_markdown(runs, ("policy", "pid")).splitlines() == [
         "| case | disturbance | policy | pid |", "|---|---|---|---|", "| a | none | 0.10 % (+1.00 s) | 1.23 % (-0.50 s) |"]
+
+
+def test_worlds_of_other_code_are_set_aside_and_computed_again(metro, tmp_path):
+    import json
+
+    from pymoo_rail.experiments.loop_study import LoopStudyCase, load_loop_rows, loop_code, run_loop_study
+    from pymoo_rail.experiments.store import record_checksum
+
+    item = LoopStudyCase(metro, 80.0, 1)
+    names = ("optimal_controls",)
+    rows = run_loop_study([item], 5, tmp_path, controllers=names, say=lambda _: None)
+    path = tmp_path / "runs" / "metro-a-seed5-world0000.json"
+    record = json.loads(path.read_text())
+    assert record["code"] == loop_code()
+    # the same world, as stored by other code (its checksum right): not served
+    record.pop("checksum")
+    record["code"] = dict(record["code"], **{"pymoo-rail code": "sha256:other"})
+    record["rows"][0]["net_kwh"] = -1.0
+    record["checksum"] = record_checksum(record)
+    path.write_text(json.dumps(record))
+    assert load_loop_rows(tmp_path).empty
+    said = []
+    again = run_loop_study([item], 5, tmp_path, controllers=names, say=said.append)
+    assert said[0].startswith("1 worlds computed by other code set aside in")
+    assert len(list((tmp_path / "stale").glob("metro-a-seed5-world0000.json.*"))) == 1
+    cols = ["run", "controller", "net_kwh", "lateness_s", "gap_pct"]  # all but the CPU times
+    assert again[cols].equals(rows[cols]) and again["net_kwh"].iloc[0] > 0.0
+
+
+def test_the_code_fingerprint_covers_the_loop_and_not_the_rest_of_the_package():
+    from pymoo_rail.experiments.inputs import package_digest
+    from pymoo_rail.experiments.loop_study import LOOP_CODE_PARTS, loop_code
+
+    assert loop_code()["pymoo-rail code"] == package_digest(LOOP_CODE_PARTS)
+    assert package_digest(LOOP_CODE_PARTS) != package_digest()  # the whole package is more
+    assert package_digest(("control",)) != package_digest(("control", "sim"))
