@@ -91,7 +91,8 @@ def real_model(case: Case, disturbance: LoopDisturbance, dx_m: float | None = No
     model = model._replace(davis_a_n=model.davis_a_n * f, davis_b_nsm=model.davis_b_nsm * f,
                            davis_c_ns2m2=model.davis_c_ns2m2 * f,
                            regen_efficiency=min(model.regen_efficiency * disturbance.regen_factor, 1.0),
-                           regen_map_values=np.minimum(model.regen_map_values * disturbance.regen_factor, 1.0))
+                           regen_map_values=None if model.regen_map_values is None else
+                           np.minimum(model.regen_map_values * disturbance.regen_factor, 1.0))
     if disturbance.restriction is not None:
         disturbance.restriction.check_on(case)
         return restricted_model(model, disturbance.restriction, float(case.train.length_m))

@@ -199,8 +199,8 @@ def pymoo_rail_row(name: str, running_time_s: float) -> dict:
 def cpu_breakdown(name: str, running_time_s: float) -> dict:
     """CPU seconds of one profile (as timed by :func:`pymoo_rail_row`) per kernel of the exact solver.
 
-    cProfile in ``time.process_time``: tables (``_count_targets`` + ``_fill_transitions``, default and
-    half grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
+    cProfile in ``time.process_time``: tables (``_fill_transitions``: its counting and filling passes, default
+    and half grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
     """
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import OptimalSolver
@@ -211,13 +211,13 @@ def cpu_breakdown(name: str, running_time_s: float) -> dict:
     OptimalSolver(case).profile(running_time_s)
     profiler.disable()
     stats = pstats.Stats(profiler).stats  # (file, line, function) -> (calls, ..., own time, cumulative time, ...)
-    own = {name: [0, 0.0] for name in ("_count_targets", "_fill_transitions", "backward_sweep", "forward_rollout")}
+    own = {name: [0, 0.0] for name in ("_fill_transitions", "backward_sweep", "forward_rollout")}
     for (path, _, function), (_, calls, tottime, _, _) in stats.items():
         if path.endswith("dp.py") and function in own:
             own[function][0] += calls
             own[function][1] += tottime
     total = sum(v[2] for v in stats.values())
-    tables = own["_count_targets"][1] + own["_fill_transitions"][1]
+    tables = own["_fill_transitions"][1]
     sweeps, runs = own["backward_sweep"], own["forward_rollout"]
     return {"case": case.name, "cpu_s": total, "tables_s": tables, "sweeps": sweeps[0], "sweeps_s": sweeps[1],
             "forward_runs": runs[0], "forward_runs_s": runs[1], "rest_s": total - tables - sweeps[1] - runs[1]}

@@ -67,7 +67,7 @@ _TOP_RTOL = 1e-6
 END_PRICE_FACTOR = 100.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def node_u(top_u, k, k_max, bias):
     """Kinetic energy of speed node ``k``: ``top_u g(k / k_max)`` with ``g(s) = s + bias s (1 - s)``.
 
@@ -78,7 +78,7 @@ def node_u(top_u, k, k_max, bias):
     return top_u * (s + bias * s * (1.0 - s))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def node_position(top_u, u, k_max, bias):
     """Fractional node index of kinetic energy ``u`` (the inverse of :func:`node_u`), top_u > 0."""
     y = u / top_u
@@ -91,7 +91,7 @@ def node_position(top_u, u, k_max, bias):
     return (b1 - math.sqrt(disc)) / (2.0 * bias) * k_max
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w):
     """What the simulator's ``run_program`` does in one cell for a program row of its own.
 
@@ -132,7 +132,7 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
     return u1, f, w0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     """Net energy of the cell plus ``time_price_w`` x its time (J), and its time (s).
 
@@ -167,7 +167,7 @@ def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     return e + time_price_w * dt, dt
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def value_position(top_u, u, k_max, bias):
     """Where kinetic energy ``u`` falls among the speed nodes over ``[0, top_u]``: a fractional index.
 
@@ -235,13 +235,13 @@ def interp_aug(v_next, p, sing_p, sing_val):
     return lv + (p - lp) / (rp - lp) * (rv - lv)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def interp_value(v_next, top_u, u, bias):
     """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
     return interp_at(v_next, value_position(top_u, u, v_next.shape[0] - 1, bias))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def psi_speed(b_nsm, c_ns2m2, psi_w):
     """The speed ``v`` with ``psi(v) = v^2 R'(v) = v^2 (b + 2 c v) = psi_w`` (m/s; Davis ``R``; 0 if none).
 
@@ -262,7 +262,7 @@ def psi_speed(b_nsm, c_ns2m2, psi_w):
     return v
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def electric_force(m, v, f):
     """Electrical energy per metre (N) of the control force ``f`` (N) at speed ``v``: ``f / eta_traction(v, f)``
     when pulling, ``-eta_regen(v, |f|) |f|`` when braking electrically (the maps where the train has them;
@@ -274,7 +274,7 @@ def electric_force(m, v, f):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def map_is_constant(values, constant):
     """Whether an efficiency map gives ``constant`` everywhere (then the constant's closed form serves)."""
     for i in range(values.shape[0]):
@@ -284,7 +284,7 @@ def map_is_constant(values, constant):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def hold_stationarity(m, v, line_force_n, braking):
     """``v^2 (R'(v) dg/dF + dg/dv)`` at the holding force ``F = R(v) + line force`` (N x m/s = W).
 
@@ -306,7 +306,7 @@ def hold_stationarity(m, v, line_force_n, braking):
     return v * v * ((m.davis_b_nsm + 2.0 * m.davis_c_ns2m2 * v) * g_f + g_v)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def map_hold_speed(m, price_w, line_force_n, braking, v_top):
     """The speed below ``v_top`` where :func:`hold_stationarity` equals ``price_w``, by bisection (0 if
     there is none: the condition stays above or below the price over ``(0, v_top)``)."""
@@ -342,9 +342,9 @@ def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p) -> None:
     """
     # Chosen here, in Python, so that a case without a map never compiles the map's bisections
     # (about 1.5 s of a first run's compile): Numba compiles both branches of a jitted if.
-    map_traction = m.traction_map_values.shape[0] > 0 and not map_is_constant(m.traction_map_values,
+    map_traction = m.traction_map_values is not None and not map_is_constant(m.traction_map_values,
                                                                               m.traction_efficiency)
-    map_regen = m.regen_map_values.shape[0] > 0 and not map_is_constant(m.regen_map_values, m.regen_efficiency)
+    map_regen = m.regen_map_values is not None and not map_is_constant(m.regen_map_values, m.regen_efficiency)
     if map_traction or map_regen:
         v_hold, v_regen = map_holding_speeds(m, time_price_w, map_traction, map_regen)
     else:
@@ -352,7 +352,7 @@ def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p) -> None:
     place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def constant_holding_speeds(m, time_price_w):
     """``(V, W)`` per cell (m/s) with constant efficiencies: the closed form of :func:`psi_speed`
     (``W`` 0 without regeneration or at or below its cut-off speed)."""
@@ -367,7 +367,7 @@ def constant_holding_speeds(m, time_price_w):
     return v_hold, v_regen
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def map_holding_speeds(m, time_price_w, map_traction, map_regen):
     """``(V, W)`` per cell (m/s) where a map is not constant: the root of :func:`hold_stationarity` at
     the cell's holding force (the closed form for the side whose map is constant)."""
@@ -382,7 +382,7 @@ def map_holding_speeds(m, time_price_w, map_traction, map_regen):
     return v_hold, v_regen
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p):
     """Write the holding speeds of each cell into ``sing_v`` / ``sing_p`` (see :func:`singular_speeds`)."""
     n = m.position_m.shape[0]
@@ -426,7 +426,7 @@ def control_cost(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
 N_FIXED = 4
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _fixed_mode(c):
     if c == 0:
         return MODE_TRACTION
@@ -437,7 +437,7 @@ def _fixed_mode(c):
     return MODE_HOLD_BRAKE
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _target_range(top_u, k_max, u0, tr_u, co_u, bias):
     """Speed nodes of the next position that partial traction (or braking) can land on exactly."""
     lo = co_u if co_u < u0 else u0
@@ -453,7 +453,7 @@ def _target_range(top_u, k_max, u0, tr_u, co_u, bias):
     return k_lo, k_hi
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _n_targets(k_lo, k_hi, max_targets):
     count = k_hi - k_lo + 1
     if count <= 0:
@@ -464,7 +464,7 @@ def _n_targets(k_lo, k_hi, max_targets):
     return (count + stride - 1) // stride, stride
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias, sing_v, sing_p, sing_val):
     """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
 
@@ -542,28 +542,12 @@ def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
     return rank[inverse.ravel()].astype(np.int64), first[order].astype(np.int64)
 
 
-@njit(cache=True, parallel=True)
-def _count_targets(m, n_speeds, max_targets, bias, first_cell, counts):
-    k_max = n_speeds - 1
-    for p_type in prange(first_cell.shape[0]):
-        t = np.int64(p_type)  # prange counts in uint64: the int64 index of every other caller
-        i = first_cell[t]
-        top0 = m.envelope_ms[i] ** 2
-        top1 = m.envelope_ms[i + 1] ** 2
-        for j in range(n_speeds):
-            counts[t * n_speeds + j] = 0
-            if top1 <= 0.0:
-                continue
-            v0 = math.sqrt(node_u(top0, j, k_max, bias))
-            tr_u = full_step(m, v0, i, KIND_TRACTION)[0]
-            co_u = full_step(m, v0, i, KIND_COAST)[0]
-            k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
-            counts[t * n_speeds + j] = _n_targets(k_lo, k_hi, max_targets)[0]
-
-
-@njit(cache=True, parallel=True)
-def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, fixed_u1, fixed_e, fixed_dt, tgt_u1, tgt_e,
-                      tgt_dt):
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
+def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, counting, counts, offsets, fixed_u1, fixed_e,
+                      fixed_dt, tgt_u1, tgt_e, tgt_dt):
+    """Both passes of :func:`transitions`: with ``counting``, only the number of partial-traction targets
+    of each state into ``counts`` (to size the flat tables); then the tables. One parallel kernel for
+    both: a second one cost about 1 s of the first run's compile."""
     k_max = n_speeds - 1
     aux = m.aux_power_w
     for p_type in prange(first_cell.shape[0]):
@@ -575,6 +559,12 @@ def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, fixed
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
             tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
             co_u, co_f, co_w, _ = full_step(m, v0, i, KIND_COAST)
+            if counting:
+                counts[t * n_speeds + j] = 0
+                if top1 > 0.0:
+                    k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
+                    counts[t * n_speeds + j] = _n_targets(k_lo, k_hi, max_targets)[0]
+                continue
             br_u, br_f, br_w, _ = full_step(m, v0, i, KIND_BRAKE)
             for c in range(N_FIXED):
                 u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
@@ -619,18 +609,19 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
         cell_type = first_cell = np.arange(m.position_m.shape[0] - 1, dtype=np.int64)
     n_types = first_cell.shape[0]
     counts = np.zeros(n_types * n_speeds, dtype=np.int64)
-    _count_targets(m, n_speeds, max_targets, bias, first_cell, counts)
     offsets = np.zeros(counts.shape[0] + 1, dtype=np.int64)
-    np.cumsum(counts, out=offsets[1:])
     # single precision halves the memory; the tables only shape the cost-to-go (an error of 1e-7
     # of a node spacing or of a cell's energy), the forward run recomputes every step exactly
     fixed = [np.empty((n_types, n_speeds, N_FIXED), dtype=np.float32) for _ in range(3)]
+    no_tgt = np.empty(0, dtype=np.float32)
+    _fill_transitions(m, n_speeds, max_targets, bias, first_cell, True, counts, offsets, *fixed, no_tgt, no_tgt, no_tgt)
+    np.cumsum(counts, out=offsets[1:])
     tgt = [np.empty(offsets[-1], dtype=np.float32) for _ in range(3)]
-    _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, *fixed, *tgt)
+    _fill_transitions(m, n_speeds, max_targets, bias, first_cell, False, counts, offsets, *fixed, *tgt)
     return (*fixed, offsets, *tgt, cell_type)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _singular_rows(m, i, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val):
     """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them."""
     for s in range(sing_v.shape[1]):
@@ -642,7 +633,7 @@ def _singular_rows(m, i, price_w, v_next, max_targets, bias, floor_k, sing_v, si
         sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
                    floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
@@ -683,21 +674,23 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
             for c in range(N_FIXED):
                 e = fixed_e[t, j, c]
                 if e < INF:
-                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_aug(v_next, fixed_u1[t, j, c], sp_next,
-                                                                                 sv_next)
+                    # the float32 position as float64 (exact; interp_aug computes in float64 either way):
+                    # one compiled interp_aug for the tables and the forward run
+                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_aug(v_next, np.float64(fixed_u1[t, j, c]),
+                                                                                 sp_next, sv_next)
                     if cost < best:
                         best = cost
             s = t * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_aug(v_next, tgt_u1[p], sp_next, sv_next)
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_aug(v_next, np.float64(tgt_u1[p]), sp_next, sv_next)
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds, sing_v=None,
                     sing_p=None, sing_val=None):
     """Drive from the case's initial speed choosing each cell's control from the cost-to-go (continuous state).

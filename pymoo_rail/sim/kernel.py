@@ -90,8 +90,10 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
              "brake_work_j", "davis_work_j", "line_work_j", "grade_work_j", "final_speed_ms", "reached",
              "electric_brake_work_j", "max_abs_accel_ms2", "neutral_traction_j", "peak_traction_kw")
 
-# the three full-force steps of ``full_step`` (public for the DP)
-KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
+# the three full-force steps of ``full_step`` (public for the DP). NumPy integers, not Python ones:
+# Numba types a Python int constant as a literal and compiled full_step and scaled_step once per
+# kind (about 1 s of the first run's compile); inlined, LLVM folds the constant kind all the same
+KIND_TRACTION, KIND_COAST, KIND_BRAKE = np.int64(0), np.int64(1), np.int64(2)
 
 
 @inlined
@@ -284,7 +286,7 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
     return v1, stopped, x1, a_cell, totals
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def trace_cell_energies(m, x, v, f):
     """Per-cell energies of a recorded run (J): traction drawn and regeneration delivered.
 
@@ -437,7 +439,7 @@ def drive_cell(m, program, totals, i, v, row, hold_speed):
 
 # No reference counting inside: the run allocates nothing, and NRT incref/decref pairs on the
 # model's arrays in every inlined helper call were half the cost of a cell (benchmarks/throughput.py --jit).
-@njit(cache=True, _nrt=False)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     """Simulate one run; write the summary into ``out`` and, if ``record``, the trace arrays.
 
@@ -481,7 +483,7 @@ def advance_run(m, program, totals, i, v, row, hold_speed, moving, stop_pos):
 # leaves most of the core idle; the cells of two independent runs interleave in the out-of-order
 # core and nearly halve the time per cell (docs/performance.md). Each run does exactly the
 # arithmetic of ``run_program``, so results are bitwise the same.
-@njit(cache=True, _nrt=False)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
     """Summaries of two runs, simulated side by side (no traces; ``empty``, ``empty_r``: the
     empty float and int8 trace arrays ``write_summary`` takes)."""
@@ -511,7 +513,7 @@ def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
     write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, no_count, record, empty, empty, empty_r)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def simulate_serial(m, programs, out):
     """Summaries of runs ``programs`` (N, rows, 3) into ``out`` (N, N_OUT), in this thread."""
     n_runs = programs.shape[0]
@@ -520,13 +522,15 @@ def simulate_serial(m, programs, out):
     for j in range(n_runs // 2):
         run_two_programs(m, programs[2 * j], programs[2 * j + 1], out[2 * j], out[2 * j + 1], empty, empty_r)
     if n_runs % 2 == 1:
-        # a run-time False, not the literal: with a literal Numba compiles run_program a second time
-        # (once per value of ``record``), which doubles the first-run compile time
-        record = n_runs < 0
-        run_program(m, programs[n_runs - 1], out[n_runs - 1], record, empty, empty, empty, empty, empty, empty_r)
+        # an odd last run beside a copy of itself (the same arithmetic, bit for bit): calling
+        # run_program here would make LLVM optimise and emit its run loop once more in this kernel
+        # (about 0.5 s of the first run's compile) for one run in a batch
+        spare = np.empty(N_OUT)
+        last = programs[n_runs - 1]
+        run_two_programs(m, last, last, out[n_runs - 1], spare, empty, empty_r)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
 def simulate_batch(m, programs):
     """Summaries of many runs, one per program, in parallel. ``programs`` is (N, rows, 3).
 
@@ -551,7 +555,7 @@ def simulate_batch_serial(m, programs):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def trace_arrays(n):
     """Uninitialised trace buffers for ``n`` nodes: (x, v, t, a, force, regime); regime is int8.
 
