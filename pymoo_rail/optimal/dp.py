@@ -700,9 +700,11 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     chatter (coast, land on a node, coast...) for no measurable energy.
 
     Writes per cell ``modes``, ``targets`` and per node ``speeds``. Returns
-    ``(n_cells_done, net_energy_j, time_s, tie_cost_j)``; ``n_cells_done < n_nodes - 1`` means no
-    feasible control was found at that cell; ``tie_cost_j`` is what keeping the regime cost over
-    the best control, summed over the cells where it was kept (by the cost-to-go's estimate).
+    ``(n_cells_done, net_energy_j, time_s, tie_cost_j, start_j)``; ``n_cells_done < n_nodes - 1``
+    means no feasible control was found at that cell; ``tie_cost_j`` is what keeping the regime cost
+    over the best control, summed over the cells where it was kept (by the cost-to-go's estimate);
+    ``start_j`` is the cost-to-go from the initial speed (here, not from Python: each small kernel
+    called from Python is one more to load from the cache on every run).
     """
     n = m.position_m.shape[0]
     if sing_p is None:  # no singular speeds (:func:`singular_speeds`)
@@ -714,6 +716,8 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         sp_all = sing_p
         sval_all = sing_val
     v = m.initial_speed_ms
+    start_j = interp_aug(value[0], value_position(m.envelope_ms[0] ** 2, v ** 2, value.shape[1] - 1, bias), sp_all[0],
+                         sval_all[0])
     speeds[0] = v
     energy = 0.0
     time = 0.0
@@ -723,7 +727,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias, sv_all[i + 1],
                                           sp_all[i + 1], sval_all[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
-            return i, energy, time, tie_cost
+            return i, energy, time, tie_cost, start_j
         tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
         co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
         br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
@@ -745,7 +749,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         previous = mode
         v = math.sqrt(u1)
         speeds[i + 1] = v
-    return n - 1, energy, time, tie_cost
+    return n - 1, energy, time, tie_cost, start_j
 
 
 def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.ndarray:
@@ -764,7 +768,8 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
     k_max = n_speeds - 1
     lo_u = min(end_lo_ms ** 2, top_u)
     price = END_PRICE_FACTOR * model.effective_mass_kg / model.traction_efficiency
-    u = np.array([node_u(top_u, k, k_max, bias) for k in range(n_speeds)])
+    # node_u's Python function: the same arithmetic, without loading a kernel for it on every run
+    u = np.array([node_u.py_func(top_u, k, k_max, bias) for k in range(n_speeds)])
     return price * np.maximum(lo_u - u, 0.0)
 
 
@@ -819,10 +824,9 @@ def _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, s
     modes = np.zeros(n - 1, dtype=np.int64)
     targets = np.zeros(n - 1)
     speeds = np.zeros(n)
-    done, energy, time, tie_cost = forward_rollout(model, price, value, int(max_targets), float(bias), float(tie_j),
-                                                   modes, targets, speeds, sing_v, sing_p, sing_val)
-    start_j = interp_aug(value[0], value_position(model.envelope_ms[0] ** 2, model.initial_speed_ms ** 2,
-                                                  value.shape[1] - 1, float(bias)), sing_p[0], sing_val[0])
+    done, energy, time, tie_cost, start_j = forward_rollout(model, price, value, int(max_targets), float(bias),
+                                                            float(tie_j), modes, targets, speeds, sing_v, sing_p,
+                                                            sing_val)
     return modes, targets, speeds, done, energy, time, tie_cost, start_j
 
 
