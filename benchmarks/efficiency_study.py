@@ -43,7 +43,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--mseetc", type=Path, required=True, help="an ms-eetc checkout")
     parser.add_argument("--mseetc-python", default=sys.executable, help="interpreter with casadi")
-    parser.add_argument("--reserves", type=float, nargs="+", default=[10.0, 20.0, 30.0], help="time reserves (%)")
+    parser.add_argument("--reserves", type=float, nargs="+", default=[10.0, 20.0, 30.0], help="time reserves (%%)")
     parser.add_argument("--intervals", type=int, default=300, help="ms-eetc's N")
     parser.add_argument("--figure", type=Path, default=Path("/tmp/efficiency_study.png"), help="the runs drawn")
     parser.add_argument("--report", type=Path, default=REPORT)

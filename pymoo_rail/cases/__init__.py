@@ -117,9 +117,10 @@ def load_case(name_or_path: str | Path, load: str | None = None, *,
 
 def load_train(path: str | Path, **options) -> Train:
     """The train of a file in any format of :data:`~pymoo_rail.cases.formats.FORMATS`: the
-    ``[train]`` table of a TOML file (a case, or the train alone), or a TTOBench train file
-    (``train_length_m=`` as in :func:`from_ttobench`). A train meets the plausibility bounds when
-    it joins a case."""
+    ``[train]`` table of a TOML file (a case, or the train alone), a TTOBench train file
+    (``train_length_m=`` as in :func:`from_ttobench`; efficiencies given as loss tables become
+    efficiency maps and auxiliary power), or an OSRD railjson rolling stock (``mode=``,
+    ``comfort=``; docs/railjson.md). A train meets the plausibility bounds when it joins a case."""
     path = Path(path)
     if not path.is_file():
         raise CaseError("path", str(path), "no such train file")

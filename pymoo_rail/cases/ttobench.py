@@ -40,8 +40,10 @@ Mapping decisions (the full table is in ``docs/ttobench.md``):
   tunnels become ``line.tunnels`` (``tunnel_model``: Liu (2019) eq. 2-12, or ``"none"``).
 - Read and checked but not modelled, each named in a :class:`TTOBenchWarning`: ``ETCS braking
   data`` (tracks and trains) and the trains' speed-dependent ``tunnel resistance``. ``num seats``
-  and ``num coaches`` are kept on :class:`TTOBenchTrain`. An efficiency map (not part of the
-  released format) is a :class:`CaseError`.
+  and ``num coaches`` are kept on :class:`TTOBenchTrain`.
+- An efficiency given as a table of losses over load and velocity (TTOBench's dynamic locomotive
+  ``00_Loco_Dyn``) becomes an :class:`~pymoo_rail.model.EfficiencyMap` and the auxiliary power
+  (:mod:`pymoo_rail.cases.ttobench_efficiency`).
 
 The TTOBench files shipped in ``pymoo_rail/cases/data/`` (Yizhuang line and Beijing subway train)
 are copies under the BSD 2-Clause license; the notice is in ``data/TTOBENCH_LICENSE``.
@@ -60,6 +62,7 @@ from typing import Any, Union
 import numpy as np
 
 from pymoo_rail.cases.json_files import load_json_object
+from pymoo_rail.cases.ttobench_efficiency import FIELDS, map_from_loss_table, no_load_loss_kw
 from pymoo_rail.model import Case, CaseError, DavisResistance, ForceCurve, Line, Train
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model.line import CURVE_MODELS
@@ -537,10 +540,6 @@ def read_train(source: Source, *, train_length_m: float | None = None) -> TTOBen
     """
     data, label = _load(source, "train")
     _check_keys(data, _TRAIN_REQUIRED, _TRAIN_USED | _TRAIN_INFORMATIONAL, "train", label)
-    for key in ("efficiency traction", "efficiency reg brake"):
-        if isinstance(data.get(key), Mapping) and ("units" in data[key] or "values" in data[key]):
-            raise CaseError(key, data[key], "an efficiency map is not part of the released TTOBench format "
-                                            "(v1.5 gives each efficiency as one {unit, value}); give a scalar", label)
     counts = {key: _count(data, key, label) for key in ("num seats", "num coaches")}
     tunnel_resistance = _tunnel_resistance(data["tunnel resistance"], label) if "tunnel resistance" in data else ()
     if "ETCS braking data" in data:
@@ -562,8 +561,12 @@ def read_train(source: Source, *, train_length_m: float | None = None) -> TTOBen
     if any(has_eta) and not all(has_eta):
         missing = "efficiency reg brake" if has_eta[0] else "efficiency traction"
         raise CaseError(missing, None, "TTOBench gives both efficiencies or neither", label)
-    eta_t = _fraction(data, "efficiency traction", label, default=1.0)
-    eta_r = _fraction(data, "efficiency reg brake", label, default=0.0)
+    tables = {d: _loss_table(data[f], f, label) for d, f in FIELDS.items() if _is_table(data.get(f))}
+    aux_kw = no_load_loss_kw(tables)
+    caps = {"traction": (trac_f, trac_p), "regen": (reg_f, reg_p)}
+    maps = {d: map_from_loss_table(d, rows, *caps[d], aux_kw, label) for d, rows in tables.items()}
+    eta_t = maps["traction"].peak if "traction" in maps else _fraction(data, "efficiency traction", label, default=1.0)
+    eta_r = maps["regen"].peak if "regen" in maps else _fraction(data, "efficiency reg brake", label, default=0.0)
     for key, value in (("mass", mass_t), ("max speed", vmax), ("max traction power", trac_p),
                        ("max traction force", trac_f), ("max reg braking power", reg_p),
                        ("max reg braking force", reg_f)):
@@ -587,13 +590,37 @@ def read_train(source: Source, *, train_length_m: float | None = None) -> TTOBen
             resistance=DavisResistance(r0, r1, r2, unit="kN", speed_unit="kmh"),
             traction=ForceCurve(max_force_kn=trac_f, max_power_kw=trac_p),
             braking=braking_curve(reg_f, reg_p, pn_f, vmax),
-            regen_max_force_kn=reg_f, regen_max_power_kw=reg_p,
+            regen_max_force_kn=reg_f, regen_max_power_kw=reg_p, aux_power_kw=aux_kw,
+            traction_efficiency_map=maps.get("traction"), regen_efficiency_map=maps.get("regen"),
         )
     except CaseError as err:  # name the TTOBench field behind the model's field
         raise CaseError(_TTOBENCH_FIELD.get(err.field, err.field), err.value, err.reason, label) from None
     return TTOBenchTrain(id=data["metadata"]["id"], train=train, length_m=length, metadata=dict(data["metadata"]),
                          n_seats=counts["num seats"], n_coaches=counts["num coaches"],
                          tunnel_resistance=tunnel_resistance)
+
+
+_LOSS_COLUMNS = (("load", _FRACTION), ("velocity", _SPEED_KMH), ("losses", _POWER_KW))
+
+
+def _is_table(entry: Any) -> bool:
+    """An efficiency given as a loss table (``units``/``values``) rather than one ``{unit, value}``."""
+    return isinstance(entry, Mapping) and ("units" in entry or "values" in entry)
+
+
+def _loss_table(entry: Any, key: str, source: str) -> tuple[tuple[float, float, float], ...]:
+    """An efficiency's loss table ``[[load, velocity, losses], ...]`` as rows ``(load fraction, km/h,
+    kW)``, each number finite and >= 0 (:mod:`pymoo_rail.cases.ttobench_efficiency` reads them)."""
+    factors, values = _table_entry(entry, key, _LOSS_COLUMNS, source)
+    if not values:
+        raise CaseError(f"{key}.values", values, "needs at least one row [load, velocity, losses]", source)
+    rows = []
+    for k, row in enumerate(values):
+        converted = tuple(_convert(_number(f"{key}.values[{k}]", x, source), f) for x, f in zip(row, factors))
+        if min(converted) < 0.0:
+            raise CaseError(f"{key}.values[{k}]", row, "load, velocity and losses must be >= 0", source)
+        rows.append(converted)
+    return tuple(rows)
 
 
 def _count(data: Mapping, key: str, source: str) -> int | None:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from pymoo_rail.cases.ttobench import LIBRARY_VERSION, POINT_MASS_LENGTH_M, TTOBENCH_NOTICE
+from pymoo_rail.cases.ttobench_efficiency import DIRECTIONS, FIELDS, loss_table_rows
 from pymoo_rail.constants import KMH_PER_MS
 from pymoo_rail.model import Case, CaseError, Line, Train
 
@@ -89,8 +90,10 @@ def train_to_json(train: Train, train_id: str, *, metadata: Mapping[str, Any] | 
                         "TTOBench trains give traction as a force cap and a power cap only")
     if train.regen_min_speed_kmh > 0:
         raise CaseError("train.regen_min_speed_kmh", train.regen_min_speed_kmh, "TTOBench has no regen cut-off speed")
-    if train.aux_power_kw > 0:
-        raise CaseError("train.aux_power_kw", train.aux_power_kw, "TTOBench has no auxiliary power")
+    maps = {d: getattr(train, f"{d}_efficiency_map") for d in DIRECTIONS}
+    if train.aux_power_kw > 0 and not any(maps.values()):
+        raise CaseError("train.aux_power_kw", train.aux_power_kw,
+                        "TTOBench carries auxiliary power only inside a loss table (a train with an efficiency map)")
     trac_f = train.traction.max_force_kn
     # No power cap: F <= F_max equals min(F_max, F_max v_max / v) at every speed the train can run.
     trac_p = train.traction.max_power_kw if train.traction.max_power_kw is not None else \
@@ -126,9 +129,16 @@ def train_to_json(train: Train, train_id: str, *, metadata: Mapping[str, Any] | 
         "rolling resistance r1": _entry("kN/(km/h)", b),
         "rolling resistance r2": _entry("kN/(km/h)^2", c),
     })
-    if not (train.traction_efficiency == 1.0 and train.regen_efficiency == 0.0):  # absent = (1, 0) on import
-        out["efficiency traction"] = _entry("%", train.traction_efficiency * 100.0)
-        out["efficiency reg brake"] = _entry("%", train.regen_efficiency * 100.0)
+    scalars = {"traction": train.traction_efficiency, "regen": train.regen_efficiency}
+    if any(maps.values()) or scalars != {"traction": 1.0, "regen": 0.0}:  # absent = (1, 0) on import
+        caps = {"traction": (trac_f, trac_p), "regen": (reg_f, reg_p)}
+        for direction, field in FIELDS.items():
+            if maps[direction] is None:
+                out[field] = _entry("%", scalars[direction] * 100.0)
+            else:
+                out[field] = {"units": {"load": "%", "velocity": "km/h", "losses": "kW"},
+                              "values": loss_table_rows(maps[direction], direction, *caps[direction],
+                                                        train.aux_power_kw)}
     return out
 
 
@@ -169,7 +179,8 @@ def to_ttobench(case: Case, out_dir: str | Path, *, track_id: str | None = None,
     Returns ``(track_path, train_path)``, files named ``<id>.json``. Raises :class:`CaseError`
     naming the field for what TTOBench cannot hold: traction as polynomials or tables, a braking
     curve not of the form ``pneumatic + min(F_reg, P_reg / v)``, a regen cut-off speed, auxiliary
-    power, curves, tunnels, neutral sections, or averaged gradients on a point-mass train.
+    power without an efficiency map (a map is written as TTOBench's loss table, which carries it), an
+    efficiency map whose row at 0 km/h or column at 0 kN is not its neighbour's, curves, tunnels, neutral sections, or averaged gradients on a point-mass train.
 
     ``altitude_m`` is the altitude of the first stop (the case does not store it). ``license_text``
     goes into the metadata; by default the TTOBench notice is carried when the case came from

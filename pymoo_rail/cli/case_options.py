@@ -60,10 +60,11 @@ def case_from_args(args):
         raise UsageError("CASE", "give either CASE or --track, not both")
     if args.train is None:
         raise UsageError("--train", "--track needs --train R.json")
-    from pymoo_rail.cases.ttobench import from_ttobench
+    from pymoo_rail.cases import load_case as load
     from pymoo_rail.optimal import min_running_time
 
-    case = from_ttobench(args.track, args.train, _stop_ref(args.from_stop), _stop_ref(args.to_stop), 1.0,
-                         curve_model=args.curve_model)
+    # through the format registry, as every case file (pymoo_rail.cases.formats)
+    case = load(args.track, train=args.train, from_stop=_stop_ref(args.from_stop), to_stop=_stop_ref(args.to_stop),
+                planned_time_s=1.0, curve_model=args.curve_model)
     time_s = args.planned_time if args.planned_time is not None else 1.15 * min_running_time(case)
     return case.with_planned_time(time_s)

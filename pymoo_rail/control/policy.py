@@ -36,7 +36,7 @@ from pymoo_rail.model.errors import FieldError, check_number
 from pymoo_rail.optimal import OptimalSolver, dp
 from pymoo_rail.sim import Trajectory
 from pymoo_rail.sim import kernel as sk
-from pymoo_rail.sim.drivers import flat_out_program
+from pymoo_rail.sim.drivers import flat_out_program, replaced_rows
 from pymoo_rail.sim.physics import KernelModel, braking_envelope
 from pymoo_rail.sim.trajectory import energy_from_summary, summary_dict
 
@@ -193,8 +193,9 @@ class OptimalPolicy:
         Its price of time (W), the centre of the lattice of prices the policy keeps.
     n_sweeps : int
         Backward sweeps done so far (a re-plan that reuses the lattice does none).
-    last_program : array (rows, 3)
-        The driving program (``end_m, mode, target_ms``, absolute positions) of the last run
+    last_program : array (rows, 3 or 4)
+        The driving program (``end_m, mode, target_ms`` and, where the train has a varying traction
+        efficiency map, the traction share of part-power rows; absolute positions) of the last run
         returned: the optimal controls themselves, for a controller that applies them directly.
 
     Examples
@@ -409,13 +410,11 @@ class OptimalPolicy:
             price_w = (1.0 - share) * price_w + share * self._price(k + 1)
             sing_v, sing_p, sing_val = np.zeros_like(sing_v), np.full_like(sing_p, -1.0), np.zeros_like(sing_val)
         n = model.position_m.shape[0]
-        modes = np.zeros(n - 1, dtype=np.int64)
-        targets = np.zeros(n - 1)
-        speeds = np.zeros(n)
         price = np.full(n - 1, price_w + model.aux_power_w)
-        done = dp.forward_rollout(model, price, np.ascontiguousarray(value), self.max_targets, self.bias, self.tie_j,
-                                  modes, targets, speeds, np.ascontiguousarray(sing_v), np.ascontiguousarray(sing_p),
-                                  np.ascontiguousarray(sing_val))[0]
+        # part-power traction among the controls where the train has a varying traction efficiency map
+        modes, targets, _, done, *_ = dp.forward_run(model, price, np.ascontiguousarray(value), self.max_targets,
+                                                     self.bias, self.tie_j, np.ascontiguousarray(sing_v),
+                                                     np.ascontiguousarray(sing_p), np.ascontiguousarray(sing_val))
         if done < n - 1:
             raise FieldError("speed_ms", speed_ms, f"leaves no way to the platform from {model.position_m[0]:.1f} m")
         return np.column_stack([model.position_m[1:], modes.astype(float), targets])
@@ -474,12 +473,9 @@ class OptimalPolicy:
         keep = sk.MODE_TRACTION if modes[last] == sk.MODE_TRACTION else sk.MODE_HOLD_BRAKE
 
         def moved(j: int) -> np.ndarray:
-            p = program.copy()
             if too_slow:  # power j cells longer
-                p[last + 1:last + 1 + j, 1:] = (keep, 0.0)
-            else:  # coast j cells earlier
-                p[max(last + 1 - j, 0):last + 1, 1:] = (sk.MODE_COAST, 0.0)
-            return p
+                return replaced_rows(program, slice(last + 1, last + 1 + j), keep)
+            return replaced_rows(program, slice(max(last + 1 - j, 0), last + 1), sk.MODE_COAST)  # coast j cells earlier
 
         lo, hi = 0, (program.shape[0] - 1 - last) if too_slow else last + 1
         if hi == 0:

@@ -107,17 +107,19 @@ class Tracker:
                           stop_error_m=float(out[sk.OUT_STOP_ERROR_M]), summary=summary)
 
     def run_program(self, program: np.ndarray) -> Trajectory:
-        """Simulate a driving program (rows, 3) and track its ideal run."""
+        """Simulate a driving program (rows, 3 or 4) and track its ideal run."""
         return self.run(self.simulator.run(program))
 
     def run_batch(self, programs: np.ndarray) -> np.ndarray:
         """Summaries (N, N_OUT) of the tracked runs of programs (N, rows, 3), in parallel.
 
-        The same array :meth:`pymoo_rail.sim.Simulator.run_batch` returns for the ideal runs.
+        The same array :meth:`pymoo_rail.sim.Simulator.run_batch` returns for the ideal runs. A fourth
+        column, the traction share of ``toward`` rows (the exact solver's part-power cells), is the
+        simulator's too.
         """
         programs = np.ascontiguousarray(programs, dtype=float)
-        if programs.ndim != 3 or programs.shape[2] != 3:
-            raise ValueError(f"programs must have shape (N, rows, 3), got {programs.shape}")
+        if programs.ndim != 3 or programs.shape[2] not in (3, 4):
+            raise ValueError(f"programs must have shape (N, rows, 3) or (N, rows, 4), got {programs.shape}")
         return ck.track_programs(self.simulator.model, programs, self._code, self._params, self.control_period_s)
 
 

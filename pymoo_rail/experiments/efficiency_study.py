@@ -8,7 +8,6 @@ driver; ``benchmarks/efficiency_study.py`` is the command line (``docs/efficienc
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -54,9 +53,7 @@ def reserve_rows(checkout: Path, python: str, intervals: int, case, models: dict
                  reserve_pct: float) -> tuple[list[dict], list]:
     """Both solvers, three models, one time reserve (%): the table rows and the figure's runs."""
     running_time_s = es.STUDY_MIN_TIME_S * (1.0 + reserve_pct / 100.0)
-    start = time.process_time()
     ours = es.planned_runs(models, running_time_s)
-    ours_cpu = (time.process_time() - start) / len(models)
     rows, runs = [], []
     for row in ours:
         name, run = row["model"], row["run"]
@@ -68,7 +65,10 @@ def reserve_rows(checkout: Path, python: str, intervals: int, case, models: dict
                      "own_diff_pct": 100.0 * (row["own_kwh"] / theirs["energy_kwh"] - 1.0),
                      "ours_dynamic_kwh": row["dynamic_kwh"], "mseetc_dynamic_kwh": theirs["dynamic_energy_kwh"],
                      "dynamic_diff_pct": 100.0 * (row["dynamic_kwh"] / theirs["dynamic_energy_kwh"] - 1.0),
-                     "mseetc_run_in_ours_kwh": replayed, "ours_cpu_s": ours_cpu, "mseetc_cpu_s": theirs["cpu_s"]})
+                     "mseetc_run_in_ours_kwh": replayed,
+                     "ours_part_power_km": es.part_power_km(case, run.position_m, run.speed_ms),
+                     "mseetc_part_power_km": es.part_power_km(case, theirs["position_m"], theirs["speed_ms"]),
+                     "ours_cpu_s": row["cpu_s"], "mseetc_cpu_s": theirs["cpu_s"]})
         runs.append((f"pymoo-rail {name} ({row['dynamic_kwh']:.1f} kWh)", run.position_m, run.speed_ms,
                      COLOURS[name], "-"))
         runs.append((f"ms-eetc {name} ({theirs['dynamic_energy_kwh']:.1f} kWh)", theirs["position_m"],
@@ -82,13 +82,19 @@ def findings(table: pd.DataFrame) -> dict[str, str]:
 
     ``own_within``: the largest |own_diff_pct| of the fixed models; ``dynamic_range``: their
     dynamic_diff_pct range; ``faithful_range``: ms-eetc's run costed by pymoo-rail's maps over ms-eetc's
-    figure; ``control_range``: pymoo-rail's optimum over ms-eetc's run under the same maps (all in %).
+    figure; ``control_range``: pymoo-rail's optimum over ms-eetc's run under the same maps;
+    ``dynamic_own_range``: pymoo-rail's dynamic optimum over ms-eetc's figure (all in %);
+    ``part_power``: both solvers' part-power distances per reserve (km, pymoo-rail / ms-eetc).
     """
     dyn = table[table["model"] == "dynamic"]
     fixed = table[table["model"] != "dynamic"]
     faithful = 100.0 * (dyn["mseetc_run_in_ours_kwh"] / dyn["mseetc_dynamic_kwh"] - 1.0)
     control = 100.0 * (dyn["ours_dynamic_kwh"] / dyn["mseetc_run_in_ours_kwh"] - 1.0)
+    part = ", ".join(f"{r['ours_part_power_km']:.1f} / {r['mseetc_part_power_km']:.1f} km at {r['reserve_pct']:g} %"
+                     for _, r in dyn.iterrows()) if "ours_part_power_km" in dyn else ""
     return {"own_within": f"{fixed['own_diff_pct'].abs().max():.2f}",
             "dynamic_range": f"{fixed['dynamic_diff_pct'].min():+.2f} to {fixed['dynamic_diff_pct'].max():+.2f}",
             "faithful_range": f"{faithful.min():+.2f} to {faithful.max():+.2f}",
-            "control_range": f"{control.min():+.2f} to {control.max():+.2f}"}
+            "control_range": f"{control.min():+.2f} to {control.max():+.2f}",
+            "dynamic_own_range": f"{dyn['own_diff_pct'].min():+.2f} to {dyn['own_diff_pct'].max():+.2f}",
+            "part_power": part}

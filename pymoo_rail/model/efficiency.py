@@ -129,6 +129,18 @@ def _cell(nodes: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return k, t
 
 
+def efficiency_of_losses(wheel_power: np.ndarray, loss: np.ndarray, aux_power: float | np.ndarray,
+                         braking: bool) -> np.ndarray:
+    """Efficiency at operating points whose losses include the auxiliary power (any one power unit).
+
+    Traction: ``P / (P + loss - aux)``; braking: ``(P - loss + aux) / P``, ``P`` the wheel power
+    (> 0). Not clipped: a value outside (0, 1] is for the caller to refuse or hold.
+    """
+    wheel = np.asarray(wheel_power, dtype=float)
+    lost = np.asarray(loss, dtype=float) - aux_power
+    return (wheel - lost) / wheel if braking else wheel / (wheel + lost)
+
+
 def maps_from_losses(speeds_kmh, forces_kn, traction_loss_w, braking_loss_w, aux_power_kw: float = 0.0,
                      min_efficiency: float = 0.01) -> tuple[EfficiencyMap, EfficiencyMap, int]:
     """Traction and regeneration maps of a source that gives power losses (W) at the operating point.
@@ -152,8 +164,8 @@ def maps_from_losses(speeds_kmh, forces_kn, traction_loss_w, braking_loss_w, aux
                         "must all be > 0: an efficiency needs wheel power")
     aux_w = aux_power_kw * 1000.0
     wheel_w = f * v
-    traction = wheel_w / (wheel_w + np.asarray(traction_loss_w, dtype=float) - aux_w)
-    regen = (wheel_w - np.asarray(braking_loss_w, dtype=float) + aux_w) / wheel_w
+    traction = efficiency_of_losses(wheel_w, traction_loss_w, aux_w, braking=False)
+    regen = efficiency_of_losses(wheel_w, braking_loss_w, aux_w, braking=True)
     raised = int(sum(np.count_nonzero((e < min_efficiency) | (e > 1.0)) for e in (traction, regen)))
 
     def table(values: np.ndarray, field: str) -> EfficiencyMap:

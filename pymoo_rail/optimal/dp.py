@@ -12,7 +12,9 @@ Controls of one cell are exactly the simulator's driving modes (``pymoo_rail.sim
 maximum traction, coasting, maximum braking, holding the entry speed (by partial traction, or by
 partial regenerative-first braking where coasting would accelerate), and ``toward`` a target
 speed, which lands exactly on a speed node of the next position by partial traction (or partial
-braking). Each transition is computed by the simulator's own step functions, including its
+braking); where the train has a varying traction efficiency map, also traction at a share of the
+maximum force (``toward`` rows with the simulator's fourth program column, :func:`part_power_shares`).
+Each transition is computed by the simulator's own step functions, including its
 braking-envelope override (``clamp_to_envelope``), so a control sequence chosen here replays bit
 for bit in the simulator. The cost of a cell is the simulator's own accounting
 (``complete_cell``): ``traction work / eta_traction - eta_regen * electric braking work +
@@ -39,6 +41,7 @@ from pymoo_rail.sim.kernel import (
     REGIME_COAST,
     clamp_to_envelope,
     full_step,
+    scaled_step,
     share_above,
 )
 from pymoo_rail.sim.jit import inlined
@@ -284,6 +287,13 @@ def map_is_constant(values, constant):
     return True
 
 
+def varying_maps(m) -> tuple[bool, bool]:
+    """Whether the kernel model's traction and regenerative efficiency maps vary (a map giving its
+    direction's constant everywhere is the constant: its closed forms and controls serve)."""
+    return (m.traction_map_values is not None and not map_is_constant(m.traction_map_values, m.traction_efficiency),
+            m.regen_map_values is not None and not map_is_constant(m.regen_map_values, m.regen_efficiency))
+
+
 @njit(cache=True, no_cfunc_wrapper=True)
 def hold_stationarity(m, v, line_force_n, braking):
     """``v^2 (R'(v) dg/dF + dg/dv)`` at the holding force ``F = R(v) + line force`` (N x m/s = W).
@@ -342,9 +352,7 @@ def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p) -> None:
     """
     # Chosen here, in Python, so that a case without a map never compiles the map's bisections
     # (about 1.5 s of a first run's compile): Numba compiles both branches of a jitted if.
-    map_traction = m.traction_map_values is not None and not map_is_constant(m.traction_map_values,
-                                                                              m.traction_efficiency)
-    map_regen = m.regen_map_values is not None and not map_is_constant(m.regen_map_values, m.regen_efficiency)
+    map_traction, map_regen = varying_maps(m)
     if map_traction or map_regen:
         v_hold, v_regen = map_holding_speeds(m, time_price_w, map_traction, map_regen)
     else:
@@ -542,6 +550,14 @@ def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
     return rank[inverse.ravel()].astype(np.int64), first[order].astype(np.int64)
 
 
+@inlined
+def _kind_cell(m, first_cell, p_type):
+    """Kind ``t`` of a table loop's ``prange`` index, its first cell ``i`` and the envelope's ``u`` at both ends."""
+    t = np.int64(p_type)  # prange counts in uint64: the int64 index of every other caller
+    i = first_cell[t]
+    return t, i, m.envelope_ms[i] ** 2, m.envelope_ms[i + 1] ** 2
+
+
 @njit(cache=True, no_cfunc_wrapper=True, parallel=True)
 def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, counting, counts, offsets, fixed_u1, fixed_e,
                       fixed_dt, tgt_u1, tgt_e, tgt_dt):
@@ -551,10 +567,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, counting, coun
     k_max = n_speeds - 1
     aux = m.aux_power_w
     for p_type in prange(first_cell.shape[0]):
-        t = np.int64(p_type)  # prange counts in uint64: the int64 index of every other caller
-        i = first_cell[t]
-        top0 = m.envelope_ms[i] ** 2
-        top1 = m.envelope_ms[i + 1] ** 2
+        t, i, top0, top1 = _kind_cell(m, first_cell, p_type)
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
             tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
@@ -594,7 +607,9 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
     """Every kind of cell's transitions from every speed node, which do not depend on the price of time.
 
     Returns a tuple ``(fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type)``:
-    for the four fixed controls arrays (n_types, n_speeds, 4) of where the speed reached falls
+    for the four fixed controls (and, where the train has a varying traction efficiency map, the
+    part-power shares after them, :func:`part_power_shares`) arrays (n_types, n_speeds, 4 [+ n_shares])
+    of where the speed reached falls
     among the next position's speed nodes (:func:`value_position`, computed once here rather than
     in every sweep), the net energy (J, with auxiliary power) and the time of the cell; for partial
     traction onto speed nodes the same in flat arrays, state ``s = t * n_speeds + j`` owning entries
@@ -618,6 +633,10 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
     np.cumsum(counts, out=offsets[1:])
     tgt = [np.empty(offsets[-1], dtype=np.float32) for _ in range(3)]
     _fill_transitions(m, n_speeds, max_targets, bias, first_cell, False, counts, offsets, *fixed, *tgt)
+    shares = part_power_shares(m)
+    if shares.shape[0] > 0:  # a varying traction map: the part-power controls after the fixed ones
+        part = part_power_transitions(m, n_speeds, bias, first_cell, shares)
+        fixed = [np.concatenate((a, b), axis=2) for a, b in zip(fixed, part)]
     return (*fixed, offsets, *tgt, cell_type)
 
 
@@ -671,7 +690,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
                        sing_val)
         for j in range(n_speeds):
             best = INF
-            for c in range(N_FIXED):
+            for c in range(fixed_e.shape[2]):  # N_FIXED, and the part-power shares where the train has them
                 e = fixed_e[t, j, c]
                 if e < INF:
                     # the float32 position as float64 (exact; interp_aug computes in float64 either way):
@@ -786,7 +805,9 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     ``tables`` are the model's :func:`transitions`; ``value`` (n_nodes, n_speeds) receives the
     cost-to-go. ``singular`` adds the singular speeds of the price as states (:func:`singular_speeds`).
     Returns the forward run: (modes, targets, speeds, cells done, net energy J, time s, cost of the kept
-    regimes J) and the cost-to-go from the initial speed (J).
+    regimes J) and the cost-to-go from the initial speed (J). Where the train has a varying traction
+    efficiency map, ``targets`` is (n_cells, 2): target and traction share (:func:`forward_rollout_part_power`),
+    the program's third and fourth columns.
     Time is priced at ``lambda + P_aux`` in the forward run: auxiliary energy is part of the net
     energy, and the tables already hold it.
 
@@ -821,13 +842,33 @@ def _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, s
     """The forward run of :func:`solve` on a swept cost-to-go, and the cost-to-go from the initial speed."""
     n = model.position_m.shape[0]
     price = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,))) + model.aux_power_w
+    return forward_run(model, price, value, max_targets, bias, tie_j, sing_v, sing_p, sing_val)
+
+
+def forward_run(model, time_price_w, value, max_targets, bias, tie_j, sing_v, sing_p, sing_val) -> tuple:
+    """The forward run on a swept cost-to-go: :func:`forward_rollout`, or where the train has a varying
+    traction efficiency map :func:`forward_rollout_part_power` (chosen here, in Python: a case without
+    one compiles no part-power kernel).
+
+    ``time_price_w`` (n_cells,) includes the auxiliary power. Returns ``(modes, targets, speeds,
+    n_cells_done, net_energy_j, time_s, tie_cost_j, start_j)``; ``targets`` is (n_cells,), or (n_cells, 2)
+    with the traction share beside the target where part power is among the controls, so that
+    ``np.column_stack([end_m, modes, targets])`` is the simulator's program either way; ``start_j`` is
+    the cost-to-go from the initial speed.
+    """
+    n = model.position_m.shape[0]
     modes = np.zeros(n - 1, dtype=np.int64)
-    targets = np.zeros(n - 1)
     speeds = np.zeros(n)
-    done, energy, time, tie_cost, start_j = forward_rollout(model, price, value, int(max_targets), float(bias),
-                                                            float(tie_j), modes, targets, speeds, sing_v, sing_p,
-                                                            sing_val)
-    return modes, targets, speeds, done, energy, time, tie_cost, start_j
+    shares = part_power_shares(model)
+    if shares.shape[0] > 0:
+        targets = np.zeros((n - 1, 2))
+        run = forward_rollout_part_power(model, time_price_w, value, int(max_targets), float(bias), float(tie_j),
+                                         shares, modes, targets, speeds, sing_v, sing_p, sing_val)
+    else:
+        targets = np.zeros(n - 1)
+        run = forward_rollout(model, time_price_w, value, int(max_targets), float(bias), float(tie_j), modes, targets,
+                              speeds, sing_v, sing_p, sing_val)
+    return (modes, targets, speeds, *run)
 
 
 def speed_floor_nodes(model, floor_ms: np.ndarray, n_speeds: int, bias: float) -> np.ndarray:
@@ -844,3 +885,179 @@ def speed_floor_nodes(model, floor_ms: np.ndarray, n_speeds: int, bias: float) -
         u = floor_ms[i] ** 2
         out[i] = n_speeds if u > top_u or top_u <= 0.0 else int(math.ceil(node_position(top_u, u, k_max, bias) - 1e-9))
     return out
+
+
+# ---------------------------------------------------------------- part-power traction (efficiency maps)
+# With a traction efficiency that depends on the force, pulling at part of the maximum force can be
+# cheaper than full traction and coasting (docs/efficiency.md, "Part-power traction"). Where the train
+# has such a map, the DP adds these shares of the maximum traction force (the simulator's fourth program
+# column, ``scaled_step``) as further controls of every cell; the forward run refines the share of its
+# best one between the neighbouring shares (:func:`best_part_power`). A case without a varying map
+# never reaches these functions (chosen in Python: nothing more to compile on its first run).
+PART_POWER_SHARES = np.linspace(0.1, 0.9, 9)
+# golden-section steps of the forward run's refinement: the bracket (two share steps, 0.2) shrinks to 1e-5
+PART_POWER_REFINE_STEPS = 24
+_GOLDEN = 0.5 * (math.sqrt(5.0) - 1.0)
+
+
+def part_power_shares(m) -> np.ndarray:
+    """The traction shares the DP tries as part-power controls: :data:`PART_POWER_SHARES` where the kernel
+    model has a varying traction efficiency map (:func:`varying_maps`), none otherwise."""
+    return PART_POWER_SHARES.copy() if varying_maps(m)[0] else np.empty(0)
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def part_power_target(m, cell):
+    """The target speed of a part-power row (m/s): the braking envelope at the cell's end, which the
+    ``toward`` row lands on rather than overshoot (the envelope would stop it there anyway)."""
+    return m.envelope_ms[cell + 1]
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def part_power_outcome(m, v0, cell, share):
+    """The simulator's cell of a ``toward`` row at traction ``share`` (:func:`part_power_target`):
+    ``(u1, force_n, w0_n)``, as :func:`cell_outcome` gives it for a row of full traction."""
+    tr_u, tr_f, tr_w, _ = scaled_step(m, v0, cell, KIND_TRACTION, share)
+    co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
+    # a toward row never brakes: the braking step is not read, the coast step stands in for it
+    return cell_outcome(m, v0, cell, np.int64(MODE_TOWARD), part_power_target(m, cell), tr_u, tr_f, tr_w,
+                        co_u, co_f, co_w, co_u, co_f, co_w)
+
+
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
+def _fill_part_power(m, n_speeds, bias, first_cell, shares, pp_u1, pp_e, pp_dt):
+    k_max = n_speeds - 1
+    for p_type in prange(first_cell.shape[0]):
+        t, i, top0, top1 = _kind_cell(m, first_cell, p_type)
+        for j in range(n_speeds):
+            v0 = math.sqrt(node_u(top0, j, k_max, bias))
+            for c in range(shares.shape[0]):
+                u1, f, w0 = part_power_outcome(m, v0, i, shares[c])
+                e, dt = cell_cost(m, v0, u1, f, w0, i, m.aux_power_w)
+                pp_u1[t, j, c] = value_position(top1, u1, k_max, bias)
+                pp_e[t, j, c] = e
+                pp_dt[t, j, c] = dt
+
+
+def part_power_transitions(m, n_speeds: int, bias: float, first_cell: np.ndarray, shares: np.ndarray) -> list:
+    """The part-power controls' transitions (``[u1, e, dt]``, each (n_types, n_speeds, n_shares), single
+    precision), for :func:`transitions` to append to its fixed controls."""
+    out = [np.empty((first_cell.shape[0], n_speeds, shares.shape[0]), dtype=np.float32) for _ in range(3)]
+    _fill_part_power(m, n_speeds, bias, first_cell, shares, *out)
+    return out
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_p, sing_val):
+    """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`control_cost`'s sum)."""
+    u1, f, w0 = part_power_outcome(m, v0, cell, share)
+    cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
+    if cost < INF:
+        cost += interp_aug(v_next, value_position(top_u, u1, v_next.shape[0] - 1, bias), sing_p, sing_val)
+    return cost
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def best_part_power(m, cell, v0, time_price_w, v_next, bias, sing_p, sing_val, shares):
+    """The best traction share from ``v0``: the best of ``shares``, refined by golden section between its
+    neighbours (0 and 1 at the ends). Returns ``(total_cost, share)``.
+
+    The refinement is the Pontryagin condition of part-power traction taken on the cell itself: the
+    share minimising the cell's electrical energy and time plus the cost-to-go where it ends is the
+    one where the marginal electrical energy of force, ``d(F / eta(v, F))/dF``, equals the value of
+    the kinetic energy it buys, ``-dV/dE_kin`` (docs/efficiency.md).
+    """
+    top_u = m.envelope_ms[cell + 1] ** 2
+    best = INF
+    best_c = -1
+    for c in range(shares.shape[0]):
+        cost = part_power_cost(m, v0, cell, shares[c], time_price_w, v_next, top_u, bias, sing_p, sing_val)
+        if cost < best:
+            best = cost
+            best_c = c
+    if best_c < 0:
+        return INF, 1.0
+    best_share = shares[best_c]
+    lo = shares[best_c - 1] if best_c > 0 else 0.0
+    hi = shares[best_c + 1] if best_c < shares.shape[0] - 1 else 1.0
+    a = hi - _GOLDEN * (hi - lo)
+    b = lo + _GOLDEN * (hi - lo)
+    fa = part_power_cost(m, v0, cell, a, time_price_w, v_next, top_u, bias, sing_p, sing_val)
+    fb = part_power_cost(m, v0, cell, b, time_price_w, v_next, top_u, bias, sing_p, sing_val)
+    for _ in range(PART_POWER_REFINE_STEPS):
+        if fa <= fb:
+            hi, b, fb = b, a, fa
+            a = hi - _GOLDEN * (hi - lo)
+            fa = part_power_cost(m, v0, cell, a, time_price_w, v_next, top_u, bias, sing_p, sing_val)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + _GOLDEN * (hi - lo)
+            fb = part_power_cost(m, v0, cell, b, time_price_w, v_next, top_u, bias, sing_p, sing_val)
+    if fa < best and a < 1.0:
+        best, best_share = fa, a
+    if fb < best and b < 1.0:
+        best, best_share = fb, b
+    return best, best_share
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j, shares, modes, targets, speeds,
+                               sing_v, sing_p, sing_val):
+    """:func:`forward_rollout` with part-power traction among the controls (:func:`best_part_power`).
+
+    ``targets`` is (n_cells, 2): each cell's target speed and traction share (1 but on a part-power
+    cell), the simulator's third and fourth program columns. The tie rule keeps the previous control
+    as :func:`forward_rollout` does, a part-power cell its share. Returns what :func:`forward_rollout` does.
+    """
+    n = m.position_m.shape[0]
+    v = m.initial_speed_ms
+    start_j = interp_aug(value[0], value_position(m.envelope_ms[0] ** 2, v ** 2, value.shape[1] - 1, bias), sing_p[0],
+                         sing_val[0])
+    speeds[0] = v
+    energy = time = tie_cost = 0.0
+    previous, previous_share = MODE_TRACTION, 1.0  # the control of the cell before
+    for i in range(n - 1):
+        price = time_price_w[i]
+        cost, mode, target = best_control(m, i, v, price, value[i + 1], max_targets, bias, sing_v[i + 1],
+                                          sing_p[i + 1], sing_val[i + 1])
+        if cost >= PENALTY_J:  # every control leads to a stop short of the platform
+            return i, energy, time, tie_cost, start_j
+        share = 1.0
+        pp_cost, pp_share = best_part_power(m, i, v, price, value[i + 1], bias, sing_p[i + 1], sing_val[i + 1],
+                                            shares)
+        if pp_cost < cost:
+            cost, mode, target, share = pp_cost, MODE_TOWARD, part_power_target(m, i), pp_share
+        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
+        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
+        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
+        if i > 0 and tie_j > 0.0 and (mode != previous or share != previous_share):
+            top_u = m.envelope_ms[i + 1] ** 2
+            if previous_share < 1.0:  # keep pulling at the previous share
+                c_keep = part_power_cost(m, v, i, previous_share, price, value[i + 1], top_u, bias, sing_p[i + 1],
+                                         sing_val[i + 1])
+                keep, keep_target = MODE_TOWARD, part_power_target(m, i)
+            else:
+                keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
+                keep_target = 0.0
+                c_keep = INF
+                if keep != mode or share < 1.0:
+                    c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
+                                          price, value[i + 1], top_u, bias, sing_p[i + 1], sing_val[i + 1])
+            if c_keep < INF and c_keep <= cost + tie_j:
+                tie_cost += c_keep - cost
+                mode, target, share = keep, keep_target, previous_share
+        if share < 1.0:
+            u1, f, w0 = part_power_outcome(m, v, i, share)
+        else:
+            u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+        energy += c_energy
+        time += dt
+        modes[i] = mode
+        targets[i, 0] = target
+        targets[i, 1] = share
+        previous = mode
+        previous_share = share
+        v = math.sqrt(u1)
+        speeds[i + 1] = v
+    return n - 1, energy, time, tie_cost, start_j

@@ -9,6 +9,7 @@ the energy it really draws. ``benchmarks/efficiency_study.py`` runs it beside ms
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 
 import numpy as np
@@ -72,26 +73,26 @@ def efficiency_models(case: Case, traction_map: EfficiencyMap, regen_map: Effici
 
 def planned_runs(models: dict[str, Case], running_time_s: float, costed_under: str = "dynamic") -> list[dict]:
     """The optimal run of each model at ``running_time_s``, its energy under its own model and under
-    ``costed_under`` (kWh), its running time and the run itself (``run``)."""
+    ``costed_under`` (kWh), its running time, the CPU time of its solve (``cpu_s``) and the run itself (``run``)."""
     judge = Simulator(models[costed_under])
     rows = []
     for name, case in models.items():
+        started = time.process_time()
         run = OptimalSolver(case).profile(running_time_s)
+        cpu_s = time.process_time() - started
         real = judge.energy_of(run)
-        rows.append({"model": name, "running_time_s": run.running_time_s, "own_kwh": run.energy.net_kwh,
+        rows.append({"model": name, "running_time_s": run.running_time_s, "own_kwh": run.energy.net_kwh, "cpu_s": cpu_s,
                      f"{costed_under}_kwh": real.net_kwh, f"{costed_under}_traction_kwh": real.traction_kwh,
                      f"{costed_under}_regen_kwh": real.regen_kwh, f"{costed_under}_aux_kwh": real.aux_kwh,
                      "run": run})
     return rows
 
 
-def profile_energy_kwh(case: Case, position_m, speed_ms, time_s) -> float:
-    """Net energy (kWh) of a speed profile given at its own points (another solver's run) under the
-    case's train: the force of each interval from the change of kinetic energy, ``F = M (v1^2 -
-    v0^2) / (2 d) + R(v) + line force`` at its mean speed and its middle, drawn as ``F d / eta`` when
-    pulling and returned as ``eta |F| d`` when braking (all braking electric: the study's train has no
-    regen caps), plus the auxiliary power over the run's time."""
-    x, v, t = (np.asarray(a, dtype=float) for a in (position_m, speed_ms, time_s))
+def profile_forces_n(case: Case, position_m, speed_ms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The force at the wheel of each interval of a speed profile given at its own points (another
+    solver's run): ``F = M (v1^2 - v0^2) / (2 d) + R(v) + line force`` at its mean speed and its middle.
+    Returns ``(force_n, mean_speed_ms, length_m)``, one per interval."""
+    x, v = np.asarray(position_m, dtype=float), np.asarray(speed_ms, dtype=float)
     train = case.train
     a, b, c = train.resistance.coefficients_si(train.mass_kg)
     grid = Simulator(case).grid
@@ -99,6 +100,28 @@ def profile_energy_kwh(case: Case, position_m, speed_ms, time_s) -> float:
     cell = np.minimum((x_mid / grid.dx_m).astype(int), grid.line_force_n.shape[0] - 1)
     force = (train.effective_mass_kg * (v[1:] ** 2 - v[:-1] ** 2) / (2.0 * d) + a + b * v_mid + c * v_mid ** 2
              + grid.line_force_n[cell])
+    return force, v_mid, d
+
+
+def part_power_km(case: Case, position_m, speed_ms, below: float = 0.95, min_accel_ms2: float = 0.02) -> float:
+    """How far a speed profile accelerates at part power (km): intervals pulling with a force below ``below``
+    x the traction curve at their mean speed (:func:`profile_forces_n`) and accelerating at least at
+    ``min_accel_ms2`` (not holding a speed: a solver's holding arc gains or loses a little speed)."""
+    force, v_mid, d = profile_forces_n(case, position_m, speed_ms)
+    curve_n = case.train.traction.force_kn(v_mid * KMH_PER_MS) * 1000.0
+    v = np.asarray(speed_ms, dtype=float)
+    accelerating = (v[1:] ** 2 - v[:-1] ** 2) / (2.0 * d) >= min_accel_ms2
+    return float(d[(force > 0.0) & accelerating & (force < below * curve_n)].sum() / 1000.0)
+
+
+def profile_energy_kwh(case: Case, position_m, speed_ms, time_s) -> float:
+    """Net energy (kWh) of a speed profile given at its own points (another solver's run) under the
+    case's train: the force of each interval (:func:`profile_forces_n`) drawn as ``F d / eta`` when
+    pulling and returned as ``eta |F| d`` when braking (all braking electric: the study's train has no
+    regen caps), plus the auxiliary power over the run's time."""
+    t = np.asarray(time_s, dtype=float)
+    train = case.train
+    force, v_mid, d = profile_forces_n(case, position_m, speed_ms)
     speed_kmh, force_kn = v_mid * KMH_PER_MS, force / 1000.0
     eta_t = (train.traction_efficiency_map.efficiency(speed_kmh, force_kn) if train.traction_efficiency_map
              is not None else np.full(force.shape, train.traction_efficiency))

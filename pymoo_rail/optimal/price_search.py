@@ -19,6 +19,7 @@ import numpy as np
 
 from pymoo_rail.constants import J_PER_KWH
 from pymoo_rail.model import InfeasibleCaseError
+from pymoo_rail.sim.drivers import replaced_rows
 from pymoo_rail.sim.kernel import (
     MODE_COAST,
     MODE_HOLD,
@@ -272,16 +273,12 @@ def move_last_switch(solver: OptimalSolver, solution: Solve, target: float) -> S
         slow_end, fast_end = 0, n_cells - 1 - last
 
         def moved(j):
-            p = program.copy()
-            p[last + 1:last + 1 + j, 1:] = (mode, 0.0)
-            return p
+            return replaced_rows(program, slice(last + 1, last + 1 + j), mode)
     else:  # cut short: coast earlier
         slow_end, fast_end = last + 1, 0
 
         def moved(j):
-            p = program.copy()
-            p[last + 1 - j:last + 1, 1:] = (MODE_COAST, 0.0)
-            return p
+            return replaced_rows(program, slice(last + 1 - j, last + 1), MODE_COAST)
 
     def run(j):
         p = moved(j)

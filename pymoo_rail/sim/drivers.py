@@ -140,3 +140,12 @@ def braking_programs(positions_m: np.ndarray, regimes: tuple[str, ...], decel_ms
 def flat_out_program(length_m: float) -> np.ndarray:
     """Maximum traction everywhere: the limits and the platform brake it (the fastest run)."""
     return np.array([[length_m, MODE_TRACTION, 0.0]])
+
+
+def replaced_rows(program: np.ndarray, rows: slice, mode: int) -> np.ndarray:
+    """A copy of ``program`` whose ``rows`` say ``mode`` (no target; full traction where the program
+    has a fourth column, the traction share of part-power rows)."""
+    p = program.copy()
+    p[rows, 1:3] = (mode, 0.0)
+    p[rows, 3:] = 1.0
+    return p

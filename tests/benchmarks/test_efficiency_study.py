@@ -34,6 +34,10 @@ def test_findings_name_the_ranges_of_the_table():
     assert "-0.10 to +1.50 %" in text
     assert "-0.41 to +0.00 %" in text  # 120 / 120.5 - 1 and 108 / 108 - 1
     assert "+2.50 to +3.70 %" in text  # 123 / 120 - 1 and 112 / 108 - 1
+    assert "+2.00 to +2.00 %" in text  # the dynamic rows' own_diff_pct
+    rows[2].update(ours_part_power_km=3.21, mseetc_part_power_km=4.0)
+    rows[5].update(ours_part_power_km=2.0, mseetc_part_power_km=2.5)
+    assert findings(pd.DataFrame(rows))["part_power"] == "3.2 / 4.0 km at 10 %, 2.0 / 2.5 km at 20 %"
 
 
 def test_sampled_maps_reproduce_the_loss_function_they_come_from():
@@ -72,3 +76,11 @@ def test_mseetc_study_driver_returns_the_run_and_the_losses():
     assert result["position_m"][-1] == pytest.approx(8500.0) and result["speed_ms"][-1] == pytest.approx(100 / 3.6)
     # its midpoint energy and its CVODES-integrated one agree
     assert result["dynamic_energy_kwh"] == pytest.approx(result["energy_kwh"], rel=5e-3)
+
+
+def test_the_command_line_help_prints():
+    import subprocess
+
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "efficiency_study.py"
+    out = subprocess.run([sys.executable, str(script), "--help"], capture_output=True, text=True, check=True)
+    assert "--mseetc" in out.stdout and "time reserves (%)" in out.stdout

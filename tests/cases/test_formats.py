@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import ast
 import shutil
 import warnings
+from pathlib import Path
 
 import pytest
 
@@ -64,3 +66,21 @@ def test_load_train_reads_a_case_file_a_train_alone_or_a_ttobench_train(tmp_path
     no_train.write_text('name = "x"\n')
     with pytest.raises(CaseError, match="train"):
         load_train(no_train)
+
+
+def test_the_cli_reads_case_and_train_files_only_through_the_registry():
+    # the CLI imports pymoo_rail.cases (load_case, load_train, ...), never one format's reader module,
+    # so that every file a command takes goes through formats.FORMATS
+
+    cli = Path(__file__).resolve().parents[2] / "pymoo_rail" / "cli"
+    readers = {f"pymoo_rail.cases.{name}" for name in ("toml_case", "ttobench", "railjson", "railjson_infra",
+                                                       "railjson_rolling_stock", "formats")}
+    imported = set()
+    for path in cli.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                imported.add(node.module)
+            elif isinstance(node, ast.Import):
+                imported.update(alias.name for alias in node.names)
+    assert "pymoo_rail.cases" in imported
+    assert not imported & readers, sorted(imported & readers)

@@ -10,19 +10,18 @@ from pathlib import Path
 import pytest
 
 from pymoo_rail.cases import generate_case, load_train, railjson_case
+from pymoo_rail.experiments.osrd_fleet import KINDS, MODES
 from pymoo_rail.optimal import optimal_profile
 from pymoo_rail.sim import Simulator
 from pymoo_rail.sim.checks import check_run
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "osrd"
 STOCKS = sorted((DATA / "rolling_stocks").glob("*.json"))
-# the high-speed train's default mode (1500V) has no traction on the 25 kV lines of small_infra
-MODES = {"high-speed-train": "25000V"}
-# the kind of generated line each train runs on
-KINDS = {"commuter-train": "suburban", "d-tram-train": "metro", "dmu-regional-train": "suburban",
-         "e-tram-train": "metro", "emu-regional-train": "suburban", "freight-train": "intercity",
-         "high-speed-train": "high-speed", "intercity-train": "intercity", "light-freight-train": "intercity",
-         "night-train": "intercity", "touristic-train": "metro"}
+# North_East -> West on small_infra (45.8 km): 300 km/h but 142 km/h over [4500, 5000] m, where a
+# train faster than 142 km/h must hold it until its tail has left the restriction
+RESTRICTION_M = (4500.0, 5000.0, 142.0)
+# the trains fast enough to reach it flat out (the others top out below it or are still accelerating)
+HELD_BY_THE_TAIL = {"emu-regional-train", "high-speed-train", "intercity-train", "night-train"}
 
 
 def _check_physics(case, trajectory) -> None:
@@ -46,6 +45,32 @@ def _drive(case) -> tuple[float, float]:
     # slack buys energy: the optimal run needs less than the fastest
     assert optimal.energy.net_kwh < fastest.energy.net_kwh
     return fastest.running_time_s, optimal.energy.net_kwh
+
+
+def _drive_restricted(stock: Path) -> None:
+    """Flat-out and optimal on North_East -> West; a train faster than the restriction holds it
+    over its whole length: <= 142 km/h until the tail leaves 5000 m, faster after."""
+    case = _osrd_case(stock, "North_East_station", "West_station")
+    assert RESTRICTION_M in case.line.speed_limits
+    _drive(case)
+    fastest = Simulator(case).flat_out()
+    start, end, limit_kmh = RESTRICTION_M
+    behind = (fastest.position_m >= start) & (fastest.position_m < end + case.train.length_m)
+    assert fastest.speed_ms[behind].max() * 3.6 <= limit_kmh + 1e-6
+    if stock.stem in HELD_BY_THE_TAIL:  # the restriction binds: at 142 km/h until the tail clears, faster after
+        assert fastest.speed_ms[behind].max() * 3.6 == pytest.approx(limit_kmh, abs=1e-6)
+        assert fastest.speed_ms[fastest.position_m > end + case.train.length_m].max() * 3.6 > limit_kmh + 5.0
+
+
+def test_an_intercity_train_holds_a_restriction_until_its_tail_clears_it():
+    case = _osrd_case(DATA / "rolling_stocks" / "intercity-train.json", "North_East_station", "West_station")
+    fastest = Simulator(case).flat_out()
+    _check_physics(case, fastest)
+    start, end, limit_kmh = RESTRICTION_M
+    tail_inside = (fastest.position_m >= end) & (fastest.position_m < end + case.train.length_m)
+    # the head has left the restriction, the tail has not: the run stays at 142 km/h for those 200 m
+    assert fastest.speed_ms[tail_inside] * 3.6 == pytest.approx(limit_kmh, abs=1e-6)
+    assert fastest.speed_ms[fastest.position_m > end + case.train.length_m + 200.0].max() * 3.6 > limit_kmh
 
 
 def _osrd_case(stock: Path, start: str, end: str):
@@ -84,3 +109,16 @@ def test_every_realistic_train_drives_an_osrd_line_and_a_generated_line(stock):
     # train's kind (seed 0: 1.9 to 37 km, climbs and descents, curves, neutral sections)
     _drive(_osrd_case(stock, "Mid_East_station", "West_station"))
     _drive(_generated_case(stock, 0))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stock", STOCKS, ids=[p.stem for p in STOCKS])
+def test_every_realistic_train_drives_an_osrd_line_with_a_restriction(stock):
+    # the 26.3 km path above has one limit (300 km/h): this 45.8 km one has a 142 km/h restriction
+    # that the faster trains (EMU, intercity, night, high-speed) must hold over their whole length
+    _drive_restricted(stock)
+
+
+def test_the_fleet_is_the_eleven_osrd_stocks():
+    # the slow tests above are parametrised over STOCKS: all eleven, each with a kind of generated line
+    assert len(STOCKS) == 11 and set(KINDS) == {p.stem for p in STOCKS}

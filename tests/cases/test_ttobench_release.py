@@ -80,12 +80,13 @@ def test_every_train_imports_unedited_and_names_what_is_not_modelled(path):
         assert tt.n_seats == raw["num seats"]["value"] and tt.n_coaches == raw["num coaches"]["value"]
 
 
-def test_efficiency_map_is_refused_with_a_reason():
+def test_a_loss_table_without_wheel_power_is_refused_with_a_reason():
+    # loss tables are read (tests/cases/test_ttobench_efficiency.py); one only at rest holds no efficiency
     raw = json.loads((RELEASE / "trains" / "CN_Beijing_Subway.json").read_text())
     raw["efficiency traction"] = {"units": {"load": "%", "velocity": "km/h", "losses": "kW"}, "values": [[0, 0, 1]]}
-    with pytest.raises(CaseError, match="efficiency map is not part of the released TTOBench format") as err:
+    with pytest.raises(CaseError, match="needs rows at a velocity above 0") as err:
         read_train(raw)
-    assert err.value.field == "efficiency traction"
+    assert err.value.field == "efficiency traction.values"
 
 
 def _curved_track(radius_start, radius_end, length_m=1000.0):
