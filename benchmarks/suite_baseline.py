@@ -24,6 +24,8 @@ import os
 import sys
 from pathlib import Path
 
+import numba
+
 from pymoo_rail.experiments import read_study, run_study
 from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, convergence, cut_study,
                                              indicator_frame, performance_profile, projected_cpu_h)
@@ -100,4 +102,8 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
+    # runs made in this process (--workers 1) get one Numba thread, as each worker of the pool has:
+    # the kernel's second thread saves little wall time and its spin-waits count as CPU of the run
+    # (twice the kernel's CPU, ten times the history's, measured by suite_baseline_profile.py)
+    numba.set_num_threads(1)
     raise SystemExit(main())

@@ -11,6 +11,7 @@ Usage::
     nice python benchmarks/suite_families.py                      # every family, n_var 10-1000, fronts
     nice python benchmarks/suite_families.py --no-fronts          # throughput only (about a minute)
     nice python benchmarks/suite_families.py --kinds metro --n-vars 10 1000
+    nice python benchmarks/suite_families.py --bounded --n-vars 10 100 1000 --seed 1   # the -3obj gaps
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from __future__ import annotations
 import argparse
 
 from pymoo_rail.cases import KINDS
-from pymoo_rail.experiments.family_cost import N_VARS, front_table, throughput_table
+from pymoo_rail.experiments.family_cost import N_VARS, bounded_table, front_table, throughput_table
 from pymoo_rail.suite import list_families
 
 
@@ -29,7 +30,11 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=7)
     parser.add_argument("--min-cpu-s", type=float, default=0.5, help="CPU seconds per throughput measurement")
     parser.add_argument("--no-fronts", action="store_true", help="throughput only")
+    parser.add_argument("--bounded", action="store_true", help="only the -3obj families' bounded fronts and gaps")
     args = parser.parse_args()
+    if args.bounded:
+        print(bounded_table(args.kinds, args.n_vars, args.seed).to_string(index=False))
+        return
     families = [f for f in list_families() if any(f.startswith(f"generated-{k}-") for k in args.kinds)]
     table = throughput_table(families, args.n_vars, args.seed, args.min_cpu_s)
     print("\nEvaluations per CPU second (batches of 100):")

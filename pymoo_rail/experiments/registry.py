@@ -248,6 +248,15 @@ def _nsga3(problem, pop_size: int = 100, **params):
     return NSGA3(ref_dirs=_ref_dirs(problem.n_obj, pop_size), pop_size=pop_size, **params)
 
 
+@_forwards("pymoo.algorithms.moo.ctaea", "CTAEA")
+def _ctaea(problem, pop_size: int = 100, **params):
+    """C-TAEA (Li et al. 2019) with ``pop_size`` reference directions: its population and each
+    generation's offspring are one per direction, so an ``n_eval`` budget counts ``pop_size`` a generation."""
+    from pymoo.algorithms.moo.ctaea import CTAEA
+
+    return CTAEA(ref_dirs=_ref_dirs(problem.n_obj, pop_size), **params)
+
+
 @_forwards("pymoo.algorithms.moo.moead", "MOEAD")
 def _moead(problem, pop_size: int = 100, n_neighbors: int = 20, **params):
     """MOEA/D with ``pop_size`` uniform weight vectors (the population is one per vector)."""
@@ -322,6 +331,8 @@ class AlgorithmEntry:
 ALGORITHMS: dict[str, AlgorithmEntry] = {
     "nsga2": AlgorithmEntry(_nsga2, "any", "NSGA-II (pymoo)"),
     "nsga3": AlgorithmEntry(_nsga3, "multi", "NSGA-III with pop_size reference directions (pymoo)"),
+    "ctaea": AlgorithmEntry(_ctaea, "multi", "C-TAEA, two archives for constrained problems, pop_size reference "
+                                             "directions (pymoo)"),
     "moead": AlgorithmEntry(_moead, "multi", "MOEA/D with pop_size weight vectors (pymoo)"),
     "sms-emoa": AlgorithmEntry(_smsemoa, "multi", "SMS-EMOA (pymoo)"),
     "age-moea": AlgorithmEntry(_agemoea, "multi", "AGE-MOEA, adaptive geometry estimation (pymoo)"),
@@ -335,7 +346,7 @@ ALGORITHMS: dict[str, AlgorithmEntry] = {
     "grnsga2": AlgorithmEntry(_grnsga2, "any", "golden-ratio NSGA-II (pymoo_rail, Tang et al. (2020))"),
 }
 
-ALIASES = {"smsemoa": "sms-emoa", "agemoea": "age-moea", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3",
+ALIASES = {"smsemoa": "sms-emoa", "agemoea": "age-moea", "moea/d": "moead", "nsga-ii": "nsga2", "nsga-iii": "nsga3", "c-taea": "ctaea",
            "golden-ratio-nsga2": "grnsga2", "goldenrationsga2": "grnsga2", "speed-profile": "speed_profile",
            "cooperative-trains": "cooperative_trains", "rail-suite": "rail_suite",
            "suite-family": "suite_family", "random-search": "random",

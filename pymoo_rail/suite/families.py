@@ -11,6 +11,10 @@ solver and cached on disk under the case's content hash.
   (:func:`pymoo_rail.optimal.reference.default_window`), ``n_var`` speed codes (km/h).
 - ``generated-<kind>-single``: net energy under ``|T - T_plan| <= 1 %`` of the planned time (at least
   1 s), paced speed codes: ``n_var - 1`` shapes and the running time (s); its optimum is certified.
+- ``generated-<kind>-3obj``: net energy, running time and comfort (``accel_variation``, m/s^2) in
+  the planner's window, ``n_var`` speed codes; its front is *bounded*, not certified
+  (:mod:`pymoo_rail.suite.comfort`): an outer bound from the certified energy front and a kinematic
+  comfort floor, an inner bound of real runs, and the gap between them (:meth:`FamilyProblem.bounded_front`).
 
 Each instance carries :data:`FAMILY_VERSION` and a checksum of its definition
 (:func:`definition`): the case's content hash, the encoding and its sections, the bounds, the
@@ -29,7 +33,8 @@ from pymoo_rail.cases import KINDS, generate_case
 from pymoo_rail.model import Case
 from pymoo_rail.problems import SpeedProfileProblem
 from pymoo_rail.sim import Simulator
-from pymoo_rail.optimal.reference import FRONT_VERSION, NoExactFrontError, case_hash, default_window
+from pymoo_rail.optimal.reference import FRONT_VERSION, NoExactFrontError, case_hash, certified_front, default_window
+from pymoo_rail.suite import comfort
 from pymoo_rail.suite import problems as named
 from pymoo_rail.suite.identity import HV_MARGIN, as_text, checksum_of
 from pymoo_rail.suite.trips import TripProblem, trip_problem
@@ -41,6 +46,7 @@ N_VAR_RANGE = (2, 1000)
 DEFAULT_N_VAR = 30
 DEFAULT_SEED = 1
 BI_OBJECTIVES = ("energy", "running_time")
+FORMS = ("bi", "single", "trip", "3obj")
 PLAN_MARGIN = 1.1
 PLAN_ROUND_S = 5.0
 """A family's line is planned :data:`PLAN_MARGIN` x its minimum running time, rounded up to this (s)."""
@@ -58,10 +64,11 @@ class Family:
         ``generated-<kind>-<form>``.
     kind : str
         Kind of line (:data:`pymoo_rail.cases.KINDS`): its train and line statistics.
-    form : {"bi", "single", "trip"}
-        Energy and running time in the planner's window, energy at the planned time (1 %), or the
+    form : {"bi", "single", "trip", "3obj"}
+        Energy and running time in the planner's window, energy at the planned time (1 %), the
         energy of a whole trip of ``n_var`` sections with a fixed total running time
-        (:mod:`pymoo_rail.suite.trips`).
+        (:mod:`pymoo_rail.suite.trips`), or energy, running time and comfort in the planner's window
+        (:mod:`pymoo_rail.suite.comfort`).
     """
 
     name: str
@@ -73,17 +80,21 @@ class Family:
         """One line on what the family is."""
         what = {"bi": "net energy and running time in the planner's window, n_var speed codes",
                 "single": "net energy at the planned time (1 %), n_var - 1 paced shapes and the running time",
-                "trip": "net energy of a trip of n_var sections, their running times summing to the plan"}[self.form]
+                "trip": "net energy of a trip of n_var sections, their running times summing to the plan",
+                "3obj": "net energy, running time and comfort (accel_variation) in the planner's window, n_var speed "
+                        "codes; bounded front"}[self.form]
         return f"seeded {self.kind} lines (pymoo_rail.cases.generate_case): {what}"
 
 
 FAMILIES: tuple[Family, ...] = (*(Family(f"generated-{kind}-{form}", kind, form)
                                      for form in ("bi", "single") for kind in KINDS),
-                                  *(Family(f"generated-{kind}-trip", kind, "trip") for kind in TRIP_KINDS))
+                                  *(Family(f"generated-{kind}-trip", kind, "trip") for kind in TRIP_KINDS),
+                                  *(Family(f"generated-{kind}-3obj", kind, "3obj") for kind in KINDS))
+# new families go at the end: list_families() keeps the order of the earlier ones
 
 
 def list_families() -> list[str]:
-    """Names of the suite's scalable families (``generated-<kind>-bi`` and ``generated-<kind>-single``)."""
+    """Names of the suite's scalable families (``generated-<kind>-bi``, ``-single``, ``-trip`` and ``-3obj``)."""
     return [f.name for f in FAMILIES]
 
 
@@ -132,6 +143,9 @@ class FamilyProblem(SpeedProfileProblem):
     def certified_front(self):
         """The line's certified front (:meth:`SpeedProfileProblem.certified_front`).
 
+        The 3-objective form gets the line's energy / running-time front too: the energy any of its
+        runs needs at its running time, whatever its comfort (the outer bound's energy side).
+
         Raises
         ------
         NoExactFrontError
@@ -139,6 +153,8 @@ class FamilyProblem(SpeedProfileProblem):
             ``RuntimeError``: "refine the grid"); pymoo's display then leaves the IGD column out.
         """
         try:
+            if self.objectives == comfort.COMFORT_OBJECTIVES:  # the line's energy / running-time front
+                return certified_front(self.case, self.simulator.grid.dx_m)
             return super().certified_front()
         except NoExactFrontError:
             raise
@@ -153,13 +169,37 @@ class FamilyProblem(SpeedProfileProblem):
         Taken from the case's bi-objective front in the planner's window (energy kWh, running time s),
         restricted to this problem's objectives: the single-objective form's point is the energy of
         the fastest optimal run plus the margin of the front's energy range.
+        The 3-objective form's comfort coordinate runs from the comfort floor at the window's slow end to
+        the nadir of the inner (best-known) points (:func:`pymoo_rail.suite.comfort.cached_inner_points`):
+        comfort has no window, and smooth uniform-code runs need far less than the runs an optimiser finds.
         """
         front = self.certified_front()
         lo, hi = front.clip(self.bi_window_s)
         energy, _ = front.energy_at(np.array([lo, hi]))
         ideal = {"energy": float(energy.min()), "running_time": lo}
         nadir = {"energy": float(energy.max()), "running_time": hi}
+        if "accel_variation" in self.objectives:
+            ideal["accel_variation"] = float(comfort.comfort_floor_ms2(hi, **comfort.floor_settings(self))[0])
+            nadir["accel_variation"] = float(comfort.cached_inner_points(self)[:, 2].max())
         return np.array([nadir[o] + HV_MARGIN * (nadir[o] - ideal[o]) for o in self.objectives])
+
+    def bounded_front(self) -> comfort.BoundedFront:
+        """The 3-objective form's front bounded on both sides, and the gap (:mod:`pymoo_rail.suite.comfort`).
+
+        The inner points are computed once per instance (10,000 evaluations) and cached on disk.
+        """
+        if self.objectives != comfort.COMFORT_OBJECTIVES:
+            raise ValueError(f"{self.suite_name}: objectives {self.objectives}: only the -3obj families have a "
+                             "bounded front (the others are certified: certified_front())")
+        outer = comfort.outer_points(self.certified_front(), self.bi_window_s, comfort.floor_settings(self))
+        return comfort.bound_front(outer, comfort.cached_inner_points(self), self.hv_reference_point())
+
+    def _calc_pareto_front(self, *args, **kwargs):
+        """pymoo's hook: the certified front, or for the 3-objective form the inner (best-known) points
+        of :meth:`bounded_front`; its outer bound and gap are there."""
+        if self.objectives == comfort.COMFORT_OBJECTIVES:
+            return comfort.cached_inner_points(self)
+        return super()._calc_pareto_front(*args, **kwargs)
 
     @property
     def bi_window_s(self) -> tuple[float, float]:
@@ -185,8 +225,8 @@ def family_case(kind: str, seed: int) -> Case:
 
 
 def _settings(entry: Family, case: Case, n_var: int) -> dict:
-    if entry.form == "bi":
-        return dict(objectives=BI_OBJECTIVES, time_window_s="default", encoding="speed_codes", partition="equal",
+    if entry.form in ("bi", "3obj"):
+        return dict(objectives=BI_OBJECTIVES if entry.form == "bi" else comfort.COMFORT_OBJECTIVES, time_window_s="default", encoding="speed_codes", partition="equal",
                     n_sections=n_var)
     return dict(objectives=("energy",), time_tolerance_s=named.tolerance_s(case), encoding=named.SINGLE_ENCODING,
                 partition="equal", n_sections=n_var - 1)
@@ -207,7 +247,10 @@ def definition(problem: SpeedProfileProblem, family_name: str, seed: int) -> dic
             "objectives": list(problem.objectives), "n_ieq_constr": int(problem.n_ieq_constr),
             "time_window_s": None if window is None else text(window),
             "time_tolerance_s": None if problem.time_tolerance_s is None else text(problem.time_tolerance_s),
-            "stop_tolerance_m": problem.stop_tolerance_m, "front_version": FRONT_VERSION}
+            "stop_tolerance_m": problem.stop_tolerance_m, "front_version": FRONT_VERSION,
+            # only the 3-objective form has a bounded front: the other forms' checksums stay as they were
+            **({"bounded_front_version": comfort.COMFORT_FRONT_VERSION}
+               if problem.objectives == comfort.COMFORT_OBJECTIVES else {})}
 
 
 def get_family_problem(name: str, n_var: int = DEFAULT_N_VAR, seed: int = DEFAULT_SEED) -> FamilyProblem | TripProblem:

@@ -24,11 +24,11 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
-from pymoo.core.callback import Callback
-from pymoo.indicators.hv import HV
+
+from pymoo_rail.suite.run_log import EvaluationLogger, HVArchive
 
 
-class IOHLogger(Callback):
+class IOHLogger(EvaluationLogger):
     """A pymoo callback writing IOHprofiler data through ``ioh`` (the ``suite`` extra).
 
     Parameters
@@ -48,6 +48,8 @@ class IOHLogger(Callback):
     as a context manager) after the last run to write the IOH metadata file.
     """
 
+    label = "IOHLogger"
+
     def __init__(self, folder: str | Path, algorithm_name: str, algorithm_info: str = ""):
         super().__init__()
         import ioh  # the optional ``suite`` extra: imported only when a logger is made
@@ -60,47 +62,32 @@ class IOHLogger(Callback):
                                           triggers=[ioh.logger.trigger.ALWAYS])
         self.current = SimpleNamespace()  # the evaluated point's objectives and cv, read by ioh
         self._watched: list[str] | None = None
-        self._algorithm = None
         self._ioh_problem = None
         self._pending: list[float] = []
 
-    # ------------------------------------------------------------------ pymoo hook
-    def notify(self, algorithm) -> None:
-        """Log the individuals evaluated in this iteration (``algorithm.off``)."""
-        if algorithm is not self._algorithm:
-            self._start_run(algorithm)
-        batch = algorithm.off
-        n_new = algorithm.evaluator.n_eval - self._n_eval
-        if n_new == 0:
-            return
-        if batch is None or len(batch) != n_new:
-            raise RuntimeError(f"IOHLogger: {type(algorithm).__name__} evaluated {n_new} points but reported "
-                               f"{0 if batch is None else len(batch)} as algorithm.off; it cannot be logged")
-        self._n_eval = algorithm.evaluator.n_eval
-        F, CV, X = batch.get("F"), batch.get("CV")[:, 0], batch.get("X")
-        for x, f, cv in zip(X, F, CV):
-            self._pending.append(self._gap_after(f, cv))
-            for name, value in zip(self._objective_names, f):
-                setattr(self.current, name, float(value))
-            self.current.cv = float(cv)
-            self._ioh_problem(np.asarray(x, dtype=float))
-
     # ------------------------------------------------------------------ runs
-    def _start_run(self, algorithm) -> None:
-        problem = algorithm.problem
-        if self._ioh_problem is not None and problem.n_var == self._ioh_problem.meta_data.n_variables \
-                and getattr(problem, "suite_name", None) == self._name:
-            self._ioh_problem.reset()  # the same problem: a new run of it
-        else:
+    def start_run(self, problem) -> None:
+        """Attach ioh to ``problem`` (a new run of the same problem keeps it) and start the HV archive."""
+        if self._ioh_problem is None or problem.n_var != self._ioh_problem.meta_data.n_variables \
+                or getattr(problem, "suite_name", None) != self._name:
             self._attach(problem)
-        self._algorithm, self._n_eval, self._pending = algorithm, 0, []
-        ideal = np.atleast_1d(problem.ideal_point()).astype(float)
-        ref = np.atleast_1d(problem.hv_reference_point()).astype(float)
-        self._ideal, self._scale = ideal, ref - ideal
-        self._hv = HV(ref_point=np.ones(problem.n_obj))
-        self._hv_front = float(self._hv(self._scaled(problem.pareto_front())))
-        self._archive = np.empty((0, problem.n_obj))
+        self._pending = []
+        self._archive = HVArchive(problem)
         self._gap = 1.0
+
+    def log_point(self, evaluation: int, x: np.ndarray, f: np.ndarray, cv: float) -> None:
+        """Write one evaluation: the HV gap after it as ``raw_y``, its objectives and ``cv``."""
+        if self._archive.add(evaluation, x, f, cv):
+            self._gap = 1.0 - self._archive.hv / self._archive.hv_front
+        self._pending.append(self._gap)
+        for name, value in zip(self._objective_names, f):
+            setattr(self.current, name, float(value))
+        self.current.cv = float(cv)
+        self._ioh_problem(x)
+
+    def end_run(self) -> None:
+        """End the IOH run (ioh writes its run record)."""
+        self._ioh_problem.reset()
 
     def _attach(self, problem) -> None:
         ioh = self._ioh
@@ -124,33 +111,10 @@ class IOHLogger(Callback):
                                              lb=float(np.min(problem.xl)), ub=float(np.max(problem.xu)))
         self._ioh_problem.attach_logger(self.logger)
 
-    def _scaled(self, F: np.ndarray) -> np.ndarray:
-        return (np.atleast_2d(F) - self._ideal) / self._scale
-
-    def _gap_after(self, f: np.ndarray, cv: float) -> float:
-        """The HV gap of the feasible archive once ``f`` is added (unchanged by an infeasible or dominated ``f``)."""
-        if cv > 0:
-            return self._gap
-        z = self._scaled(f)[0]
-        if self._archive.shape[0] and np.any(np.all(self._archive <= z, axis=1)):
-            return self._gap
-        keep = ~np.all(z <= self._archive, axis=1)
-        self._archive = np.vstack([self._archive[keep], z])
-        inside = self._archive[np.all(self._archive < 1.0, axis=1)]
-        hv = float(self._hv(inside)) if inside.shape[0] else 0.0
-        self._gap = 1.0 - hv / self._hv_front
-        return self._gap
-
     def close(self) -> None:
         """End the last run and write the IOH metadata (idempotent)."""
+        super().close()
         if self._ioh_problem is not None:
-            self._ioh_problem.reset()
             self._ioh_problem.detach_logger()
             self._ioh_problem = None
         self.logger.close()
-
-    def __enter__(self) -> IOHLogger:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()

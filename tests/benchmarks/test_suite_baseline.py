@@ -18,16 +18,17 @@ def _study(*cut):
     return cut_study(read_study(STUDY_FILE), *cut)
 
 
-def test_the_full_study_is_every_bi_family_on_the_ladder_with_seven_algorithms_and_31_seeds():
+def test_the_full_study_is_every_multi_objective_family_on_the_ladder_with_nine_algorithms_and_31_seeds():
     from pymoo_rail.suite import list_families
 
     study = _study(None, None, None, None)
-    bi = {name for name in list_families() if name.endswith("-bi")}
-    assert {p.params["family"] for p in study.problems} == bi
+    multi = {name for name in list_families() if name.endswith(("-bi", "-3obj"))}
+    assert {p.params["family"] for p in study.problems} == multi
     assert sorted({p.params["n_var"] for p in study.problems}) == [10, 30, 100, 300, 1000]
-    assert len(study.problems) == 5 * len(bi)
-    assert {a.name for a in study.algorithms} == {"nsga2", "sms-emoa", "moead", "age-moea", "moabc", "grnsga2",
-                                                  "random"}
+    assert len(study.problems) == 5 * len(multi) == 40
+    assert {a.name for a in study.algorithms} == {"nsga2", "sms-emoa", "nsga3", "ctaea", "moead", "age-moea", "moabc",
+                                                  "grnsga2", "random"}
+    assert {a.params.get("pop_size") for a in study.algorithms if a.name in ("nsga3", "ctaea")} == {100}
     assert len(study.seeds) == 31
 
 
@@ -88,3 +89,21 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
     assert len(fig.axes) == 4 and all(len(ax.get_lines()) == 2 for ax in fig.axes)
     profile = pd.DataFrame({"A": [0.5, 1.0], "B": [0.0, 1.0]}, index=pd.Index([1.0, 2.0], name="tau"))
     assert len(plot_performance_profile(profile).axes[0].get_lines()) == 2
+
+
+def test_the_profile_script_splits_a_run_and_leaves_the_thread_count(capsys):
+    import numba
+
+    from benchmarks.suite_baseline_profile import main
+
+    before = numba.get_num_threads()
+    assert main(["--ladder", "10", "--families", "generated-metro-bi", "--algorithms", "random",
+                 "--n-eval", "300", "--threads", "1"]) == 0
+    assert numba.get_num_threads() == before
+    lines = capsys.readouterr().out.splitlines()
+    run = next(line for line in lines if line.startswith("generated-metro-bi/10"))
+    values = [float(v) for v in run.split()[2:]]
+    assert len(values) == 10 and values[-2] > 0  # 8 parts, the total, ms per evaluation
+    assert values[8] == pytest.approx(sum(values[:8]), abs=6e-3)  # printed to 3 decimals
+    with pytest.raises(SystemExit, match="none of the study's"):
+        main(["--ladder", "10", "--algorithms", "no-such-algorithm"])

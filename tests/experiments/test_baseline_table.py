@@ -78,3 +78,19 @@ def test_convergence_holds_each_generation(records):
     history = convergence(records)
     assert set(history["algorithm"]) == {"nsga2", "random"}
     assert history.groupby(["algorithm", "seed"])["n_eval"].max().max() <= 200
+
+
+def test_a_3obj_record_scores_against_its_bounded_front(tmp_path, monkeypatch):
+    monkeypatch.setenv("PYMOO_RAIL_CACHE_DIR", str(tmp_path))
+    spec = problem("suite_family", family="generated-metro-3obj", n_var=10, seed=1)
+    record = {**execute_run(RunSpec(spec, algorithm("ctaea", pop_size=15), 1, Budget("n_eval", 300))),
+              "algorithm_label": "C-TAEA"}
+    instance = get_problem("generated-metro-3obj", n_var=10, seed=1)
+    bounded = instance.bounded_front()
+    scores = baseline_indicators(record)
+    assert scores["igd_plus"] > 0 and 0 < scores["hv_norm"] < 1 and scores["gap_kwh"] > -1e-6
+    inner = copy.deepcopy(record)
+    inner["front"]["F"], inner["front"]["CV"] = bounded.inner.tolist(), [0.0] * len(bounded.inner)
+    best = baseline_indicators(inner)  # the inner points: IGD+ 0, HV their share of the outer bound's
+    assert best["igd_plus"] == pytest.approx(0.0, abs=1e-9)
+    assert best["hv_norm"] == pytest.approx(bounded.hv_inner / bounded.hv_outer)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from pymoo_rail.experiments.inputs import resolve_run
-from pymoo_rail.experiments.registry import build_problem, check_parameters
+from pymoo_rail.experiments.registry import build_algorithm, build_problem, check_parameters
 from pymoo_rail.experiments.runner import execute_run
 from pymoo_rail.experiments.spec import Budget, RunSpec, StudyError, algorithm, problem
 from pymoo_rail.suite import get_problem
@@ -79,3 +79,41 @@ def test_rail_suite_refuses_a_family_and_names_the_entry_that_takes_it():
         build_problem(problem("rail_suite", suite_problem=FAMILY))
     with pytest.raises(StudyError):
         build_problem(problem("rail_suite", suite_problem=FAMILY, n_var=10, seed=7))
+
+
+@pytest.mark.parametrize("name, cls", [("nsga3", "NSGA3"), ("ctaea", "CTAEA"), ("c-taea", "CTAEA")])
+def test_reference_direction_algorithms_get_one_direction_per_member(name, cls):
+    instance = build_problem(problem("suite_family", family="generated-metro-3obj", n_var=10, seed=7))
+    spec = algorithm(name, pop_size=28)
+    check_parameters(spec, "algorithms[0]")
+    built = build_algorithm(spec, instance)
+    assert type(built).__name__ == cls and built.ref_dirs.shape == (28, 3) and built.pop_size == 28
+
+
+@pytest.mark.parametrize("params, field", [({"pop_sise": 20}, "pop_sise"), ({"pop_size": "20"}, "pop_size"),
+                                           ({"eliminate_duplicate": False}, "eliminate_duplicate")])
+def test_bad_ctaea_parameters_name_the_field(params, field):
+    with pytest.raises(StudyError, match=field):
+        check_parameters(algorithm("ctaea", **params), "algorithms[0]")
+
+
+@pytest.fixture(scope="module")
+def front_cache(tmp_path_factory):
+    """One fresh cache for the module: the 3-objective instance's inner front is computed there once."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("PYMOO_RAIL_CACHE_DIR", str(tmp_path_factory.mktemp("fronts")))
+    yield
+    mp.undo()
+
+
+@pytest.mark.parametrize("name", ["nsga3", "ctaea"])
+def test_a_tiny_study_runs_nsga3_and_ctaea_on_a_constrained_3obj_instance(front_cache, name):
+    spec = problem("suite_family", family="generated-metro-3obj", n_var=10, seed=1)
+    record = execute_run(RunSpec(spec, algorithm(name, pop_size=15), 2, Budget("n_eval", 150)))
+    # the budget is counted in evaluations, one generation of pop_size offspring at a time
+    assert 150 <= record["n_eval"] <= 150 + 15 and record["n_obj"] == 3
+    instance = get_problem("generated-metro-3obj", n_var=10, seed=1)
+    X, F = np.asarray(record["front"]["X"]), np.asarray(record["front"]["F"])
+    np.testing.assert_allclose(instance.evaluate(X, return_values_of=["F"]), F, rtol=1e-12)  # searched unpenalised
+    again = execute_run(RunSpec(spec, algorithm(name, pop_size=15), 2, Budget("n_eval", 150)))
+    np.testing.assert_array_equal(np.asarray(again["front"]["F"]), F)  # same seed, same front

@@ -24,8 +24,8 @@ PINNED = {
 
 def test_families_and_problems_are_distinct_names():
     families = list_families()
-    assert len(families) == 10 and len(set(families)) == 10
-    assert {f.rsplit("-", 1)[1] for f in families} == {"bi", "single", "trip"}
+    assert len(families) == 14 and len(set(families)) == 14
+    assert {f.rsplit("-", 1)[1] for f in families} == {"bi", "single", "trip", "3obj"}
     assert not set(families) & set(list_problems())
     assert get_problem("metro-a-bi").suite_name == "metro-a-bi"  # the named problems still answer
 

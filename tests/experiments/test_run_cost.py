@@ -1,0 +1,26 @@
+"""Where a study run's CPU goes: the parts add up, the kernel is among them, and nothing stays patched."""
+
+import pymoo.core.problem
+import pymoo.optimize
+
+from pymoo_rail.experiments import runner
+from pymoo_rail.experiments.run_cost import PARTS, cpu_breakdown
+from pymoo_rail.experiments.spec import Budget, RunSpec, algorithm, problem
+from pymoo_rail.sim import Simulator
+
+
+def test_the_parts_of_a_run_add_up_and_the_patches_are_undone():
+    originals = (Simulator.run_batch, pymoo.core.problem.Problem.evaluate, pymoo.optimize.minimize,
+                 runner.build_problem, runner.convergence_point)
+    run = RunSpec(problem("suite_family", family="generated-metro-bi", n_var=10, seed=1),
+                  algorithm("nsga2", pop_size=20), 1, Budget("n_eval", 200))
+    parts, record = cpu_breakdown(run)
+    assert set(parts) == {*PARTS, "total", "n_eval"} and parts["n_eval"] == 200
+    assert all(parts[p] >= 0 for p in PARTS)
+    assert parts["total"] == sum(parts[p] for p in PARTS)
+    assert parts["kernel"] > 0 and parts["pymoo"] > 0  # 200 evaluations went through both
+    assert (Simulator.run_batch, pymoo.core.problem.Problem.evaluate, pymoo.optimize.minimize,
+            runner.build_problem, runner.convergence_point) == originals
+    # the record of the timed run is the record of an untimed one
+    untimed = runner.execute_run(run)
+    assert record["front"] == untimed["front"] and record["history"] == untimed["history"]
