@@ -553,7 +553,7 @@ def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
 @inlined
 def _kind_cell(m, first_cell, p_type):
     """Kind ``t`` of a table loop's ``prange`` index, its first cell ``i`` and the envelope's ``u`` at both ends."""
-    t = np.int64(p_type)  # prange counts in uint64: the int64 index of every other caller
+    t = np.int64(p_type)  # callers pass np.int64(p_type): prange counts in uint64 (one compiled copy)
     i = first_cell[t]
     return t, i, m.envelope_ms[i] ** 2, m.envelope_ms[i + 1] ** 2
 
@@ -567,7 +567,7 @@ def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, counting, coun
     k_max = n_speeds - 1
     aux = m.aux_power_w
     for p_type in prange(first_cell.shape[0]):
-        t, i, top0, top1 = _kind_cell(m, first_cell, p_type)
+        t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
             tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
@@ -928,7 +928,7 @@ def part_power_outcome(m, v0, cell, share):
 def _fill_part_power(m, n_speeds, bias, first_cell, shares, pp_u1, pp_e, pp_dt):
     k_max = n_speeds - 1
     for p_type in prange(first_cell.shape[0]):
-        t, i, top0, top1 = _kind_cell(m, first_cell, p_type)
+        t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
             for c in range(shares.shape[0]):
