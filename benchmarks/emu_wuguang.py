@@ -21,10 +21,9 @@ from pymoo_rail.atomic import atomic_write_text
 from pymoo_rail.cases import load_case
 from pymoo_rail.experiments import (Study, algorithm, build_problem, load_results, problem, run_study,
                                     stats, tang2020_nsga2)
-from pymoo_rail.experiments.front_table import exact_energy_kwh, front_statistics, most_punctual
-from pymoo_rail.experiments.metrics import gd_van_veldhuizen
+from pymoo_rail.experiments.front_table import exact_energy_kwh, exact_front_table, front_rows, most_punctual
 from pymoo_rail.experiments.report import fill_template, markdown_rows, mean_std, significant, write_report
-from pymoo_rail.experiments.verify import check_members, check_rows, worst_checks
+from pymoo_rail.experiments.verify import check_rows, worst_checks
 from pymoo_rail.optimal.reference import exact_points
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -78,27 +77,6 @@ def exact_front(path: Path, profile_path: Path):
 
     redo = [] if profile_path.exists() else [case.planned_time_s]
     return exact_points(case, EXACT_TIMES_S, path, n_speeds=EXACT_N_SPEEDS, redo_s=redo, on_run=keep_profile)
-
-
-def analyse(results, problems: dict, exact=None):
-    """One dict per run: indicators against the union front, extent, gaps to ``exact``, checks of every member."""
-    results = stats.add_reference_indicators(results)
-    refs = stats.reference_fronts(results)
-    rows = []
-    for _, run in results.iterrows():
-        feasible = run["CV"] <= 0
-        F, X = run["F"][feasible], run["X"][feasible]
-        row = {"problem": run["problem"], "algorithm": run["algorithm"], "seed": int(run["seed"]),
-               "n_eval": int(run["n_eval"]), "n_gen": int(run["n_gen"]), "wall_time_s": float(run["wall_time_s"]),
-               "cpu_time_s": float(run.get("cpu_time_s", np.nan)), "n_points": len(F),
-               "n_infeasible": int((~feasible).sum()), "hv_ref": run["hv_ref"], "igd_ref": run["igd_ref"],
-               "gd_ref": run["gd_ref"], "gd_seed": gd_van_veldhuizen(F, refs[run["problem"]]) if len(F) else np.nan,
-               "spacing": run.get("spacing", np.nan)}
-        if len(F):
-            row.update(front_statistics(F, problems[run["problem"]].case.planned_time_s, exact))
-            row.update(check_members(problems[run["problem"]], X, F[:, 0], F[:, 1]))
-        rows.append(row)
-    return results, rows
 
 
 def pair(rows, enc: str, key: str):
@@ -181,18 +159,6 @@ def table5(encodings, chosen, rows, exact) -> str:
     return markdown_rows(["encoding", "algorithm", "run (seed)", "energy (kWh)", "running time (s)",
                           "exact optimum at that time (kWh)", "traction / regen (kWh)", "all runs: energy (kWh)",
                           "all runs: time (s)", "all runs: least E with T <= 1050 s", "seed 003 table 5"], cells)
-
-
-def exact_table(ex) -> str:
-    """Section 5: the exact front, one row per requested time."""
-    if ex is None:
-        return "(not computed: `--no-exact`)"
-    return markdown_rows(["requested (s)", "running time (s)", "net energy (kWh)", "traction / regen (kWh)",
-                          "lambda (kWh/s)", "neutral traction (J)", "limit excess (m/s)", "stop error (m)", "solve (s)"],
-                         [[f"{r.requested_time_s:g}", f"{r.running_time_s:.2f}", f"{r.energy_kwh:.2f}",
-                           f"{r.traction_kwh:.1f} / {r.regen_kwh:.1f}", f"{r.lambda_kwh_per_s:.3f}",
-                           significant(r.neutral_traction_j), significant(r.limit_excess_ms), significant(r.stop_error_m),
-                           f"{r.solve_s:.0f}"] for r in ex.itertuples()])
 
 
 def verdict_text(rows) -> str:
@@ -296,7 +262,8 @@ def report_values(rows, enc_rows, chosen, problems, exact, args) -> dict:
         "table4": "\n\n".join(table4(rows, e) for e in encodings),
         "tests": "\n\n".join(tests_table(rows, e) for e in encodings), "table5": table5(encodings, chosen, rows, exact),
         "n_speeds": int(exact["n_speeds"].iloc[0]) if exact is not None else EXACT_N_SPEEDS,
-        "exact_table": exact_table(exact), "n_members": ver["n_members"], "n_runs": ver["n_runs"],
+        "exact_table": exact_front_table(exact) if exact is not None else "(not computed: `--no-exact`)",
+        "n_members": ver["n_members"], "n_runs": ver["n_runs"],
         "train_length_m": f"{case.train.length_m:g}",
         "verification_table": markdown_rows(["check", "worst value over all members", "required", "result"],
                                             check_rows(ver, significant)),
@@ -337,8 +304,8 @@ def main(argv=None) -> int:
     exact = None if args.no_exact else exact_front(args.out / "emu_wuguang_optimal.csv", args.work / "optimal_profile.csv")
     exact_profile = None if args.no_exact else pd.read_csv(args.work / "optimal_profile.csv")
     problems = {p.display: build_problem(p) for p in make_study("all", ENCODINGS, [1], 1).problems}
-    main_results, rows = analyse(results["main"], problems, exact)
-    enc_rows = analyse(results["encodings"], problems, exact)[1] if len(results.get("encodings", ())) else []
+    main_results, rows = front_rows(results["main"], problems, exact)
+    enc_rows = front_rows(results["encodings"], problems, exact)[1] if len(results.get("encodings", ())) else []
     chosen = punctual_choices(main_results, rows, problems)
     case = problems[MAIN_ENCODING].case
     front_figures(main_results, chosen, case.planned_time_s, exact, args.out)

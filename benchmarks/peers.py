@@ -21,7 +21,8 @@ running times, with differences in % of traction energy, CPU ratios and every ce
 (resumable), and a run with ``--intervals 300 2000 --cache FILE.csv`` reads N=2000 from it (NaN where missing)
 while running N=300 side by side; ``--refresh`` rewrites the report from its CSV with the cache read again.
 (``--quick``: only the two intercity cases; ``--breakdown``: also where pymoo-rail's CPU time goes, per
-Numba kernel of the exact solver, from a second run under cProfile). Writes ``benchmarks/reports/peers.md``.
+Numba kernel of the exact solver, from a second run under cProfile; ``--sweep-cpu SEED FACTOR``: only one DP sweep
+and forward run on a generated line, with and without the singular speeds). Writes ``benchmarks/reports/peers.md``.
 """
 
 
@@ -41,6 +42,7 @@ from pymoo_rail.experiments.peers import (
     named_rows,
     refresh_cached,
     speed_ratios,
+    sweep_cpu,
     warm_up,
 )
 from pymoo_rail.experiments.report import fill_template, markdown, write_filled, write_report
@@ -117,7 +119,12 @@ def main() -> None:
     parser.add_argument("--mseetc-only", action="store_true", help="only fill --cache with ms-eetc's answers")
     parser.add_argument("--refresh", action="store_true",
                         help="rewrite the report from its CSV (an earlier run), reading --cache again")
+    parser.add_argument("--sweep-cpu", type=float, nargs=2, metavar=("SEED", "FACTOR"),
+                        help="only: CPU of one DP sweep and forward run with and without the singular speeds")
     args = parser.parse_args()
+    if args.sweep_cpu:
+        print("\n".join(sweep_cpu(int(args.sweep_cpu[0]), args.sweep_cpu[1], repeats=3)))
+        return
     if args.mseetc_only:
         seeds = args.seeds if args.seeds else range(args.first_seed, args.first_seed + args.generated)
         mseetc_only(seeds, args.mseetc, args.mseetc_python, tuple(args.intervals), args.cache[0])

@@ -12,9 +12,15 @@ Usage::
     nice python benchmarks/suite_baseline.py --workers 2                          # the whole table
     nice python benchmarks/suite_baseline.py --families generated-metro-bi --ladder 10 30 --seeds 5 --n-eval 2000
     python benchmarks/suite_baseline.py --report-only --archive out/suite_baseline.tar.gz
+    nice python benchmarks/suite_baseline.py --profile                            # n_var 300 and 1000, every family
+    nice python benchmarks/suite_baseline.py --profile --ladder 1000 --families generated-metro-bi --n-eval 2000
 
 ``--ladder``, ``--seeds``, ``--families`` and ``--n-eval`` reduce the study (the report says so);
 ``--archive PATH`` packs the study file and raw records into one .tar.gz and prints its SHA-256.
+``--profile`` stores nothing: it runs seed 1 (default ``--ladder 300 1000``) in this process with
+``--threads`` Numba threads (default 1, as each worker of the pool) and prints where each run's CPU
+goes (``pymoo_rail.experiments.run_cost.cpu_profile``: kernel, problem, pymoo, history indicators,
+record, report indicators) and per algorithm the shares over all runs printed.
 """
 
 from __future__ import annotations
@@ -31,6 +37,7 @@ from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseli
                                              indicator_frame, performance_profile, projected_cpu_h)
 from pymoo_rail.experiments.report import write_filled
 from pymoo_rail.experiments.results import load_records
+from pymoo_rail.experiments.run_cost import PARTS, cpu_profile, cpu_shares
 from pymoo_rail.experiments.stats import to_markdown
 from pymoo_rail.plotting import plot_cell_convergence, plot_performance_profile
 
@@ -65,6 +72,28 @@ def report_values(study, frame, pictures, command: str) -> dict:
             "table": to_markdown(table, bold_marker=None), "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
 
 
+def profile(study, algorithms, threads: int) -> int:
+    """Print the CPU of each part of each run of ``study`` (of ``algorithms``), then each algorithm's shares."""
+    runs = [r for r in study.runs() if not algorithms or r.algorithm.display in algorithms]
+    if not runs:
+        raise SystemExit(f"--algorithms {algorithms}: none of the study's")
+    previous, rows = numba.get_num_threads(), []
+    numba.set_num_threads(threads)
+    try:
+        print(f"{'problem':28s} {'algorithm':11s} " + " ".join(f"{p:>8s}" for p in PARTS) + "    total  ms/eval")
+        for row in cpu_profile(runs):
+            print(f"{row['instance']:28s} {row['algorithm']:11s} " + " ".join(f"{row[p]:8.3f}" for p in PARTS)
+                  + f" {row['total']:8.2f} {row['ms_per_eval']:8.3f}", flush=True)
+            rows.append(row)
+    finally:
+        numba.set_num_threads(previous)
+    print("\nshare of each part in the CPU of the runs above, per algorithm (%)")
+    print(f"{'algorithm':11s} " + " ".join(f"{p:>8s}" for p in PARTS) + "  ms/eval")
+    for name, share in cpu_shares(rows).iterrows():
+        print(f"{name:11s} " + " ".join(f"{share[p]:8.1f}" for p in PARTS) + f" {share['ms_per_eval']:8.3f}")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--families", nargs="+", default=None, help="families of the study file (default: all)")
@@ -79,8 +108,14 @@ def main(argv=None) -> int:
     parser.add_argument("--archive", type=Path, default=None, help="pack the raw records into this .tar.gz")
     parser.add_argument("--estimate", action="store_true",
                         help="print the whole study's CPU time projected from the stored runs' CPU per evaluation")
+    parser.add_argument("--profile", action="store_true", help="print where each run's CPU goes (seed 1)")
+    parser.add_argument("--algorithms", nargs="+", default=None, help="algorithm labels (--profile; default: all)")
+    parser.add_argument("--threads", type=int, default=1, help="Numba threads (--profile; default 1)")
     args = parser.parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")
+    if args.profile:
+        return profile(cut_study(read_study(STUDY_FILE), args.families, args.ladder or [300, 1000], 1, args.n_eval),
+                       args.algorithms, args.threads)
     study = cut_study(read_study(STUDY_FILE), args.families, args.ladder, args.seeds, args.n_eval)
     if not args.report_only:
         run_study(study, args.work, workers=args.workers, scheduler="local" if args.dask else None, seed_major=True)
@@ -104,6 +139,6 @@ def main(argv=None) -> int:
 if __name__ == "__main__":
     # runs made in this process (--workers 1) get one Numba thread, as each worker of the pool has:
     # the kernel's second thread saves little wall time and its spin-waits count as CPU of the run
-    # (twice the kernel's CPU, ten times the history's, measured by suite_baseline_profile.py)
+    # (twice the kernel's CPU, ten times the history's, measured by --profile)
     numba.set_num_threads(1)
     raise SystemExit(main())

@@ -19,7 +19,8 @@ import pandas as pd
 
 from pymoo_rail.cases import load_case
 from pymoo_rail.control import Hysteresis, track
-from pymoo_rail.experiments import Study, algorithm, load_results, problem, punctual_member, run_study
+from pymoo_rail.experiments import Study, algorithm, load_results, problem, run_study
+from pymoo_rail.experiments.front_table import punctual_choice
 from pymoo_rail.experiments.report import fill_template, fixed, lower_priority, markdown_rows, write_report
 from pymoo_rail.experiments.stats import nondominated, rank_sum
 from pymoo_rail.optimal import optimal_profile
@@ -64,31 +65,9 @@ def load(out: Path, seeds, tolerance_s: float = TOLERANCE_S, n_equal=N_EQUAL) ->
             for name, study in build_studies(seeds, tolerance_s, n_equal).items()}
 
 
-def choose(row, planned_s: float, tolerance_s: float) -> dict:
-    """A run's recommended solution: the least-energy feasible member with |T - T_plan| <= tolerance
-    (``experiments.punctual_member``), and the extent of its final set."""
-    ex, F = row["extras"], np.asarray(row["F"], dtype=float)
-    energy, time_s = np.asarray(ex["energy_kwh"], dtype=float), np.asarray(ex["running_time_s"], dtype=float)
-    CV = np.asarray(row["CV"], dtype=float).reshape(-1)
-    feasible, window_s = CV <= 0.0, tolerance_s + 1e-9
-    out = {"algorithm": row["algorithm"], "partition": row["problem"], "seed": int(row["seed"]),
-           "n_eval": int(row["n_eval"]), "wall_time_s": float(row["wall_time_s"]), "n_front": int(len(F)),
-           "n_feasible": int(feasible.sum()),
-           "n_within": int((feasible & (np.abs(time_s - planned_s) <= window_s)).sum())}
-    if F.shape[1] >= 2 and feasible.any():
-        err = np.abs(time_s[feasible] - planned_s)
-        out.update(front_time_error_min_s=float(err.min()), front_time_error_max_s=float(err.max()),
-                   front_energy_min_kwh=float(energy[feasible].min()), front_energy_max_kwh=float(energy[feasible].max()))
-    i = punctual_member(time_s, energy, planned_s, window_s, CV)
-    out.update(energy_kwh=np.nan, running_time_s=np.nan, stop_error_m=np.nan, x=None) if i is None else out.update(
-        energy_kwh=float(energy[i]), running_time_s=float(time_s[i]), stop_error_m=float(ex["stop_error_m"][i]),
-        x=[float(v) for v in np.asarray(row["X"], dtype=float)[i]])
-    return out
-
-
 def choices(results: dict, planned_s: float, tolerance_s: float) -> pd.DataFrame:
     """One chosen solution per run, non-equal partition first, then the equal ones by size."""
-    df = pd.DataFrame([choose(r, planned_s, tolerance_s) for d in results.values() for _, r in d.iterrows()])
+    df = pd.DataFrame([punctual_choice(r, planned_s, tolerance_s) for d in results.values() for _, r in d.iterrows()])
     df["time_error_s"] = (df["running_time_s"] - planned_s).abs()
     order = df["partition"].map(lambda p: 0 if p == NON_EQUAL else int(p.split("-")[1]))
     return df.assign(order=order).sort_values(["algorithm", "order", "seed"]).drop(columns="order").reset_index(drop=True)

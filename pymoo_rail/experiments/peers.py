@@ -199,8 +199,8 @@ def pymoo_rail_row(name: str, running_time_s: float) -> dict:
 def cpu_breakdown(name: str, running_time_s: float) -> dict:
     """CPU seconds of one profile (as timed by :func:`pymoo_rail_row`) per kernel of the exact solver.
 
-    cProfile in ``time.process_time``: tables (``_fill_transitions``: its counting and filling passes, default
-    and half grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
+    cProfile in ``time.process_time``: tables (``_count_targets`` + ``_fill_transitions``, default and
+    half grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
     """
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import OptimalSolver
@@ -211,16 +211,59 @@ def cpu_breakdown(name: str, running_time_s: float) -> dict:
     OptimalSolver(case).profile(running_time_s)
     profiler.disable()
     stats = pstats.Stats(profiler).stats  # (file, line, function) -> (calls, ..., own time, cumulative time, ...)
-    own = {name: [0, 0.0] for name in ("_fill_transitions", "backward_sweep", "forward_rollout")}
+    own = {name: [0, 0.0] for name in ("_count_targets", "_fill_transitions", "backward_sweep", "forward_rollout")}
     for (path, _, function), (_, calls, tottime, _, _) in stats.items():
         if path.endswith("dp.py") and function in own:
             own[function][0] += calls
             own[function][1] += tottime
     total = sum(v[2] for v in stats.values())
-    tables = own["_fill_transitions"][1]
+    tables = own["_count_targets"][1] + own["_fill_transitions"][1]
     sweeps, runs = own["backward_sweep"], own["forward_rollout"]
     return {"case": case.name, "cpu_s": total, "tables_s": tables, "sweeps": sweeps[0], "sweeps_s": sweeps[1],
             "forward_runs": runs[0], "forward_runs_s": runs[1], "rest_s": total - tables - sweeps[1] - runs[1]}
+
+
+def best_cpu_s(call, repeats: int) -> float:
+    """The least CPU time (``time.process_time``) of ``repeats`` calls of ``call()`` (s)."""
+    times = []
+    for _ in range(repeats):
+        start = time.process_time()
+        call()
+        times.append(time.process_time() - start)
+    return min(times)
+
+
+def sweep_cpu(seed: int, factor: float, repeats: int = 5) -> list[str]:
+    """CPU time of one backward sweep and one forward run of the exact solver, as report lines.
+
+    On ``comparable_case(seed)`` at the price of time of its optimum at ``factor`` x the minimum running
+    time, each the best of ``repeats``, with the singular speeds as states and with the speed grid alone
+    (``OptimalSolver(singular=False)``), alternated twice.
+    """
+    from pymoo_rail.optimal import OptimalSolver, dp, min_running_time
+
+    case = comparable_case(seed)
+    solver = OptimalSolver(case, certify=False)
+    lambda_w = solver.profile(factor * min_running_time(case)).summary["lambda_w"]
+    model, tables, n_speeds, bias = solver.simulator.model, solver.transition_tables(), solver.n_speeds, solver.top_bias
+    n = model.position_m.shape[0]
+    prices, floor_k = np.full(n - 1, lambda_w), np.zeros(n, dtype=np.int64)
+    sing_v, sing_p, sing_val, value = np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2)), np.empty((n, n_speeds))
+    terminal_j = dp.terminal_cost(model, n_speeds, bias, solver.end_speed_ms[0])
+    lines = [f"{case.name}: {n - 1} cells, {tables[0].shape[0]} kinds of cell, {n_speeds} speed nodes, lambda "
+             f"{lambda_w:.0f} W (load average {os.getloadavg()[0]:.1f})"]
+    for singular in (True, False, True, False):
+        if singular:
+            dp.singular_speeds(model, prices + model.aux_power_w, n_speeds, bias, sing_v, sing_p)
+        else:
+            sing_v[:], sing_p[:] = 0.0, -1.0
+        sweep_s = best_cpu_s(lambda: dp.backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v,
+                                                       sing_p, sing_val, solver.max_targets, bias), repeats)
+        run_s = best_cpu_s(lambda: dp.forward_run(model, prices + model.aux_power_w, value, solver.max_targets, bias,
+                                                  solver.tie_j, sing_v, sing_p, sing_val), repeats)
+        lines.append(f"singular speeds {'on ' if singular else 'off'}: backward sweep {sweep_s * 1e3:.1f} ms, "
+                     f"forward run {run_s * 1e3:.1f} ms")
+    return lines
 
 
 def speed_ratios(ours: pd.DataFrame, theirs: pd.DataFrame) -> pd.DataFrame:

@@ -14,7 +14,8 @@ around its parts (each the CPU time of this process inside the part, nested part
   (:func:`pymoo_rail.experiments.baseline.baseline_indicators`), computed when the report is written.
 
 The timers wrap the parts by patching them for the duration of the call (restored after); the
-results are those of an unpatched run.
+results are those of an unpatched run. :func:`cpu_profile` splits a list of runs, :func:`cpu_shares`
+sums its rows into each algorithm's shares (``python benchmarks/suite_baseline.py --profile``).
 """
 
 from __future__ import annotations
@@ -22,7 +23,12 @@ from __future__ import annotations
 import tempfile
 import time
 from contextlib import ExitStack, contextmanager
-from typing import Any, Callable
+from dataclasses import replace
+from typing import Any, Callable, Iterable, Iterator
+
+import pandas as pd
+
+from pymoo_rail.experiments.spec import Budget
 
 PARTS = ("setup", "kernel", "problem", "history", "pymoo", "final", "write", "report")
 """The parts of a run's CPU time, in the order a run meets them."""
@@ -91,3 +97,39 @@ def cpu_breakdown(run) -> tuple[dict[str, float], dict]:
     parts["total"] = sum(parts.values())
     parts["n_eval"] = float(record["n_eval"])
     return parts, record
+
+
+def cpu_profile(runs: Iterable, warm_n_eval: int = 200) -> Iterator[dict]:
+    """Split each run's CPU (:func:`cpu_breakdown`), one row per run, yielded as each run ends.
+
+    A short first run of each algorithm (``warm_n_eval`` evaluations, not yielded) loads the compiled
+    kernels and the fronts and pays one-time compilations (pymoo's AGE-MOEA compiles its Numba
+    functions in every process), so the rows hold what every later run of the process pays.
+
+    Yields
+    ------
+    dict
+        ``instance`` (the problem's display name: ``problem`` is a part) and ``algorithm``, the CPU
+        seconds of each part (:data:`PARTS`), ``total``, ``n_eval`` and ``ms_per_eval`` (milliseconds of CPU per evaluation).
+    """
+    runs = list(runs)
+    warmed: set[str] = set()
+    for run in runs:
+        if run.algorithm.display not in warmed:
+            cpu_breakdown(replace(run, budget=Budget("n_eval", warm_n_eval)))
+            warmed.add(run.algorithm.display)
+    for run in runs:
+        parts, _ = cpu_breakdown(run)
+        yield {"instance": run.problem.display, "algorithm": run.algorithm.display, **parts,
+               "ms_per_eval": 1000 * parts["total"] / parts["n_eval"]}
+
+
+def cpu_shares(rows: Iterable[dict]) -> pd.DataFrame:
+    """Each algorithm's share (%) of each part in the CPU of its rows of :func:`cpu_profile`, and its ``ms_per_eval``.
+
+    One row per algorithm, in the order they first appear; columns :data:`PARTS` and ``ms_per_eval``.
+    """
+    sums = pd.DataFrame(list(rows)).groupby("algorithm", sort=False)[[*PARTS, "total", "n_eval"]].sum()
+    shares = 100 * sums[list(PARTS)].div(sums["total"], axis=0)
+    shares["ms_per_eval"] = 1000 * sums["total"] / sums["n_eval"]
+    return shares

@@ -238,6 +238,17 @@ def interp_aug(v_next, p, sing_p, sing_val):
     return lv + (p - lp) / (rp - lp) * (rv - lv)
 
 
+@inlined
+def interp_split(v_next, p, split, sing_p, sing_val):
+    """:func:`interp_aug` where ``split[k]`` says whether a singular speed lies inside the interval
+    ``(k, k + 1)`` of the speed nodes: the others take :func:`interp_at`, the same arithmetic without
+    the search for one: ``benchmarks/peers.py --sweep-cpu``, a sweep of generated seed 21 35 -> 27 ms).
+    The sweep passes its float32 positions as float64 (exact): one compiled copy of the interpolations."""
+    if p >= 0.0 and not split[int(p)]:
+        return interp_at(v_next, p)
+    return interp_aug(v_next, p, sing_p, sing_val)
+
+
 @njit(cache=True, no_cfunc_wrapper=True)
 def interp_value(v_next, top_u, u, bias):
     """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
@@ -413,21 +424,6 @@ def place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p):
             sing_p[i, s] = p
 
 
-@inlined
-def control_cost(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w, time_price_w,
-                 v_next, top_u, bias, sing_p, sing_val):
-    """Cell cost plus interpolated cost-to-go of one control from ``v0`` (:func:`cell_outcome`, :func:`cell_cost`).
-
-    Infinite when the train stops inside the cell; the cost-to-go ``v_next`` is spread over
-    ``[0, top_u]``, with the next position's singular speeds as further nodes (:func:`interp_aug`).
-    """
-    u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-    cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
-    if cost < INF:
-        cost += interp_aug(v_next, value_position(top_u, u1, v_next.shape[0] - 1, bias), sing_p, sing_val)
-    return cost
-
-
 # traction, coast, brake, hold. Holding is ``hold_brake``: where coasting decelerates it is ``hold``
 # (partial traction), and where coasting accelerates ``hold`` would only coast, which the coast
 # control already is, while ``hold_brake`` holds the speed by partial (regenerative-first) braking.
@@ -473,55 +469,94 @@ def _n_targets(k_lo, k_hi, max_targets):
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def best_control(m, cell, v0, time_price_w, v_next, max_targets, bias, sing_v, sing_p, sing_val):
-    """The control of one cell from speed ``v0`` minimising cell cost + interpolated cost-to-go.
+def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
+    """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
 
-    ``sing_v``, ``sing_p``, ``sing_val`` are the next position's singular speeds, their node
-    indices and cost-to-go (:func:`singular_speeds`): further nodes of the cost-to-go and further
-    ``toward`` targets, so that a run lands on them and holds them exactly.
-    Returns ``(total_cost, mode, target_ms)``; ``total_cost`` is at least ``PENALTY_J`` when no
-    control can reach the platform.
+    ``table`` is ``(modes, targets, positions, energies, times, u1)``, arrays of at least
+    ``N_FIXED + sing_v.shape[0] + max_targets`` entries: per control its mode and target speed, the
+    node position it reaches among the next position's ``k_max + 1`` speed nodes
+    (:func:`value_position`; -1 where the train stops in the cell), its net energy without the price
+    of time (infinite where it stops), its time and the ``u = v^2`` it reaches (the simulator's
+    ``cell_outcome`` and ``cell_cost``). The controls: the fixed ones, entries ``0 .. N_FIXED - 1``
+    in the order of :func:`_fixed_mode` (holding, the last, needs a speed to hold), ``toward`` each
+    of the next position's singular speeds ``sing_v`` in reach (where ``sing_p`` >= 0: landing on
+    them and holding them exactly), and ``toward`` speed nodes of the next position in reach by
+    partial traction (or braking). They depend on the kind of the cell (:func:`cell_types`),
+    ``v0`` and the next position's singular speeds, not on the price of time or the cost-to-go.
     """
+    modes, targets, pos, energy, dt, u1s = table
     top_u = m.envelope_ms[cell + 1] ** 2
-    k_max = v_next.shape[0] - 1
     tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
     co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
     br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
-    best = INF
-    best_mode = MODE_COAST
-    best_target = 0.0
     n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
-    for c in range(n_fixed):
-        mode = _fixed_mode(c)
-        cost = control_cost(m, v0, cell, mode, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                            time_price_w, v_next, top_u, bias, sing_p, sing_val)
-        if cost < best:
-            best = cost
-            best_mode = mode
-            best_target = 0.0
-    for s in range(sing_v.shape[0]):  # land exactly on a singular speed (holding it, from it)
-        if sing_p[s] < 0.0:
-            continue
-        target = sing_v[s]
-        cost = control_cost(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                            br_u, br_f, br_w, time_price_w, v_next, top_u, bias, sing_p, sing_val)
-        if cost < best:
-            best = cost
-            best_mode = MODE_TOWARD
-            best_target = target
-    # partial traction (or braking) landing exactly on a speed node of the next position
+    n_sing = sing_v.shape[0]
+    k_lo, stride, n_nodes = 1, 1, 0
     if top_u > 0.0 and k_max > 0:
         k_lo, k_hi = _target_range(top_u, k_max, v0 * v0, tr_u, co_u, bias)
-        stride = _n_targets(k_lo, k_hi, max_targets)[1]
-        for k in range(k_lo, k_hi + 1, stride):
-            target = math.sqrt(node_u(top_u, k, k_max, bias))
-            cost = control_cost(m, v0, cell, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                br_u, br_f, br_w, time_price_w, v_next, top_u, bias, sing_p, sing_val)
-            if cost < best:
-                best = cost
-                best_mode = MODE_TOWARD
-                best_target = target
-    return best, best_mode, best_target
+        n_nodes, stride = _n_targets(k_lo, k_hi, max_targets)
+    p = 0
+    for c in range(n_fixed + n_sing + n_nodes):
+        if c < n_fixed:
+            mode = _fixed_mode(c)
+            target = 0.0
+        elif c < n_fixed + n_sing:
+            mode = MODE_TOWARD
+            target = sing_v[c - n_fixed]
+            if sing_p[c - n_fixed] < 0.0:
+                continue
+            # out of reach (``cell_outcome``'s rule): ``toward`` is the traction or coast step, entries already
+            if (tr_u <= target * target) if v0 < target else (co_u >= target * target):
+                continue
+        else:  # partial traction (or braking) landing exactly on a speed node of the next position
+            mode = MODE_TOWARD
+            target = math.sqrt(node_u(top_u, k_lo + (c - n_fixed - n_sing) * stride, k_max, bias))
+        u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
+        # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost`` does
+        e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
+        modes[p] = mode
+        targets[p] = target
+        u1s[p] = u1
+        energy[p] = e
+        dt[p] = d
+        pos[p] = value_position(top_u, u1, k_max, bias) if e < INF else -1.0
+        p += 1
+    return p
+
+
+@inlined
+def entry_cost(table, p, time_price_w, v_next, sing_p, sing_val):
+    """Cost of entry ``p`` of a control table (:func:`control_table`) plus the cost-to-go it reaches.
+
+    The cell priced as ``cell_cost`` prices it, then the cost-to-go interpolated in ``v_next`` with the
+    next position's singular speeds as further nodes (:func:`interp_aug`); infinite where the train
+    stops in the cell.
+    """
+    e = table[3][p]
+    if e < INF:
+        cost = e + time_price_w * table[4][p]
+        cost += interp_aug(v_next, table[2][p], sing_p, sing_val)
+        return cost
+    return INF
+
+
+@inlined
+def table_minimum(table, n_entries, time_price_w, v_next, sing_p, sing_val):
+    """The entry of a control table (:func:`control_table`) of least :func:`entry_cost`, and that cost:
+    ``(cost, entry)``, entry -1 (cost infinite) if every control stops in the cell; the first of equals.
+
+    ``sing_p``, ``sing_val``: the next position's singular speeds (:func:`singular_speeds`), further
+    nodes of the cost-to-go (and, in the table, further ``toward`` targets: a run lands on them and
+    holds them exactly). A cost at least ``PENALTY_J``: no control can reach the platform.
+    """
+    best = INF
+    best_p = -1
+    for p in range(n_entries):
+        cost = entry_cost(table, p, time_price_w, v_next, sing_p, sing_val)
+        if cost < best:
+            best = cost
+            best_p = p
+    return best, best_p
 
 
 def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
@@ -559,11 +594,24 @@ def _kind_cell(m, first_cell, p_type):
 
 
 @njit(cache=True, no_cfunc_wrapper=True, parallel=True)
-def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, counting, counts, offsets, fixed_u1, fixed_e,
-                      fixed_dt, tgt_u1, tgt_e, tgt_dt):
-    """Both passes of :func:`transitions`: with ``counting``, only the number of partial-traction targets
-    of each state into ``counts`` (to size the flat tables); then the tables. One parallel kernel for
-    both: a second one cost about 1 s of the first run's compile."""
+def _count_targets(m, n_speeds, max_targets, bias, first_cell, counts):
+    k_max = n_speeds - 1
+    for p_type in prange(first_cell.shape[0]):
+        t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
+        for j in range(n_speeds):
+            counts[t * n_speeds + j] = 0
+            if top1 <= 0.0:
+                continue
+            v0 = math.sqrt(node_u(top0, j, k_max, bias))
+            tr_u = full_step(m, v0, i, KIND_TRACTION)[0]
+            co_u = full_step(m, v0, i, KIND_COAST)[0]
+            k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
+            counts[t * n_speeds + j] = _n_targets(k_lo, k_hi, max_targets)[0]
+
+
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
+def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, fixed_u1, fixed_e, fixed_dt, tgt_u1, tgt_e,
+                      tgt_dt):
     k_max = n_speeds - 1
     aux = m.aux_power_w
     for p_type in prange(first_cell.shape[0]):
@@ -572,12 +620,6 @@ def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, counting, coun
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
             tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
             co_u, co_f, co_w, _ = full_step(m, v0, i, KIND_COAST)
-            if counting:
-                counts[t * n_speeds + j] = 0
-                if top1 > 0.0:
-                    k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
-                    counts[t * n_speeds + j] = _n_targets(k_lo, k_hi, max_targets)[0]
-                continue
             br_u, br_f, br_w, _ = full_step(m, v0, i, KIND_BRAKE)
             for c in range(N_FIXED):
                 u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
@@ -624,15 +666,14 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
         cell_type = first_cell = np.arange(m.position_m.shape[0] - 1, dtype=np.int64)
     n_types = first_cell.shape[0]
     counts = np.zeros(n_types * n_speeds, dtype=np.int64)
+    _count_targets(m, n_speeds, max_targets, bias, first_cell, counts)
     offsets = np.zeros(counts.shape[0] + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
     # single precision halves the memory; the tables only shape the cost-to-go (an error of 1e-7
     # of a node spacing or of a cell's energy), the forward run recomputes every step exactly
     fixed = [np.empty((n_types, n_speeds, N_FIXED), dtype=np.float32) for _ in range(3)]
-    no_tgt = np.empty(0, dtype=np.float32)
-    _fill_transitions(m, n_speeds, max_targets, bias, first_cell, True, counts, offsets, *fixed, no_tgt, no_tgt, no_tgt)
-    np.cumsum(counts, out=offsets[1:])
     tgt = [np.empty(offsets[-1], dtype=np.float32) for _ in range(3)]
-    _fill_transitions(m, n_speeds, max_targets, bias, first_cell, False, counts, offsets, *fixed, *tgt)
+    _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, *fixed, *tgt)
     shares = part_power_shares(m)
     if shares.shape[0] > 0:  # a varying traction map: the part-power controls after the fixed ones
         part = part_power_transitions(m, n_speeds, bias, first_cell, shares)
@@ -641,14 +682,39 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
-def _singular_rows(m, i, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val):
-    """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them."""
-    for s in range(sing_v.shape[1]):
+def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val, memo_key,
+                   memo_n, memo):
+    """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them.
+
+    The least :func:`entry_cost` of their control tables (:func:`control_table`), kept per kind of cell
+    ``t`` and singular speed ``s`` in row ``t * n_singular + s`` of ``memo``: a cell of the kind last
+    tabulated from the same singular speed with the same next singular speeds (``memo_key``) reuses the
+    table, the same numbers bit for bit, so a sweep pays the simulator's steps once per kind of cell
+    rather than once per cell and price of time (``benchmarks/peers.py --sweep-cpu``: with :func:`interp_split`, a
+    sweep of the 32 km generated line of seed 21 takes 27 ms against 74 ms, 22 ms without them).
+    """
+    sp_next = sing_p[i + 1]
+    sv_next = sing_val[i + 1]
+    n_sing = sing_v.shape[1]
+    for s in range(n_sing):
         sing_val[i, s] = PENALTY_J
         if sing_p[i, s] < 0.0 or sing_p[i, s] < floor_k:
             continue
-        best = best_control(m, i, sing_v[i, s], price_w, v_next, max_targets, bias, sing_v[i + 1], sing_p[i + 1],
-                            sing_val[i + 1])[0]
+        v0 = sing_v[i, s]
+        row = t * n_sing + s
+        table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row], memo[5][row])
+        # the table's key: the speed held and the next position's singular targets (-1: none there)
+        key = memo_key[row]
+        same = key[0] == v0
+        for q in range(n_sing):
+            same = same and key[q + 1] == (sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0)
+        if not same:
+            memo_n[row] = control_table(m, i, v0, sing_v[i + 1], sp_next, v_next.shape[0] - 1, max_targets, bias,
+                                        table)
+            key[0] = v0
+            for q in range(n_sing):
+                key[q + 1] = sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0
+        best = table_minimum(table, memo_n[row], price_w, v_next, sp_next, sv_next)[0]
         sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
 
 
@@ -668,7 +734,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
 
     The singular speeds (:func:`singular_speeds`: ``sing_v``, ``sing_p``, both (n_nodes, 2)) are
     further states: their cost-to-go ``sing_val`` (n_nodes, 2) is found by evaluating every control
-    from them with the simulator's steps (:func:`best_control`, as in the forward run, prices
+    from them with the simulator's steps (:func:`control_table`, as in the forward run, prices
     ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
     through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
     them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone.
@@ -681,32 +747,61 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
         value[n - 1, j] = terminal_j[j] if j >= floor_k[n - 1] else PENALTY_J
     for s in range(sing_val.shape[1]):
         sing_val[n - 1, s] = PENALTY_J
+    # the singular speeds' control tables, one per kind of cell and singular speed, filled as the sweep
+    # meets them (:func:`_singular_rows`); a key of NaN matches nothing
+    n_sing = sing_v.shape[1]
+    n_rows = (offsets.shape[0] - 1) // n_speeds * n_sing
+    memo_key = np.full((n_rows, 1 + n_sing), np.nan)
+    split = np.zeros(n_speeds, dtype=np.bool_)  # :func:`interp_split`
+    memo_n = np.zeros(n_rows, dtype=np.int64)
+    size = N_FIXED + n_sing + max_targets
+    memo = (np.empty((n_rows, size), dtype=np.int64), np.empty((n_rows, size)), np.empty((n_rows, size)),
+            np.empty((n_rows, size)), np.empty((n_rows, size)), np.empty((n_rows, size)))
     for i in range(n - 2, -1, -1):
         v_next = value[i + 1]
         sp_next = sing_p[i + 1]
         sv_next = sing_val[i + 1]
         t = cell_type[i]
-        _singular_rows(m, i, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
-                       sing_val)
+        for s in range(n_sing):  # the intervals of the next position's nodes a singular speed splits
+            q = sp_next[s]
+            if q >= 0.0 and q != math.floor(q):
+                split[int(q)] = True
+        _singular_rows(m, i, t, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
+                       sing_val, memo_key, memo_n, memo)
         for j in range(n_speeds):
             best = INF
             for c in range(fixed_e.shape[2]):  # N_FIXED, and the part-power shares where the train has them
                 e = fixed_e[t, j, c]
                 if e < INF:
-                    # the float32 position as float64 (exact; interp_aug computes in float64 either way):
-                    # one compiled interp_aug for the tables and the forward run
-                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_aug(v_next, np.float64(fixed_u1[t, j, c]),
-                                                                                 sp_next, sv_next)
+                    p_next = np.float64(fixed_u1[t, j, c])
+                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_split(v_next, p_next, split, sp_next,
+                                                                                   sv_next)
                     if cost < best:
                         best = cost
             s = t * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_aug(v_next, np.float64(tgt_u1[p]), sp_next, sv_next)
+                    p_next = np.float64(tgt_u1[p])
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_split(v_next, p_next, split, sp_next, sv_next)
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
+        for s in range(n_sing):
+            if sp_next[s] >= 0.0:
+                split[int(sp_next[s])] = False
+
+
+@inlined
+def _fixed_entry(mode, v0):
+    """The entry of a fixed control ``mode`` in a control table from ``v0`` (:func:`control_table`): the
+    fixed controls come first, in the order of :func:`_fixed_mode`; holding from a standstill is traction."""
+    for c in range(N_FIXED):
+        if _fixed_mode(c) == mode:
+            break
+    if c == N_FIXED - 1 and v0 <= 0.0:
+        c = 0
+    return c
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -719,11 +814,9 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     chatter (coast, land on a node, coast...) for no measurable energy.
 
     Writes per cell ``modes``, ``targets`` and per node ``speeds``. Returns
-    ``(n_cells_done, net_energy_j, time_s, tie_cost_j, start_j)``; ``n_cells_done < n_nodes - 1``
-    means no feasible control was found at that cell; ``tie_cost_j`` is what keeping the regime cost
-    over the best control, summed over the cells where it was kept (by the cost-to-go's estimate);
-    ``start_j`` is the cost-to-go from the initial speed (here, not from Python: each small kernel
-    called from Python is one more to load from the cache on every run).
+    ``(n_cells_done, net_energy_j, time_s, tie_cost_j)``; ``n_cells_done < n_nodes - 1`` means no
+    feasible control was found at that cell; ``tie_cost_j`` is what keeping the regime cost over
+    the best control, summed over the cells where it was kept (by the cost-to-go's estimate).
     """
     n = m.position_m.shape[0]
     if sing_p is None:  # no singular speeds (:func:`singular_speeds`)
@@ -734,41 +827,40 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
         sv_all = sing_v
         sp_all = sing_p
         sval_all = sing_val
+    size = N_FIXED + sp_all.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    k_max = value.shape[1] - 1
     v = m.initial_speed_ms
-    start_j = interp_aug(value[0], value_position(m.envelope_ms[0] ** 2, v ** 2, value.shape[1] - 1, bias), sp_all[0],
-                         sval_all[0])
     speeds[0] = v
     energy = 0.0
     time = 0.0
     tie_cost = 0.0
     previous = MODE_TRACTION
     for i in range(n - 1):
-        cost, mode, target = best_control(m, i, v, time_price_w[i], value[i + 1], max_targets, bias, sv_all[i + 1],
-                                          sp_all[i + 1], sval_all[i + 1])
+        v_next, sp_next, sval_next = value[i + 1], sp_all[i + 1], sval_all[i + 1]
+        n_entries = control_table(m, i, v, sv_all[i + 1], sp_next, k_max, max_targets, bias, table)
+        cost, p = table_minimum(table, n_entries, time_price_w[i], v_next, sp_next, sval_next)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
-            return i, energy, time, tie_cost, start_j
-        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
-        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
-        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
+            return i, energy, time, tie_cost
+        mode, target = table[0][p], table[1][p]
         if i > 0 and mode != previous and tie_j > 0.0:
             keep = MODE_HOLD_BRAKE if previous == MODE_TOWARD else previous
             if keep != mode:
-                c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                      time_price_w[i], value[i + 1], m.envelope_ms[i + 1] ** 2, bias, sp_all[i + 1],
-                                      sval_all[i + 1])
+                c = _fixed_entry(keep, v)
+                c_keep = entry_cost(table, c, time_price_w[i], v_next, sp_next, sval_next)
                 if c_keep < INF and c_keep <= cost + tie_j:
                     tie_cost += c_keep - cost
-                    mode, target = keep, 0.0
-        u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
-        energy += c_energy
-        time += dt
+                    mode, target, p = keep, 0.0, c
+        # the chosen control's cell, as ``cell_cost`` prices it with the auxiliary power alone
+        energy += table[3][p] + m.aux_power_w * table[4][p]
+        time += table[4][p]
         modes[i] = mode
         targets[i] = target
         previous = mode
-        v = math.sqrt(u1)
+        v = math.sqrt(table[5][p])
         speeds[i + 1] = v
-    return n - 1, energy, time, tie_cost, start_j
+    return n - 1, energy, time, tie_cost
 
 
 def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.ndarray:
@@ -842,7 +934,10 @@ def _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, s
     """The forward run of :func:`solve` on a swept cost-to-go, and the cost-to-go from the initial speed."""
     n = model.position_m.shape[0]
     price = np.ascontiguousarray(np.broadcast_to(np.asarray(lambda_w, dtype=float), (n - 1,))) + model.aux_power_w
-    return forward_run(model, price, value, max_targets, bias, tie_j, sing_v, sing_p, sing_val)
+    run = forward_run(model, price, value, max_targets, bias, tie_j, sing_v, sing_p, sing_val)
+    start_j = interp_aug(value[0], value_position(model.envelope_ms[0] ** 2, model.initial_speed_ms ** 2,
+                                                  value.shape[1] - 1, float(bias)), sing_p[0], sing_val[0])
+    return (*run, start_j)
 
 
 def forward_run(model, time_price_w, value, max_targets, bias, tie_j, sing_v, sing_p, sing_val) -> tuple:
@@ -851,10 +946,9 @@ def forward_run(model, time_price_w, value, max_targets, bias, tie_j, sing_v, si
     one compiles no part-power kernel).
 
     ``time_price_w`` (n_cells,) includes the auxiliary power. Returns ``(modes, targets, speeds,
-    n_cells_done, net_energy_j, time_s, tie_cost_j, start_j)``; ``targets`` is (n_cells,), or (n_cells, 2)
-    with the traction share beside the target where part power is among the controls, so that
-    ``np.column_stack([end_m, modes, targets])`` is the simulator's program either way; ``start_j`` is
-    the cost-to-go from the initial speed.
+    n_cells_done, net_energy_j, time_s, tie_cost_j)``; ``targets`` is (n_cells,), or (n_cells, 2) with
+    the traction share beside the target where part power is among the controls, so that
+    ``np.column_stack([end_m, modes, targets])`` is the simulator's program either way.
     """
     n = model.position_m.shape[0]
     modes = np.zeros(n - 1, dtype=np.int64)
@@ -862,13 +956,14 @@ def forward_run(model, time_price_w, value, max_targets, bias, tie_j, sing_v, si
     shares = part_power_shares(model)
     if shares.shape[0] > 0:
         targets = np.zeros((n - 1, 2))
-        run = forward_rollout_part_power(model, time_price_w, value, int(max_targets), float(bias), float(tie_j),
-                                         shares, modes, targets, speeds, sing_v, sing_p, sing_val)
+        done, energy, time, tie_cost = forward_rollout_part_power(model, time_price_w, value, int(max_targets),
+                                                                  float(bias), float(tie_j), shares, modes, targets,
+                                                                  speeds, sing_v, sing_p, sing_val)
     else:
         targets = np.zeros(n - 1)
-        run = forward_rollout(model, time_price_w, value, int(max_targets), float(bias), float(tie_j), modes, targets,
-                              speeds, sing_v, sing_p, sing_val)
-    return (modes, targets, speeds, *run)
+        done, energy, time, tie_cost = forward_rollout(model, time_price_w, value, int(max_targets), float(bias),
+                                                       float(tie_j), modes, targets, speeds, sing_v, sing_p, sing_val)
+    return modes, targets, speeds, done, energy, time, tie_cost
 
 
 def speed_floor_nodes(model, floor_ms: np.ndarray, n_speeds: int, bias: float) -> np.ndarray:
@@ -949,7 +1044,7 @@ def part_power_transitions(m, n_speeds: int, bias: float, first_cell: np.ndarray
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_p, sing_val):
-    """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`control_cost`'s sum)."""
+    """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`entry_cost`'s sum)."""
     u1, f, w0 = part_power_outcome(m, v0, cell, share)
     cost, _ = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
     if cost < INF:
@@ -1010,28 +1105,29 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     as :func:`forward_rollout` does, a part-power cell its share. Returns what :func:`forward_rollout` does.
     """
     n = m.position_m.shape[0]
+    size = N_FIXED + sing_v.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    k_max = value.shape[1] - 1
     v = m.initial_speed_ms
-    start_j = interp_aug(value[0], value_position(m.envelope_ms[0] ** 2, v ** 2, value.shape[1] - 1, bias), sing_p[0],
-                         sing_val[0])
     speeds[0] = v
     energy = time = tie_cost = 0.0
     previous, previous_share = MODE_TRACTION, 1.0  # the control of the cell before
     for i in range(n - 1):
         price = time_price_w[i]
-        cost, mode, target = best_control(m, i, v, price, value[i + 1], max_targets, bias, sing_v[i + 1],
-                                          sing_p[i + 1], sing_val[i + 1])
+        n_entries = control_table(m, i, v, sing_v[i + 1], sing_p[i + 1], k_max, max_targets, bias, table)
+        cost, p = table_minimum(table, n_entries, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
-            return i, energy, time, tie_cost, start_j
+            return i, energy, time, tie_cost
+        mode, target = table[0][p], table[1][p]
         share = 1.0
         pp_cost, pp_share = best_part_power(m, i, v, price, value[i + 1], bias, sing_p[i + 1], sing_val[i + 1],
                                             shares)
         if pp_cost < cost:
             cost, mode, target, share = pp_cost, MODE_TOWARD, part_power_target(m, i), pp_share
-        tr_u, tr_f, tr_w, _ = full_step(m, v, i, KIND_TRACTION)
-        co_u, co_f, co_w, _ = full_step(m, v, i, KIND_COAST)
-        br_u, br_f, br_w, _ = full_step(m, v, i, KIND_BRAKE)
         if i > 0 and tie_j > 0.0 and (mode != previous or share != previous_share):
             top_u = m.envelope_ms[i + 1] ** 2
+            c = p
             if previous_share < 1.0:  # keep pulling at the previous share
                 c_keep = part_power_cost(m, v, i, previous_share, price, value[i + 1], top_u, bias, sing_p[i + 1],
                                          sing_val[i + 1])
@@ -1041,16 +1137,16 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
                 keep_target = 0.0
                 c_keep = INF
                 if keep != mode or share < 1.0:
-                    c_keep = control_cost(m, v, i, keep, 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w,
-                                          price, value[i + 1], top_u, bias, sing_p[i + 1], sing_val[i + 1])
+                    c = _fixed_entry(keep, v)
+                    c_keep = entry_cost(table, c, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
             if c_keep < INF and c_keep <= cost + tie_j:
                 tie_cost += c_keep - cost
-                mode, target, share = keep, keep_target, previous_share
+                mode, target, share, p = keep, keep_target, previous_share, c
         if share < 1.0:
             u1, f, w0 = part_power_outcome(m, v, i, share)
-        else:
-            u1, f, w0 = cell_outcome(m, v, i, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+            c_energy, dt = cell_cost(m, v, u1, f, w0, i, m.aux_power_w)
+        else:  # the table's entry, as ``cell_cost`` prices it with the auxiliary power alone
+            u1, c_energy, dt = table[5][p], table[3][p] + m.aux_power_w * table[4][p], table[4][p]
         energy += c_energy
         time += dt
         modes[i] = mode
@@ -1060,4 +1156,4 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
         previous_share = share
         v = math.sqrt(u1)
         speeds[i + 1] = v
-    return n - 1, energy, time, tie_cost, start_j
+    return n - 1, energy, time, tie_cost

@@ -349,6 +349,10 @@ class OptimalSolver:
             finer = OptimalSolver(self.case, self.dx_m, 2 * self.n_speeds, self.max_targets, self.time_tol_s,
                                   self.top_bias, self.tie_j, self.certify, self.price_shape, self.speed_floor_ms,
                                   self.singular)
+            # the finer grid's certificate compares it with this grid (half its nodes): its tables serve
+            coarse = finer.coarse_solver()
+            if coarse.n_speeds == self.n_speeds:
+                coarse._tables = self.transition_tables()
             tr = finer.profile(running_time_s, solution.lambda_w)
             self.last_bound_parts = finer.last_bound_parts
             return tr

@@ -91,13 +91,13 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
     assert len(plot_performance_profile(profile).axes[0].get_lines()) == 2
 
 
-def test_the_profile_script_splits_a_run_and_leaves_the_thread_count(capsys):
+def test_the_profile_mode_splits_a_run_and_leaves_the_thread_count(capsys):
     import numba
 
-    from benchmarks.suite_baseline_profile import main
+    from benchmarks.suite_baseline import main
 
     before = numba.get_num_threads()
-    assert main(["--ladder", "10", "--families", "generated-metro-bi", "--algorithms", "random",
+    assert main(["--profile", "--ladder", "10", "--families", "generated-metro-bi", "--algorithms", "random",
                  "--n-eval", "300", "--threads", "1"]) == 0
     assert numba.get_num_threads() == before
     lines = capsys.readouterr().out.splitlines()
@@ -106,4 +106,4 @@ def test_the_profile_script_splits_a_run_and_leaves_the_thread_count(capsys):
     assert len(values) == 10 and values[-2] > 0  # 8 parts, the total, ms per evaluation
     assert values[8] == pytest.approx(sum(values[:8]), abs=6e-3)  # printed to 3 decimals
     with pytest.raises(SystemExit, match="none of the study's"):
-        main(["--ladder", "10", "--algorithms", "no-such-algorithm"])
+        main(["--profile", "--ladder", "10", "--algorithms", "no-such-algorithm"])

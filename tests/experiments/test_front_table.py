@@ -4,7 +4,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pymoo_rail.experiments.front_table import exact_energy_kwh, front_statistics, most_punctual
+from pymoo_rail.experiments.front_table import (exact_energy_kwh, exact_front_table, front_statistics, most_punctual,
+                                               punctual_choice)
 
 EXACT = pd.DataFrame({"running_time_s": [100.0, 110.0, 120.0], "energy_kwh": [30.0, 20.0, 15.0]})
 
@@ -57,3 +58,30 @@ def test_signed_percent_keeps_two_decimals_under_one_percent():
     from pymoo_rail.experiments.stats import signed_percent
 
     assert (signed_percent(0.456), signed_percent(-12.34), signed_percent(1.0)) == ("+0.46 %", "-12.3 %", "+1.0 %")
+
+
+def test_punctual_choice_is_the_least_energy_within_the_window_and_none_outside():
+    row = {"algorithm": "MOABC", "problem": "non-equal", "seed": 3, "n_eval": 200, "wall_time_s": 1.5,
+           "F": np.array([[20.0, 0.5], [19.0, 2.0], [21.0, 0.0], [10.0, 0.2]]),
+           "CV": np.array([0.0, 0.0, 0.0, 1.0]),  # the cheapest member is infeasible
+           "X": np.array([[1.0], [2.0], [3.0], [4.0]]),
+           "extras": {"energy_kwh": [20.0, 19.0, 21.0, 10.0], "running_time_s": [150.5, 152.0, 150.0, 150.2],
+                      "stop_error_m": [0.1, 0.2, 0.3, 0.4]}}
+    chosen = punctual_choice(row, 150.0, 1.0)
+    assert (chosen["energy_kwh"], chosen["running_time_s"], chosen["stop_error_m"], chosen["x"]) == (20.0, 150.5, 0.1, [1.0])
+    assert (chosen["n_front"], chosen["n_feasible"], chosen["n_within"]) == (4, 3, 2)
+    assert (chosen["front_time_error_min_s"], chosen["front_time_error_max_s"]) == (0.0, 2.0)
+    assert (chosen["front_energy_min_kwh"], chosen["front_energy_max_kwh"]) == (19.0, 21.0)
+    missed = punctual_choice(row, 160.0, 1.0)
+    assert missed["x"] is None and np.isnan(missed["energy_kwh"]) and missed["n_within"] == 0
+
+
+def test_the_exact_front_table_has_a_row_per_requested_time():
+    exact = pd.DataFrame({"requested_time_s": [990.0, 1050.0], "running_time_s": [990.004, 1049.996],
+                          "energy_kwh": [700.123, 640.5], "traction_kwh": [800.0, 720.0], "regen_kwh": [100.0, 79.5],
+                          "lambda_kwh_per_s": [0.5, 0.25], "neutral_traction_j": [0.0, 0.0],
+                          "limit_excess_ms": [1e-9, 0.0], "stop_error_m": [0.01, 0.02], "solve_s": [12.4, 30.6]})
+    lines = exact_front_table(exact).splitlines()
+    assert len(lines) == 2 + 2 and lines[0].startswith("| requested (s) | running time (s) | net energy (kWh)")
+    assert lines[2].startswith("| 990 | 990.00 | 700.12 | 800.0 / 100.0 | 0.500 |")
+    assert lines[3].endswith("| 31 |")
