@@ -45,7 +45,7 @@ from pymoo_rail.optimal.price_search import (
 )
 from pymoo_rail.sim import Simulator, Trajectory
 
-SOLVER_VERSION = "3"
+SOLVER_VERSION = "4"
 """Version of the solver's answers: bump it whenever a run the solver returns for a case can change
 (DP, search, certificate, or the simulator that replays the run), so on-disk caches of its runs
 (:func:`pymoo_rail.optimal.reference.exact_points`, :func:`pymoo_rail.journeys.section_fronts`)
@@ -54,7 +54,9 @@ stop serving the old rows; bump ``pymoo_rail.optimal.reference.FRONT_VERSION`` w
 as states and the end speed an equality (the shipped fronts of version 6, rest to rest, move by at
 most 0.0045 kWh, 0.005 %, within their certificates: not recomputed); 3: the certificate's floor at
 least 5e-4 of the run's traction energy, runs unchanged (fronts recomputed as version 7 for their
-certificates)."""
+certificates); 4: the coast curves into the braking envelope's corners and the end speed, and the
+full-traction start, as states of the DP (``dp.coast_curves``; runs change where they coast into a
+lower limit or a moving end, fronts recomputed as version 8)."""
 DEFAULT_N_SPEEDS = 200
 DEFAULT_MAX_TARGETS = 16
 DEFAULT_TIME_TOL_S = 0.05
@@ -133,7 +135,6 @@ class OptimalSolver:
         self._tables = None  # transitions, built on the first solve (they do not depend on lambda)
         self._swept = None  # (price, shape, floor) of the cost-to-go in _value and _sing
         n_nodes = self.simulator.grid.n_nodes
-        self._sing = (np.empty((n_nodes, 2)), np.empty((n_nodes, 2)), np.empty((n_nodes, 2)))  # dp.solve's
         self._min_time_s: float | None = None
         self.n_solves = 0  # DP solves so far (for benchmarks)
         # the parts of the last certificate (kWh): grid, moved run, kept regimes, untied run (for benchmarks)
@@ -146,6 +147,10 @@ class OptimalSolver:
         # the arrival speeds the case asks for: (lo, hi), lo = hi = the final speed unless it gives a window
         self.end_speed_ms = case.end_speed_window_ms()
         self._terminal_j = dp.terminal_cost(self.simulator.model, self.n_speeds, self.top_bias, self.end_speed_ms[0])
+        # the coast curves into the envelope's corners and the end speed: kinks of the cost-to-go, held as states
+        self._arrival = dp.coast_curves(self.simulator.model, float(self.end_speed_ms[0]), self.n_speeds,
+                                        self.top_bias)
+        self._sing = tuple(np.empty((n_nodes, dp.N_SINGULAR + self._arrival[0].shape[1])) for _ in range(3))
         self.speed_floor_ms: np.ndarray | None = None
         self._floor_k: np.ndarray | None = None
         self.set_speed_floor(speed_floor_ms)
@@ -226,7 +231,8 @@ class OptimalSolver:
         # the cost-to-go of the last sweep still holds at its price and settings: only the forward run
         key = (lambda_w, id(self.price_shape), id(self._floor_k))
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, tie_j,
-                       self._value, self._floor_k, self._terminal_j, self.singular, self._sing, self._swept == key)
+                       self._value, self._floor_k, self._terminal_j, self.singular, self._sing, self._swept == key,
+                       self._arrival)
         self._swept = key
         return run
 
