@@ -91,7 +91,8 @@ def real_model(case: Case, disturbance: LoopDisturbance, dx_m: float | None = No
     model = disturbed_tracker(case, PID(), disturbance, dx_m=dx_m).simulator.model
     model = resistance_scaled(model, float(disturbance.resistance_factor))
     model = model._replace(regen_efficiency=min(model.regen_efficiency * disturbance.regen_factor, 1.0),
-                           regen_map_values=np.minimum(model.regen_map_values * disturbance.regen_factor, 1.0))
+                           regen_map_values=None if model.regen_map_values is None else
+                           np.minimum(model.regen_map_values * disturbance.regen_factor, 1.0))
     if disturbance.restriction is not None:
         disturbance.restriction.check_on(case)
         return restricted_model(model, disturbance.restriction, float(case.train.length_m))

@@ -64,7 +64,7 @@ class TrackGrid:
 Rows = Sequence[Sequence[float]]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _running_integrals(knots: np.ndarray, slope: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """W and WW at the knots of a piecewise-constant w (``slope`` on each knot interval)."""
     n = knots.shape[0]

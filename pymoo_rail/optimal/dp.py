@@ -70,7 +70,7 @@ _TOP_RTOL = 1e-6
 END_PRICE_FACTOR = 100.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def node_u(top_u, k, k_max, bias):
     """Kinetic energy of speed node ``k``: ``top_u g(k / k_max)`` with ``g(s) = s + bias s (1 - s)``.
 
@@ -81,7 +81,7 @@ def node_u(top_u, k, k_max, bias):
     return top_u * (s + bias * s * (1.0 - s))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def node_position(top_u, u, k_max, bias):
     """Fractional node index of kinetic energy ``u`` (the inverse of :func:`node_u`), top_u > 0."""
     y = u / top_u
@@ -94,7 +94,7 @@ def node_position(top_u, u, k_max, bias):
     return (b1 - math.sqrt(disc)) / (2.0 * bias) * k_max
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w):
     """What the simulator's ``run_program`` does in one cell for a program row of its own.
 
@@ -135,7 +135,7 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
     return u1, f, w0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     """Net energy of the cell plus ``time_price_w`` x its time (J), and its time (s).
 
@@ -170,7 +170,7 @@ def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     return e + time_price_w * dt, dt
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def value_position(top_u, u, k_max, bias):
     """Where kinetic energy ``u`` falls among the speed nodes over ``[0, top_u]``: a fractional index.
 
@@ -242,19 +242,20 @@ def interp_aug(v_next, p, sing_p, sing_val):
 def interp_split(v_next, p, split, sing_p, sing_val):
     """:func:`interp_aug` where ``split[k]`` says whether a singular speed lies inside the interval
     ``(k, k + 1)`` of the speed nodes: the others take :func:`interp_at`, the same arithmetic without
-    the search for one: ``benchmarks/peers.py --sweep-cpu``, a sweep of generated seed 21 35 -> 27 ms)."""
+    the search for one: ``benchmarks/peers.py --sweep-cpu``, a sweep of generated seed 21 35 -> 27 ms).
+    The sweep passes its float32 positions as float64 (exact): one compiled copy of the interpolations."""
     if p >= 0.0 and not split[int(p)]:
         return interp_at(v_next, p)
     return interp_aug(v_next, p, sing_p, sing_val)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def interp_value(v_next, top_u, u, bias):
     """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
     return interp_at(v_next, value_position(top_u, u, v_next.shape[0] - 1, bias))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def psi_speed(b_nsm, c_ns2m2, psi_w):
     """The speed ``v`` with ``psi(v) = v^2 R'(v) = v^2 (b + 2 c v) = psi_w`` (m/s; Davis ``R``; 0 if none).
 
@@ -275,7 +276,7 @@ def psi_speed(b_nsm, c_ns2m2, psi_w):
     return v
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def electric_force(m, v, f):
     """Electrical energy per metre (N) of the control force ``f`` (N) at speed ``v``: ``f / eta_traction(v, f)``
     when pulling, ``-eta_regen(v, |f|) |f|`` when braking electrically (the maps where the train has them;
@@ -287,7 +288,7 @@ def electric_force(m, v, f):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def map_is_constant(values, constant):
     """Whether an efficiency map gives ``constant`` everywhere (then the constant's closed form serves)."""
     for i in range(values.shape[0]):
@@ -300,11 +301,11 @@ def map_is_constant(values, constant):
 def varying_maps(m) -> tuple[bool, bool]:
     """Whether the kernel model's traction and regenerative efficiency maps vary (a map giving its
     direction's constant everywhere is the constant: its closed forms and controls serve)."""
-    return (m.traction_map_values.shape[0] > 0 and not map_is_constant(m.traction_map_values, m.traction_efficiency),
-            m.regen_map_values.shape[0] > 0 and not map_is_constant(m.regen_map_values, m.regen_efficiency))
+    return (m.traction_map_values is not None and not map_is_constant(m.traction_map_values, m.traction_efficiency),
+            m.regen_map_values is not None and not map_is_constant(m.regen_map_values, m.regen_efficiency))
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def hold_stationarity(m, v, line_force_n, braking):
     """``v^2 (R'(v) dg/dF + dg/dv)`` at the holding force ``F = R(v) + line force`` (N x m/s = W).
 
@@ -326,7 +327,7 @@ def hold_stationarity(m, v, line_force_n, braking):
     return v * v * ((m.davis_b_nsm + 2.0 * m.davis_c_ns2m2 * v) * g_f + g_v)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def map_hold_speed(m, price_w, line_force_n, braking, v_top):
     """The speed below ``v_top`` where :func:`hold_stationarity` equals ``price_w``, by bisection (0 if
     there is none: the condition stays above or below the price over ``(0, v_top)``)."""
@@ -370,7 +371,7 @@ def singular_speeds(m, time_price_w, n_speeds, bias, sing_v, sing_p) -> None:
     place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def constant_holding_speeds(m, time_price_w):
     """``(V, W)`` per cell (m/s) with constant efficiencies: the closed form of :func:`psi_speed`
     (``W`` 0 without regeneration or at or below its cut-off speed)."""
@@ -385,7 +386,7 @@ def constant_holding_speeds(m, time_price_w):
     return v_hold, v_regen
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def map_holding_speeds(m, time_price_w, map_traction, map_regen):
     """``(V, W)`` per cell (m/s) where a map is not constant: the root of :func:`hold_stationarity` at
     the cell's holding force (the closed form for the side whose map is constant)."""
@@ -400,7 +401,7 @@ def map_holding_speeds(m, time_price_w, map_traction, map_regen):
     return v_hold, v_regen
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def place_singular_speeds(m, v_hold, v_regen, n_speeds, bias, sing_v, sing_p):
     """Write the holding speeds of each cell into ``sing_v`` / ``sing_p`` (see :func:`singular_speeds`)."""
     n = m.position_m.shape[0]
@@ -563,7 +564,7 @@ def coast_curves(model, end_lo_ms: float, n_speeds: int, bias: float, max_curves
 N_FIXED = 4
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _fixed_mode(c):
     if c == 0:
         return MODE_TRACTION
@@ -574,7 +575,7 @@ def _fixed_mode(c):
     return MODE_HOLD_BRAKE
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _target_range(top_u, k_max, u0, tr_u, co_u, bias):
     """Speed nodes of the next position that partial traction (or braking) can land on exactly."""
     lo = co_u if co_u < u0 else u0
@@ -590,7 +591,7 @@ def _target_range(top_u, k_max, u0, tr_u, co_u, bias):
     return k_lo, k_hi
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _n_targets(k_lo, k_hi, max_targets):
     count = k_hi - k_lo + 1
     if count <= 0:
@@ -601,7 +602,7 @@ def _n_targets(k_lo, k_hi, max_targets):
     return (count + stride - 1) // stride, stride
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
 
@@ -721,16 +722,16 @@ def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
 @inlined
 def _kind_cell(m, first_cell, p_type):
     """Kind ``t`` of a table loop's ``prange`` index, its first cell ``i`` and the envelope's ``u`` at both ends."""
-    t = np.int64(p_type)  # prange counts in uint64: the int64 index of every other caller
+    t = np.int64(p_type)  # callers pass np.int64(p_type): prange counts in uint64 (one compiled copy)
     i = first_cell[t]
     return t, i, m.envelope_ms[i] ** 2, m.envelope_ms[i + 1] ** 2
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
 def _count_targets(m, n_speeds, max_targets, bias, first_cell, counts):
     k_max = n_speeds - 1
     for p_type in prange(first_cell.shape[0]):
-        t, i, top0, top1 = _kind_cell(m, first_cell, p_type)
+        t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             counts[t * n_speeds + j] = 0
             if top1 <= 0.0:
@@ -742,13 +743,13 @@ def _count_targets(m, n_speeds, max_targets, bias, first_cell, counts):
             counts[t * n_speeds + j] = _n_targets(k_lo, k_hi, max_targets)[0]
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
 def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, fixed_u1, fixed_e, fixed_dt, tgt_u1, tgt_e,
                       tgt_dt):
     k_max = n_speeds - 1
     aux = m.aux_power_w
     for p_type in prange(first_cell.shape[0]):
-        t, i, top0, top1 = _kind_cell(m, first_cell, p_type)
+        t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
             tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
@@ -814,7 +815,7 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
     return (*fixed, offsets, *tgt, cell_type)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val, memo_key,
                    memo_n, memo):
     """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them.
@@ -851,7 +852,7 @@ def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v,
         sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
                    floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
@@ -906,15 +907,17 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
             for c in range(fixed_e.shape[2]):  # N_FIXED, and the part-power shares where the train has them
                 e = fixed_e[t, j, c]
                 if e < INF:
-                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_split(v_next, fixed_u1[t, j, c], split,
-                                                                                   sp_next, sv_next)
+                    p_next = np.float64(fixed_u1[t, j, c])
+                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_split(v_next, p_next, split, sp_next,
+                                                                                   sv_next)
                     if cost < best:
                         best = cost
             s = t * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_split(v_next, tgt_u1[p], split, sp_next, sv_next)
+                    p_next = np.float64(tgt_u1[p])
+                    cost = e + time_price_w[i] * tgt_dt[p] + interp_split(v_next, p_next, split, sp_next, sv_next)
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
@@ -935,7 +938,7 @@ def _fixed_entry(mode, v0):
     return c
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, targets, speeds, sing_v=None,
                     sing_p=None, sing_val=None):
     """Drive from the case's initial speed choosing each cell's control from the cost-to-go (continuous state).
@@ -1010,7 +1013,8 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
     k_max = n_speeds - 1
     lo_u = min(end_lo_ms ** 2, top_u)
     price = END_PRICE_FACTOR * model.effective_mass_kg / model.traction_efficiency
-    u = np.array([node_u(top_u, k, k_max, bias) for k in range(n_speeds)])
+    # node_u's Python function: the same arithmetic, without loading a kernel for it on every run
+    u = np.array([node_u.py_func(top_u, k, k_max, bias) for k in range(n_speeds)])
     return price * np.maximum(lo_u - u, 0.0)
 
 
@@ -1136,14 +1140,14 @@ def part_power_shares(m) -> np.ndarray:
     return PART_POWER_SHARES.copy() if varying_maps(m)[0] else np.empty(0)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def part_power_target(m, cell):
     """The target speed of a part-power row (m/s): the braking envelope at the cell's end, which the
     ``toward`` row lands on rather than overshoot (the envelope would stop it there anyway)."""
     return m.envelope_ms[cell + 1]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def part_power_outcome(m, v0, cell, share):
     """The simulator's cell of a ``toward`` row at traction ``share`` (:func:`part_power_target`):
     ``(u1, force_n, w0_n)``, as :func:`cell_outcome` gives it for a row of full traction."""
@@ -1154,11 +1158,11 @@ def part_power_outcome(m, v0, cell, share):
                         co_u, co_f, co_w, co_u, co_f, co_w)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
 def _fill_part_power(m, n_speeds, bias, first_cell, shares, pp_u1, pp_e, pp_dt):
     k_max = n_speeds - 1
     for p_type in prange(first_cell.shape[0]):
-        t, i, top0, top1 = _kind_cell(m, first_cell, p_type)
+        t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
             for c in range(shares.shape[0]):
@@ -1177,7 +1181,7 @@ def part_power_transitions(m, n_speeds: int, bias: float, first_cell: np.ndarray
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_p, sing_val):
     """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`entry_cost`'s sum)."""
     u1, f, w0 = part_power_outcome(m, v0, cell, share)
@@ -1187,7 +1191,7 @@ def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_
     return cost
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def best_part_power(m, cell, v0, time_price_w, v_next, bias, sing_p, sing_val, shares):
     """The best traction share from ``v0``: the best of ``shares``, refined by golden section between its
     neighbours (0 and 1 at the ends). Returns ``(total_cost, share)``.
@@ -1230,7 +1234,7 @@ def best_part_power(m, cell, v0, time_price_w, v_next, bias, sing_p, sing_val, s
     return best, best_share
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j, shares, modes, targets, speeds,
                                sing_v, sing_p, sing_val):
     """:func:`forward_rollout` with part-power traction among the controls (:func:`best_part_power`).

@@ -28,9 +28,9 @@ PACKAGE = "pymoo_rail"
 # compile (``benchmarks/compile_profile.py``). No reference counting: they allocate nothing, and a
 # called helper with it increfs the model's arrays on every call. They keep their Python wrapper
 # (``no_cpython_wrapper`` would save a little compile, but a call from Python then crashes).
-inlined = njit(cache=True, forceinline=True, _nrt=False)
+inlined = njit(cache=True, no_cfunc_wrapper=True, forceinline=True, _nrt=False)
 """``njit`` for a kernel helper: inlined by LLVM into every caller, no reference counting."""
-called = njit(cache=True, _nrt=False)
+called = njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 """``njit`` for a helper off the hot path of a case without it (the efficiency-map lookup): compiled
 once and called, not inlined at every call site (inlined, its two bisections cost 4.4 s of the
 first run's compile, ``benchmarks/first_run.py``); no reference counting, as for :data:`inlined`."""

@@ -90,8 +90,10 @@ OUT_NAMES = ("traction_kwh", "regen_kwh", "aux_kwh", "net_kwh", "running_time_s"
              "brake_work_j", "davis_work_j", "line_work_j", "grade_work_j", "final_speed_ms", "reached",
              "electric_brake_work_j", "max_abs_accel_ms2", "neutral_traction_j", "peak_traction_kw")
 
-# the three full-force steps of ``full_step`` (public for the DP)
-KIND_TRACTION, KIND_COAST, KIND_BRAKE = 0, 1, 2
+# the three full-force steps of ``full_step`` (public for the DP). NumPy integers, not Python ones:
+# Numba types a Python int constant as a literal and compiled full_step and scaled_step once per
+# kind (about 1 s of the first run's compile); inlined, LLVM folds the constant kind all the same
+KIND_TRACTION, KIND_COAST, KIND_BRAKE = np.int64(0), np.int64(1), np.int64(2)
 
 
 @inlined
@@ -284,7 +286,7 @@ def complete_cell(m, totals, cell, v, u1, f, w0, regime):
     return v1, stopped, x1, a_cell, totals
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def trace_cell_energies(m, x, v, f):
     """Per-cell energies of a recorded run (J): traction drawn and regeneration delivered.
 
@@ -437,7 +439,7 @@ def drive_cell(m, program, totals, i, v, row, hold_speed):
 
 # No reference counting inside: the run allocates nothing, and NRT incref/decref pairs on the
 # model's arrays in every inlined helper call were half the cost of a cell (benchmarks/throughput.py --jit).
-@njit(cache=True, _nrt=False)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def run_program(m, program, out, record, tr_x, tr_v, tr_t, tr_a, tr_f, tr_r):
     """Simulate one run; write the summary into ``out`` and, if ``record``, the trace arrays.
 
@@ -480,78 +482,78 @@ def advance_run(m, program, totals, i, v, row, hold_speed, moving, stop_pos):
 # (two square roots and two force-curve evaluations per cell, each waiting for the last), which
 # leaves most of the core idle; the cells of two independent runs interleave in the out-of-order
 # core and nearly halve the time per cell (docs/performance.md). Each run does exactly the
-# arithmetic of ``run_program``, so results are bitwise the same.
-@njit(cache=True, _nrt=False)
-def run_two_programs(m, program_a, program_b, out_a, out_b, empty, empty_r):
-    """Summaries of two runs, simulated side by side (no traces; ``empty``, ``empty_r``: the
-    empty float and int8 trace arrays ``write_summary`` takes)."""
+# arithmetic of ``run_program``, so results are bitwise the same. The loop over the pairs is in the
+# same kernel, not a caller of a pair kernel: each compiled caller makes LLVM optimise and emit the
+# callee's run loops again (about 1 s of the first run's compile).
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
+def run_pairs(m, programs, out, empty, empty_r, spare):
+    """Summaries of runs ``programs`` (N, rows, 3) into ``out`` (N, N_OUT), two side by side, in this
+    thread (no traces; ``empty``, ``empty_r``: the empty float and int8 trace arrays
+    ``write_summary`` takes). An odd last run goes beside a copy of itself, whose summary goes
+    into ``spare`` (N_OUT,)."""
+    n_runs = programs.shape[0]
     n = m.position_m.shape[0]
     record = n < 0  # a run-time False: one compiled write_summary for every caller
-    totals_a = new_totals()
-    totals_b = new_totals()
-    v_a = m.initial_speed_ms
-    v_b = m.initial_speed_ms
-    row_a = n - n  # run-time zeros, not literals (see run_program)
-    row_b = n - n
-    hold_a = -1.0
-    hold_b = -1.0
-    moving_a = n > 0  # run-time Trues, not literals: one compiled advance_run
-    moving_b = n > 0
-    stop_a = m.position_m[n - 1]
-    stop_b = m.position_m[n - 1]
-    for i in range(n - 1):
-        v_a, row_a, hold_a, moving_a, stop_a, totals_a = advance_run(
-            m, program_a, totals_a, i, v_a, row_a, hold_a, moving_a, stop_a)
-        v_b, row_b, hold_b, moving_b, stop_b, totals_b = advance_run(
-            m, program_b, totals_b, i, v_b, row_b, hold_b, moving_b, stop_b)
-        if not (moving_a or moving_b):
-            break
     no_count = n - n  # no trace nodes; a run-time 0: one compiled write_summary for every caller
-    write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, no_count, record, empty, empty, empty_r)
-    write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, no_count, record, empty, empty, empty_r)
+    for pair in range((n_runs + 1) // 2):
+        a = 2 * pair
+        b = a + 1 if a + 1 < n_runs else a
+        program_a = programs[a]
+        program_b = programs[b]
+        out_a = out[a]
+        out_b = out[b] if b > a else spare
+        totals_a = new_totals()
+        totals_b = new_totals()
+        v_a = m.initial_speed_ms
+        v_b = m.initial_speed_ms
+        row_a = n - n  # run-time zeros, not literals (see run_program)
+        row_b = n - n
+        hold_a = -1.0
+        hold_b = -1.0
+        moving_a = n > 0  # run-time Trues, not literals: one compiled advance_run
+        moving_b = n > 0
+        stop_a = m.position_m[n - 1]
+        stop_b = m.position_m[n - 1]
+        for i in range(n - 1):
+            v_a, row_a, hold_a, moving_a, stop_a, totals_a = advance_run(
+                m, program_a, totals_a, i, v_a, row_a, hold_a, moving_a, stop_a)
+            v_b, row_b, hold_b, moving_b, stop_b, totals_b = advance_run(
+                m, program_b, totals_b, i, v_b, row_b, hold_b, moving_b, stop_b)
+            if not (moving_a or moving_b):
+                break
+        write_summary(m, totals_a, out_a, v_a, moving_a, stop_a, no_count, record, empty, empty, empty_r)
+        write_summary(m, totals_b, out_b, v_b, moving_b, stop_b, no_count, record, empty, empty, empty_r)
 
 
-@njit(cache=True)
-def simulate_serial(m, programs, out):
-    """Summaries of runs ``programs`` (N, rows, 3) into ``out`` (N, N_OUT), in this thread."""
-    n_runs = programs.shape[0]
-    empty = np.empty(0)
-    empty_r = np.empty(0, dtype=np.int8)
-    for j in range(n_runs // 2):
-        run_two_programs(m, programs[2 * j], programs[2 * j + 1], out[2 * j], out[2 * j + 1], empty, empty_r)
-    if n_runs % 2 == 1:
-        # a run-time False, not the literal: with a literal Numba compiles run_program a second time
-        # (once per value of ``record``), which doubles the first-run compile time
-        record = n_runs < 0
-        run_program(m, programs[n_runs - 1], out[n_runs - 1], record, empty, empty, empty, empty, empty, empty_r)
-
-
-@njit(cache=True, parallel=True)
+@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
 def simulate_batch(m, programs):
     """Summaries of many runs, one per program, in parallel. ``programs`` is (N, rows, 3).
 
-    Runs go to the threads in pairs (:func:`run_two_programs`).
+    Runs go to the threads in pairs (:func:`run_pairs`).
     """
     n_runs = programs.shape[0]
     out = np.empty((n_runs, N_OUT))
-    n_pairs = n_runs // 2
-    for j in prange(n_pairs + n_runs % 2):
-        simulate_serial(m, programs[2 * j: 2 * j + 2], out[2 * j: 2 * j + 2])
+    n_pairs = (n_runs + 1) // 2
+    spare = np.empty((n_pairs, N_OUT))
+    empty = np.empty(0)
+    empty_r = np.empty(0, dtype=np.int8)
+    for j in prange(n_pairs):
+        run_pairs(m, programs[2 * j: 2 * j + 2], out[2 * j: 2 * j + 2], empty, empty_r, spare[j])
     return out
 
 
 def simulate_batch_serial(m, programs):
     """:func:`simulate_batch` in the calling thread: no thread start-up cost for small batches.
 
-    Plain Python around :func:`simulate_serial`: a compiled wrapper would be one more Numba
+    Plain Python around :func:`run_pairs`: a compiled wrapper would be one more Numba
     function (and one more copy of the run loops for LLVM) in the first run's compile.
     """
     out = np.empty((programs.shape[0], N_OUT))
-    simulate_serial(m, programs, out)
+    run_pairs(m, programs, out, np.empty(0), np.empty(0, dtype=np.int8), np.empty(N_OUT))
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def trace_arrays(n):
     """Uninitialised trace buffers for ``n`` nodes: (x, v, t, a, force, regime); regime is int8.
 

@@ -51,20 +51,24 @@ class KernelModel(NamedTuple):
     initial_speed_ms: float = 0.0
     final_speed_ms: float = 0.0
     dx_per_mass_m_kg: float = 0.0  # dx_m / effective_mass_kg, precomputed for the kernel's step
-    # efficiency maps over (speed, force magnitude), empty without one (``model.EfficiencyMap``)
-    traction_map_speeds_ms: np.ndarray = np.empty(0)
-    traction_map_forces_n: np.ndarray = np.empty(0)
-    traction_map_values: np.ndarray = np.empty((0, 0))
-    regen_map_speeds_ms: np.ndarray = np.empty(0)
-    regen_map_forces_n: np.ndarray = np.empty(0)
-    regen_map_values: np.ndarray = np.empty((0, 0))
+    # efficiency maps over (speed, force magnitude) (``model.EfficiencyMap.table_si``), None without
+    # one. None, not empty arrays: Numba then compiles the kernels of a train without a map without
+    # the map's six arrays in every function's model and without the lookups (a None-typed argument
+    # prunes its branch). Six fields, not two tables: a parallel kernel takes no tuple of arrays.
+    traction_map_speeds_ms: np.ndarray | None = None
+    traction_map_forces_n: np.ndarray | None = None
+    traction_map_values: np.ndarray | None = None
+    regen_map_speeds_ms: np.ndarray | None = None
+    regen_map_forces_n: np.ndarray | None = None
+    regen_map_values: np.ndarray | None = None
 
 
-def efficiency_map_arrays(efficiency_map) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The kernels' arrays of an :class:`~pymoo_rail.model.EfficiencyMap` (empty for ``None``)."""
+def efficiency_map_arrays(efficiency_map) -> tuple:
+    """The kernels' arrays of an :class:`~pymoo_rail.model.EfficiencyMap`: (speeds m/s, forces N,
+    values), C-contiguous (one compiled signature); three ``None`` for ``None``."""
     if efficiency_map is None:
-        return np.empty(0), np.empty(0), np.empty((0, 0))
-    return efficiency_map.table_si()
+        return None, None, None
+    return tuple(np.ascontiguousarray(a) for a in efficiency_map.table_si())
 
 
 def build_kernel_model(case: Case, grid: TrackGrid | None = None, dx_m: float | None = None) -> KernelModel:
@@ -203,28 +207,45 @@ def map_efficiency(speeds, forces, values, v, f):
 
 
 @inlined
+def map_excess(speeds, forces, values, eta_ref, v, f, work_j):
+    """Electrical energy of the traction work ``work_j`` at (``v``, ``f``) by a map beyond ``work_j /
+    eta_ref`` (J): zero without a map (``values`` None: Numba prunes the lookup), and exactly zero
+    where the map gives ``eta_ref``, so that a constant map reproduces the constant bit for bit."""
+    if values is None:
+        return 0.0
+    eta = map_efficiency(speeds, forces, values, v, f)
+    if eta == eta_ref:
+        return 0.0
+    return work_j / eta - work_j / eta_ref
+
+
+@inlined
+def map_shortfall(speeds, forces, values, eta_ref, v, f_electric, work_j):
+    """Regenerated energy of the electric braking work ``work_j`` at (``v``, ``f_electric``) by a map
+    short of ``eta_ref x work_j`` (J): zero without a map (``values`` None) or where it gives ``eta_ref``."""
+    if values is None:
+        return 0.0
+    eta = map_efficiency(speeds, forces, values, v, f_electric)
+    if eta == eta_ref:
+        return 0.0
+    return eta_ref * work_j - eta * work_j
+
+
+@inlined
 def traction_map_excess(m, v, f, work_j):
     """Electrical energy of the traction work ``work_j`` at (``v``, ``f``) beyond ``work_j /
     traction_efficiency`` (J): zero without a map, and exactly zero where the map gives the constant,
     so that a constant map reproduces the constant efficiency bit for bit."""
-    if m.traction_map_values.shape[0] == 0:
-        return 0.0
-    eta = map_efficiency(m.traction_map_speeds_ms, m.traction_map_forces_n, m.traction_map_values, v, f)
-    if eta == m.traction_efficiency:
-        return 0.0
-    return work_j / eta - work_j / m.traction_efficiency
+    return map_excess(m.traction_map_speeds_ms, m.traction_map_forces_n, m.traction_map_values, m.traction_efficiency,
+                      v, f, work_j)
 
 
 @inlined
 def regen_map_shortfall(m, v, f_electric, work_j):
     """Regenerated energy of the electric braking work ``work_j`` at (``v``, ``f_electric``) short of
     ``regen_efficiency x work_j`` (J): zero without a map or where it gives the constant."""
-    if m.regen_map_values.shape[0] == 0:
-        return 0.0
-    eta = map_efficiency(m.regen_map_speeds_ms, m.regen_map_forces_n, m.regen_map_values, v, f_electric)
-    if eta == m.regen_efficiency:
-        return 0.0
-    return m.regen_efficiency * work_j - eta * work_j
+    return map_shortfall(m.regen_map_speeds_ms, m.regen_map_forces_n, m.regen_map_values, m.regen_efficiency,
+                         v, f_electric, work_j)
 
 
 # Relative tolerance of a landing: the force it needs may exceed what the train has by this much
@@ -264,7 +285,7 @@ def braking_shortfall(m, v0, v1, cell):
     return need - max_braking(m, v_mid, cell)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def braking_envelope(m):
     """Highest speed at each node from which maximum braking still meets every limit ahead.
 
