@@ -164,7 +164,7 @@ def test_changed_package_code_with_the_same_version_reruns(tmp_path, monkeypatch
     study = _zdt_study()
     run_study(study, tmp_path, workers=1, progress=False)
     assert run_study(study, tmp_path, workers=1, progress=False).n_skipped == 1
-    monkeypatch.setattr(inputs_module, "package_digest", lambda: "sha256:" + "0" * 32)
+    monkeypatch.setattr(inputs_module, "package_digest", lambda parts=None: "sha256:" + "0" * 32)
     report = run_study(study, tmp_path, workers=1, progress=False)
     assert report.n_finished == 1 and "pymoo-rail code changed" in report.redone[0]
     assert "same version string" in report.redone[0]
