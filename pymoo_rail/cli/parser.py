@@ -20,7 +20,7 @@ examples:
   pymoo-rail cases                                  list the built-in cases
   pymoo-rail cases yizhuang                         describe one case
   pymoo-rail optimize yizhuang --out out/           NSGA-II on energy and time error (about 3 s
-                                                    of CPU; the first run compiles, about 18 s more)
+                                                    of CPU; the first run compiles, about 15 s more)
   pymoo-rail optimize yizhuang --algorithm moabc --pop-size 40 --n-gen 100 --seed 3 --out out/moabc
   pymoo-rail optimize yizhuang --objectives energy --time-tolerance 1 --algorithm abc --out out/abc
   pymoo-rail reference yizhuang --out out/ref       the exact minimum-energy front
