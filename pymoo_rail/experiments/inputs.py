@@ -94,16 +94,28 @@ def _module_digest(path: str) -> str | None:
 
 
 def front_digest(problem) -> str:
-    """The digest of the reference front a run of ``problem`` is scored and logged against (its content).
+    """The digest of the content of the reference front a run of ``problem`` is scored and logged against.
 
-    The front is :func:`~pymoo_rail.experiments.metrics.true_front_and_reason`'s, as the run reads
-    it (shape and float64 bytes); a problem without one gives the reason instead.
+    A front the exact solver certified counts as the file it is cached in (its nodes to 9
+    significant digits, :meth:`~pymoo_rail.optimal.reference.CertifiedFront.to_csv_text`): the
+    process that computes a front holds its nodes to the last bit, every later one reads them back
+    from the cache, and both must give one digest. The ``-bi`` and ``-single`` fronts
+    (``pareto_front()``) are computed from those nodes by code in :data:`SUITE_RUN_PARTS`. Any
+    other front counts by its array as the run reads it (shape and float64 bytes): a ``-3obj``
+    instance's inner points (cached to 17 digits, exact) next to its line's certified front, a
+    trip's exact optimum. A problem without a front gives the reason instead.
     """
     pf, reason = true_front_and_reason(problem)
     if pf is None:
         return f"none: {reason}"
     pf = np.ascontiguousarray(pf, dtype=float)
-    return _digest(str(pf.shape).encode() + pf.tobytes())
+    array = str(pf.shape).encode() + pf.tobytes()
+    certified = getattr(problem, "certified_front", None)
+    if not callable(certified):
+        return _digest(array)
+    nodes = certified().to_csv_text().encode()
+    derived = len(problem.objectives) < 3  # -bi, -single: pareto_front() comes from the nodes
+    return _digest(nodes if derived else nodes + b"\0" + array)
 
 
 def _instance_inputs(params: Mapping[str, Any]) -> dict[str, str]:
@@ -159,7 +171,8 @@ def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
 # the problem and the algorithm, the penalty, the history and the record's indicators). Not in it,
 # because a run never executes them or gets their output only as content fingerprinted on its own:
 # cases (the generated line and train are in the instance checksum, by content), optimal (the
-# planner's window and time tolerance are in the checksum, the front by the digest of its content),
+# planner's window and time tolerance are in the checksum, the front by the digest of its content;
+# only optimal/reference/front.py, which turns a front's nodes into pareto_front(), is a part),
 # control (imported for a type; a suite instance has no tracker), journeys (for the -trip families
 # only), suite's loggers and shipped files, cli, plotting and the other studies.
 # tests/experiments/test_suite_fingerprint.py runs suite runs in a fresh interpreter and fails if
@@ -167,7 +180,7 @@ def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
 SUITE_RUN_PARTS = (
     "constants.py", "model", "sim",
     "problems/__init__.py", "problems/lazy.py", "problems/speed_profile.py", "problems/objectives.py",
-    "problems/reference.py", "problems/encodings",
+    "problems/reference.py", "problems/encodings", "optimal/reference/front.py",
     "suite/families.py", "suite/comfort.py", "suite/trips.py", "suite/identity.py", "suite/problems.py",
     "algorithms", "indicators",
     "experiments/runner.py", "experiments/registry.py", "experiments/spec.py", "experiments/penalty.py",

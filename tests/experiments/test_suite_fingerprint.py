@@ -15,9 +15,9 @@ import os
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import pymoo_rail
@@ -27,6 +27,7 @@ from pymoo_rail.experiments.inputs import (SUITE_RUN_PARTS, TRIP_RUN_PARTS, code
 from pymoo_rail.experiments.runner import run_study
 from pymoo_rail.experiments.spec import Budget, RunSpec, Study, algorithm, problem
 from pymoo_rail.suite import get_problem
+from pymoo_rail.suite.families import FamilyProblem
 
 PACKAGE = Path(pymoo_rail.__file__).resolve().parent
 PROBE = Path(__file__).with_name("suite_run_probe.py")
@@ -36,7 +37,8 @@ FAMILY = "generated-metro-bi"
 EXECUTED_OUTSIDE = {
     "cases": "generate the instance's line and train, whose content is in the instance checksum (case_hash)",
     "optimal/reference": "the planner's window and the time tolerance are in the instance checksum; the front "
-                         "is read (or computed) here, and its content is in 'problem reference front'",
+                         "is read (or computed) here, and its content is in 'problem reference front' (front.py, "
+                         "which turns its nodes into pareto_front(), is a part)",
     "experiments/inputs.py": "computes the fingerprint itself, not a number of the run",
     "atomic.py": "writes a computed inner front of a -3obj instance to the cache, whose content is fingerprinted",
 }
@@ -106,13 +108,15 @@ def test_code_parts_per_problem_kind():
     assert code_parts(problem("suite_family", family="atlantis-bi")) == SUITE_RUN_PARTS  # the run reports it
     assert code_parts(problem("zdt1")) is None
     assert code_parts(problem("rail_suite", suite_problem="yizhuang-bi")) is None
-    for path in ("control", "optimal/dp.py", "cli", "plotting", "journeys", "cases", "suite/coco_logger.py"):
+    for path in ("control", "optimal/dp.py", "optimal/reference/store.py", "cli", "plotting", "journeys", "cases",
+                 "suite/coco_logger.py"):
         assert not in_parts(path, SUITE_RUN_PARTS)
     assert in_parts("journeys/problem.py", TRIP_RUN_PARTS)
 
 
 @pytest.mark.parametrize("edited, suite_changes, trip_changes", [
     ("control/controllers.py", False, False), ("optimal/dp.py", False, False), ("cli/app.py", False, False),
+    ("optimal/reference/store.py", False, False), ("optimal/reference/front.py", True, True),
     ("plotting/fronts.py", False, False), ("suite/coco_logger.py", False, False), ("cases/railjson.py", False, False),
     ("journeys/allocation.py", False, True),
     ("sim/kernel.py", True, True), ("constants.py", True, True), ("algorithms/moabc.py", True, True),
@@ -156,18 +160,35 @@ def test_stored_suite_runs_stay_current_after_a_change_outside_and_are_redone_af
     assert report.n_finished == 1 and "pymoo-rail code changed" in report.redone[0]
 
 
+def _scaled_front(front, factor: float):
+    """The front with every node's energy times ``factor`` (another solver's answer)."""
+    table = front.table.copy()
+    table["energy_kwh"] = table["energy_kwh"] * factor
+    return replace(front, table=table)
+
+
 def test_stored_suite_runs_are_redone_when_the_front_content_changes(tmp_path, monkeypatch):
     study = _suite_study()
     run_study(study, tmp_path, workers=1, progress=False)
-    real = inputs_module.true_front_and_reason
-
-    def moved(problem):  # another front (a solver that finds lower energies): the same code digest
-        pf, reason = real(problem)
-        return pf * np.array([0.99, 1.0]), reason
-
-    monkeypatch.setattr(inputs_module, "true_front_and_reason", moved)
+    real = FamilyProblem.certified_front
+    # another front (a solver that finds 1 % lower energies): the same code digest
+    monkeypatch.setattr(FamilyProblem, "certified_front", lambda self: _scaled_front(real(self), 0.99))
     report = run_study(study, tmp_path, workers=1, progress=False)
     assert report.n_finished == 1 and "problem reference front changed" in report.redone[0]
+
+
+def test_a_front_counts_as_cached_so_the_process_that_computed_it_agrees_with_later_ones(monkeypatch):
+    """The cache holds a front's nodes to 9 digits: a difference below that is no change, one above is."""
+    problem = get_problem(FAMILY, n_var=10, seed=1)
+    before = front_digest(problem)
+    real = FamilyProblem.certified_front
+    for factor, same in ((1 + 1e-12, True), (1 + 1e-6, False)):
+        monkeypatch.setattr(FamilyProblem, "certified_front", lambda self, f=factor: _scaled_front(real(self), f))
+        assert (front_digest(get_problem(FAMILY, n_var=10, seed=1)) == before) is same
+    monkeypatch.setattr(FamilyProblem, "certified_front", real)
+    # a -3obj front is its inner points (cached exactly) with its line's certified front
+    inner = front_digest(get_problem("generated-metro-3obj", n_var=10, seed=1))
+    assert inner.startswith("sha256:") and inner != before
 
 
 def test_the_front_digest_is_of_its_content():
