@@ -74,10 +74,29 @@ def test_performance_profile_reaches_one_for_the_best_at_tau_one():
     assert profile["b"].tolist() == [0.0, 0.5, 0.5, 1.0]
 
 
-def test_convergence_holds_each_generation(records):
-    history = convergence(records)
-    assert set(history["algorithm"]) == {"nsga2", "random"}
-    assert history.groupby(["algorithm", "seed"])["n_eval"].max().max() <= 200
+def test_a_suite_record_holds_raw_vectors_and_nothing_scored_against_the_front(records):
+    record = records[0]
+    assert not {"igd", "hv", "gd"} & set(record["indicators"]) and "igd" in record["unavailable"]
+    assert not {"igd", "hv", "error"} & set(record["history"])
+    checkpoints = record["checkpoints"]
+    assert checkpoints["target_n_eval"] == [200] and checkpoints["n_eval"] == [200]  # 200 of the ladder, then the end
+    F = np.asarray(checkpoints["F"][0])
+    assert F.shape[1] == 2 and len(np.unique(F, axis=0)) == len(F)
+    assert not any((F[j] <= F[i]).all() and (F[j] < F[i]).any() for i in range(len(F)) for j in range(len(F)))
+
+
+def test_convergence_scores_each_checkpoint_and_the_final_front(records):
+    longer = execute_run(RunSpec(problem("suite_family", family=FAMILY, n_var=10, seed=1), algorithm("nsga2", pop_size=50),
+                                 1, Budget("n_eval", 1200)))
+    assert longer["checkpoints"]["target_n_eval"] == [200, 500, 1000]
+    assert longer["checkpoints"]["n_eval"] == [200, 500, 1000]
+    history = convergence([{**longer, "algorithm_label": "nsga2"}])
+    assert history["n_eval"].tolist() == [200, 500, 1000, 1200]
+    final = baseline_indicators(longer)
+    assert history.iloc[-1]["igd_plus"] == final["igd_plus"]
+    # elitist NSGA-II: its front at 1000 evaluations is no worse than at 200 (it keeps its non-dominated members)
+    assert history.iloc[2]["hv_norm"] >= history.iloc[0]["hv_norm"]
+    assert set(convergence(records)["algorithm"]) == {"nsga2", "random"}
 
 
 def test_a_3obj_record_scores_against_its_bounded_front(tmp_path, monkeypatch):
