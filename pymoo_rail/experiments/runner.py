@@ -87,7 +87,7 @@ CHECKPOINT_DIGITS = 10
 """Significant digits of the objective vectors kept at the checkpoints (a record stays small)."""
 
 
-def _true_front_values(pop, penalised: bool) -> tuple[np.ndarray, np.ndarray]:
+def true_objectives(pop, penalised: bool) -> tuple[np.ndarray, np.ndarray]:
     """Objectives and constraint violation of ``pop`` on the problem itself (not the penalised one)."""
     if not penalised:
         F, CV = pop.get("F", "CV")
@@ -133,7 +133,7 @@ class _History:
         n_eval = int(algorithm.evaluator.n_eval)
         row: dict[str, float] = {"n_gen": float(algorithm.n_iter), "n_eval": float(n_eval)}
         if opt is not None and len(opt):
-            F, CV = _true_front_values(opt, self.penalised)
+            F, CV = true_objectives(opt, self.penalised)
             row.update(convergence_point(F[CV <= 0.0], self.pf))
             reached = [t for t in self.targets if t <= n_eval]
             if reached:

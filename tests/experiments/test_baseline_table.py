@@ -113,3 +113,24 @@ def test_a_3obj_record_scores_against_its_bounded_front(tmp_path, monkeypatch):
     best = baseline_indicators(inner)  # the inner points: IGD+ 0, HV their share of the outer bound's
     assert best["igd_plus"] == pytest.approx(0.0, abs=1e-9)
     assert best["hv_norm"] == pytest.approx(bounded.hv_inner / bounded.hv_outer)
+
+
+def test_the_checkpoints_of_a_penalised_search_hold_true_objectives_and_violations():
+    from pymoo.core.evaluator import Evaluator
+    from pymoo.core.population import Population
+
+    from pymoo_rail.experiments.penalty import PenalisedConstraints
+    from pymoo_rail.experiments.runner import non_dominated_feasible, true_objectives
+
+    instance = get_problem(FAMILY, n_var=10, seed=1)
+    X = np.vstack([instance.xl, instance.xu, (instance.xl + instance.xu) / 2,
+                   np.random.default_rng(3).uniform(instance.xl, instance.xu, (20, 10))])
+    truth = Evaluator().eval(instance, Population.new(X=X))
+    searched = Evaluator().eval(PenalisedConstraints(instance), Population.new(X=X))
+    F, CV = true_objectives(searched, penalised=True)
+    np.testing.assert_array_equal(F, truth.get("F"))
+    np.testing.assert_allclose(CV, truth.get("CV").reshape(-1))
+    assert (CV > 0).any() and not np.array_equal(searched.get("F"), F)  # the corners are infeasible, penalised
+    kept = non_dominated_feasible(F, CV)
+    feasible = F[CV <= 0]
+    assert len(kept) <= len(feasible) and all(np.isclose(feasible, row, rtol=1e-9).all(axis=1).any() for row in kept)
