@@ -118,7 +118,8 @@ class _History:
     Given ``checkpoints`` (evaluations, a suite family run: :data:`CHECKPOINTS_EVAL`), it also keeps
     the non-dominated feasible objective vectors of the first generation at or past each of them,
     raw, for the report to score against the front of its time; ``pf`` is then None, so nothing of
-    the record depends on the front.
+    the record depends on the front. ``snapshots`` (the record's ``checkpoints``): ``target_n_eval``
+    (the largest checkpoint a generation reached), ``n_eval`` (that generation's) and ``F``.
     """
 
     def __init__(self, pf: np.ndarray | None, checkpoints: tuple[int, ...] = (), penalised: bool = False):
@@ -191,11 +192,8 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
     its threads), the algorithm's :func:`run_counters`, the per-generation history and the versions
     of pymoo and pymoo-rail.
 
-    A suite family run (``problem = "suite_family"``) computes nothing against its front: no
-    indicator of the front (``unavailable`` says why) and no IGD / HV in its history, but the
-    non-dominated feasible objective vectors at :data:`CHECKPOINTS_EVAL` under ``checkpoints``
-    (``target_n_eval``, the ``n_eval`` of the generation that reached it, ``F``), which
-    :mod:`pymoo_rail.experiments.baseline` scores against the front of its own time.
+    A suite family run reads no front: no front indicator, no IGD / HV in ``history``, but ``checkpoints``
+    (:class:`_History`), which :mod:`pymoo_rail.experiments.baseline` scores against the front of its time.
     """
     from pymoo.core.evaluator import Evaluator
     from pymoo.core.population import Population
@@ -207,8 +205,7 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
     # an algorithm without constraint handling (MOEA/D) searches the penalised problem; its front is
     # then evaluated again on the problem itself, so the record holds true objectives and violations
     penalised = problem.has_constraints() and not handles_constraints(algorithm)
-    # a suite family run keeps raw objective vectors instead: the report scores them against the front
-    # of its own time (pymoo_rail.experiments.baseline), so a better exact solver keeps the record
+    # a suite run keeps raw vectors, scored by the report: a better exact solver keeps the record
     raw = is_suite_family(run.problem)
     pf, front_reason = (None, RAW_RECORD_REASON) if raw else true_front_and_reason(problem)
     history = _History(pf, CHECKPOINTS_EVAL if raw else (), penalised) if run.history else None

@@ -134,3 +134,18 @@ def test_the_checkpoints_of_a_penalised_search_hold_true_objectives_and_violatio
     kept = non_dominated_feasible(F, CV)
     feasible = F[CV <= 0]
     assert len(kept) <= len(feasible) and all(np.isclose(feasible, row, rtol=1e-9).all(axis=1).any() for row in kept)
+
+
+@pytest.mark.parametrize("checkpoints", [{"n_eval": [200], "F": []}, {"n_eval": [200], "F": [[[1.0, 2.0, 3.0]]]},
+                                         {"F": [[[1.0, 2.0]]]}, "200", {"n_eval": [200], "F": [[["a", 2.0]]]}])
+def test_a_record_with_malformed_checkpoints_is_refused_naming_the_field(records, tmp_path, checkpoints):
+    from pymoo_rail.experiments.store import RecordError, ResultStore
+
+    store = ResultStore(tmp_path)
+    store.prepare()
+    good = copy.deepcopy(records[0])
+    store.write(good)
+    assert store.load(good["run_id"])["checkpoints"] == records[0]["checkpoints"]
+    store.write({**good, "checkpoints": checkpoints})
+    with pytest.raises(RecordError, match="field 'checkpoints'"):
+        store.load(good["run_id"])
