@@ -151,7 +151,8 @@ def fronts_statement(fronts: pd.DataFrame) -> str:
     """A report's sentence on the fronts it scored against (:func:`front_versions`): their versions and
     one digest of their content digests, so two reports say whether they scored against the same fronts."""
     digest = hashlib.sha256("\n".join(fronts["front_digest"]).encode()).hexdigest()[:16]
-    versions = ", ".join(f"{v} ({n} instances)" for v, n in fronts["front_version"].value_counts().sort_index().items())
+    versions = ", ".join(f"{v} ({n} instance{'s' if n > 1 else ''})"
+                         for v, n in fronts["front_version"].value_counts().sort_index().items())
     return (f"Scored against the fronts of version {versions}; their content digests "
             f"(`pymoo_rail.experiments.inputs.front_digest`, one per instance) hash to `{digest}`.")
 

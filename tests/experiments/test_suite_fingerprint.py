@@ -189,7 +189,7 @@ def test_stored_suite_runs_stay_current_when_the_front_improves_and_their_scores
     assert after["hv_norm"] != before["hv_norm"]
     fronts = front_versions(records)
     assert fronts["front_version"].tolist() == ["99"] and fronts["front_digest"].tolist() == [front_digest(instance)]
-    assert "version 99 (1 instances)" in fronts_statement(fronts)
+    assert "version 99 (1 instance)" in fronts_statement(fronts)
 
 
 @pytest.mark.parametrize("family", [FAMILY, "generated-metro-3obj"])
