@@ -252,13 +252,15 @@ def sweep_cpu(seed: int, factor: float, repeats: int = 5) -> list[str]:
     terminal_j = dp.terminal_cost(model, n_speeds, bias, solver.end_speed_ms[0])
     lines = [f"{case.name}: {n - 1} cells, {tables[0].shape[0]} kinds of cell, {n_speeds} speed nodes, lambda "
              f"{lambda_w:.0f} W (load average {os.getloadavg()[0]:.1f})"]
+    no_curves = dp.curve_controls(model, sing_v[:, 2:], sing_p[:, 2:], n_speeds, solver.max_targets, bias)
     for singular in (True, False, True, False):
         if singular:
             dp.singular_speeds(model, prices + model.aux_power_w, n_speeds, bias, sing_v, sing_p)
         else:
             sing_v[:], sing_p[:] = 0.0, -1.0
         sweep_s = best_cpu_s(lambda: dp.backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v,
-                                                       sing_p, sing_val, solver.max_targets, bias), repeats)
+                                                       sing_p, sing_val, solver.max_targets, bias, no_curves),
+                             repeats)
         run_s = best_cpu_s(lambda: dp.forward_run(model, prices + model.aux_power_w, value, solver.max_targets, bias,
                                                   solver.tie_j, sing_v, sing_p, sing_val), repeats)
         lines.append(f"singular speeds {'on ' if singular else 'off'}: backward sweep {sweep_s * 1e3:.1f} ms, "

@@ -620,9 +620,8 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     """
     modes, targets, pos, energy, dt, u1s = table
     top_u = m.envelope_ms[cell + 1] ** 2
-    tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
-    co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
-    br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
+    steps = cell_steps(m, v0, cell)
+    tr_u, co_u = steps[0], steps[3]
     n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
     n_sing = sing_v.shape[0]
     k_lo, stride, n_nodes = 1, 1, 0
@@ -639,23 +638,46 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
             target = sing_v[c - n_fixed]
             if sing_p[c - n_fixed] < 0.0:
                 continue
-            # out of reach (``cell_outcome``'s rule): ``toward`` is the traction or coast step, entries already
-            if (tr_u <= target * target) if v0 < target else (co_u >= target * target):
+            if out_of_reach(v0, target, tr_u, co_u):
                 continue
         else:  # partial traction (or braking) landing exactly on a speed node of the next position
             mode = MODE_TOWARD
             target = math.sqrt(node_u(top_u, k_lo + (c - n_fixed - n_sing) * stride, k_max, bias))
-        u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost`` does
-        e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
+        u1s[p], energy[p], dt[p], pos[p] = control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias)
         modes[p] = mode
         targets[p] = target
-        u1s[p] = u1
-        energy[p] = e
-        dt[p] = d
-        pos[p] = value_position(top_u, u1, k_max, bias) if e < INF else -1.0
         p += 1
     return p
+
+
+@inlined
+def cell_steps(m, v0, cell):
+    """The cell's full traction, coast and brake steps from ``v0`` (``full_step``), shared by every control:
+    ``(tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)``."""
+    tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
+    co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
+    br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
+    return tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w
+
+
+@inlined
+def out_of_reach(v0, target, tr_u, co_u):
+    """Whether ``toward target`` from ``v0`` is only the traction or coast step (``cell_outcome``'s rule), an
+    entry of the control table already: then it is not a control of its own."""
+    return (tr_u <= target * target) if v0 < target else (co_u >= target * target)
+
+
+@inlined
+def control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias):
+    """One entry of a control table (:func:`control_table`): ``(u1, energy J, time s, node position)``.
+
+    The energy is priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price
+    as ``cell_cost`` does; the position is -1 where the train stops in the cell (infinite energy).
+    """
+    u1, f, w0 = cell_outcome(m, v0, cell, mode, target, steps[0], steps[1], steps[2], steps[3], steps[4], steps[5],
+                             steps[6], steps[7], steps[8])
+    e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
+    return u1, e, d, (value_position(top_u, u1, k_max, bias) if e < INF else -1.0)
 
 
 @inlined
@@ -815,46 +837,145 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
     return (*fixed, offsets, *tgt, cell_type)
 
 
+def curve_controls(m, curve_v: np.ndarray, curve_p: np.ndarray, n_speeds: int, max_targets: int, bias: float) -> tuple:
+    """The controls from the coast curves' states that do not depend on the price of time, built once per grid.
+
+    ``curve_v``, ``curve_p`` (n_nodes, n_curves): the curves' speeds and node positions (:func:`coast_curves`,
+    -1: no state). A curve's speed changes from node to node, so its control table
+    (:func:`control_table`) is its own at every node; it depends on the price only through its
+    ``toward`` entries onto the singular speeds ``V``, ``W`` of the next position. The rest (fixed
+    controls, node targets, ``toward`` the next position's curve speeds) is tabulated here, once, rather
+    than in every sweep (:func:`backward_sweep` adds the ``V``, ``W`` entries per price, from the cell's
+    full steps kept here).
+
+    Returns ``(row, n_entries, entries, steps)``: ``row`` (n_nodes, n_curves) the row of each state (-1:
+    none), per row its number of entries, ``entries`` (n_rows, 3, size): node position, net energy
+    (J, without the price of time) and time (s) of each entry, and ``steps`` (n_rows, 9), the cell's full
+    steps from the state (:func:`cell_steps`).
+    """
+    n, n_curves = curve_v.shape
+    active = curve_p >= 0.0
+    active[-1] = False  # no cell after the last node
+    row = np.full((n, n_curves), -1, dtype=np.int64)
+    n_rows = int(active.sum())
+    row[active] = np.arange(n_rows)
+    n_entries = np.zeros(n_rows, dtype=np.int64)
+    entries = np.empty((n_rows, 3, N_FIXED + n_curves + max_targets))
+    steps = np.empty((n_rows, 9))
+    if n_rows > 0:  # a case without curves compiles nothing here
+        _fill_curve_controls(m, np.ascontiguousarray(curve_v), np.ascontiguousarray(curve_p), row, n_speeds - 1,
+                             max_targets, bias, n_entries, entries, steps)
+    return row, n_entries, entries, steps
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _fill_curve_controls(m, curve_v, curve_p, row, k_max, max_targets, bias, n_entries, entries, steps):
+    size = entries.shape[2]
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    for i in range(row.shape[0] - 1):
+        for c in range(row.shape[1]):
+            r = row[i, c]
+            if r < 0:
+                continue
+            v0 = curve_v[i, c]
+            count = control_table(m, i, v0, curve_v[i + 1], curve_p[i + 1], k_max, max_targets, bias, table)
+            n_entries[r] = count
+            for p in range(count):
+                entries[r, 0, p] = table[2][p]
+                entries[r, 1, p] = table[3][p]
+                entries[r, 2, p] = table[4][p]
+            st = cell_steps(m, v0, i)
+            for q in range(9):
+                steps[r, q] = st[q]
+
+
+@inlined
+def _toward_states(m, i, v0, lo, hi, steps, price_w, v_next, bias, sing_v, sp_next, sv_next, best):
+    """:func:`_singular_rows`' entries ``toward`` the next position's extra states ``lo .. hi - 1`` from ``v0``
+    (those in reach, :func:`out_of_reach`), each priced as :func:`entry_cost` prices it: the least of
+    them and ``best``."""
+    k_max = v_next.shape[0] - 1
+    top_u = m.envelope_ms[i + 1] ** 2
+    for q in range(lo, hi):
+        target = sing_v[i + 1, q]
+        if sp_next[q] < 0.0 or out_of_reach(v0, target, steps[0], steps[3]):
+            continue
+        e, d, p = control_entry(m, i, v0, np.int64(MODE_TOWARD), target, steps, top_u, k_max, bias)[1:]
+        if e < INF:
+            cost = e + price_w * d
+            cost += interp_aug(v_next, p, sp_next, sv_next)
+            if cost < best:
+                best = cost
+    return best
+
+
 @njit(cache=True, no_cfunc_wrapper=True)
 def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val, memo_key,
-                   memo_n, memo):
-    """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them.
+                   memo_n, memo, memo_steps, curves):
+    """Cost-to-go of the extra states at node ``i`` (:func:`backward_sweep`): every control from them.
 
-    The least :func:`entry_cost` of their control tables (:func:`control_table`), kept per kind of cell
-    ``t`` and singular speed ``s`` in row ``t * n_singular + s`` of ``memo``: a cell of the kind last
-    tabulated from the same singular speed with the same next singular speeds (``memo_key``) reuses the
-    table, the same numbers bit for bit, so a sweep pays the simulator's steps once per kind of cell
-    rather than once per cell and price of time (``benchmarks/peers.py --sweep-cpu``: with :func:`interp_split`, a
-    sweep of the 32 km generated line of seed 21 takes 27 ms against 74 ms, 22 ms without them).
+    The least :func:`entry_cost` of their control tables (:func:`control_table`), as a set (the least
+    cost does not depend on the order of the entries). For the singular speeds ``V``, ``W`` the table
+    without the ``toward`` entries onto the coast curves is kept per kind of cell ``t`` and singular
+    speed ``s`` in row ``t * N_SINGULAR + s`` of ``memo``: a cell of the kind last tabulated from the
+    same singular speed with the same next singular speeds (``memo_key``) reuses it, the same numbers bit
+    for bit, so a sweep pays the simulator's steps once per kind of cell rather than once per cell and
+    price of time (``benchmarks/peers.py --sweep-cpu``). The coast curves' entries (their speeds change
+    per node) are added per node from the cell's full steps kept in ``memo_steps``. A coast curve's own
+    table comes from ``curves`` (:func:`curve_controls`, built once per grid), its ``toward`` entries
+    onto ``V``, ``W`` added here.
     """
     sp_next = sing_p[i + 1]
     sv_next = sing_val[i + 1]
     n_sing = sing_v.shape[1]
+    n_own = min(n_sing, N_SINGULAR)
+    curve_row, curve_n, curve_entries, curve_steps = curves
     for s in range(n_sing):
         sing_val[i, s] = PENALTY_J
         if sing_p[i, s] < 0.0 or sing_p[i, s] < floor_k:
             continue
         v0 = sing_v[i, s]
-        row = t * n_sing + s
-        table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row], memo[5][row])
-        # the table's key: the speed held and the next position's singular targets (-1: none there)
-        key = memo_key[row]
-        same = key[0] == v0
-        for q in range(n_sing):
-            same = same and key[q + 1] == (sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0)
-        if not same:
-            memo_n[row] = control_table(m, i, v0, sing_v[i + 1], sp_next, v_next.shape[0] - 1, max_targets, bias,
-                                        table)
-            key[0] = v0
-            for q in range(n_sing):
-                key[q + 1] = sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0
-        best = table_minimum(table, memo_n[row], price_w, v_next, sp_next, sv_next)[0]
+        if s < N_SINGULAR:
+            row = t * N_SINGULAR + s
+            table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row], memo[5][row])
+            # the table's key: the speed held and the next position's singular targets (-1: none there)
+            key = memo_key[row]
+            same = key[0] == v0
+            for q in range(n_own):
+                same = same and key[q + 1] == (sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0)
+            if not same:
+                memo_n[row] = control_table(m, i, v0, sing_v[i + 1, :n_own], sp_next[:n_own], v_next.shape[0] - 1,
+                                            max_targets, bias, table)
+                st = cell_steps(m, v0, i)
+                for q in range(9):
+                    memo_steps[row, q] = st[q]
+                key[0] = v0
+                for q in range(n_own):
+                    key[q + 1] = sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0
+            best = table_minimum(table, memo_n[row], price_w, v_next, sp_next, sv_next)[0]
+            best = _toward_states(m, i, v0, n_own, n_sing, memo_steps[row], price_w, v_next, bias, sing_v, sp_next,
+                                  sv_next, best)
+        else:
+            r = curve_row[i, s - N_SINGULAR]
+            if r < 0:  # not a state of ``curves``: the sweep's extra states and ``curves`` come from one arrival
+                continue
+            best = INF
+            for p in range(curve_n[r]):
+                e = curve_entries[r, 1, p]
+                if e < INF:
+                    cost = e + price_w * curve_entries[r, 2, p]
+                    cost += interp_aug(v_next, curve_entries[r, 0, p], sp_next, sv_next)
+                    if cost < best:
+                        best = cost
+            best = _toward_states(m, i, v0, 0, n_own, curve_steps[r], price_w, v_next, bias, sing_v, sp_next, sv_next,
+                                  best)
         sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
-                   floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias):
+                   floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias, curves):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
@@ -871,7 +992,9 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     from them with the simulator's steps (:func:`control_table`, as in the forward run, prices
     ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
     through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
-    them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone.
+    them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone. Their columns
+    after the first ``N_SINGULAR`` are the coast curves (:func:`coast_curves`), whose price-independent
+    controls ``curves`` holds (:func:`curve_controls` of those columns, built once per grid).
     """
     n, n_speeds = value.shape
     # at the end of the line the top node is the final speed (the envelope ends there; 0 at a
@@ -884,11 +1007,12 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     # the singular speeds' control tables, one per kind of cell and singular speed, filled as the sweep
     # meets them (:func:`_singular_rows`); a key of NaN matches nothing
     n_sing = sing_v.shape[1]
-    n_rows = (offsets.shape[0] - 1) // n_speeds * n_sing
-    memo_key = np.full((n_rows, 1 + n_sing), np.nan)
+    n_rows = (offsets.shape[0] - 1) // n_speeds * N_SINGULAR
+    memo_key = np.full((n_rows, 1 + N_SINGULAR), np.nan)
     split = np.zeros(n_speeds, dtype=np.bool_)  # :func:`interp_split`
     memo_n = np.zeros(n_rows, dtype=np.int64)
-    size = N_FIXED + n_sing + max_targets
+    memo_steps = np.empty((n_rows, 9))
+    size = N_FIXED + N_SINGULAR + max_targets
     memo = (np.empty((n_rows, size), dtype=np.int64), np.empty((n_rows, size)), np.empty((n_rows, size)),
             np.empty((n_rows, size)), np.empty((n_rows, size)), np.empty((n_rows, size)))
     for i in range(n - 2, -1, -1):
@@ -901,7 +1025,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
             if q >= 0.0 and q != math.floor(q):
                 split[int(q)] = True
         _singular_rows(m, i, t, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
-                       sing_val, memo_key, memo_n, memo)
+                       sing_val, memo_key, memo_n, memo, memo_steps, curves)
         for j in range(n_speeds):
             best = INF
             for c in range(fixed_e.shape[2]):  # N_FIXED, and the part-power shares where the train has them
@@ -1020,7 +1144,7 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
 
 def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray,
           floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None, singular: bool = True,
-          sing: tuple | None = None, reuse: bool = False, arrival: tuple | None = None):
+          sing: tuple | None = None, reuse: bool = False, arrival: tuple | None = None, curves: tuple | None = None):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
@@ -1042,7 +1166,8 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     earlier solve at the same price and settings: only the forward run is made (the certificate's run
     without the tie rule reuses the chosen run's sweep). ``arrival``: ``(curve_v, curve_p)`` of
     :func:`coast_curves`, the coast curves as further states (the columns of ``sing`` after the first
-    ``N_SINGULAR``; with ``singular`` only).
+    ``N_SINGULAR``; with ``singular`` only). ``curves``: :func:`curve_controls` of ``arrival`` on this grid
+    (the caller keeps them across prices; default: built here).
     """
     n = model.position_m.shape[0]
     if sing is None:
@@ -1064,8 +1189,11 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     else:
         sing_v[:] = 0.0
         sing_p[:] = -1.0
+    if curves is None or not singular:
+        curves = curve_controls(model, sing_v[:, N_SINGULAR:], sing_p[:, N_SINGULAR:], value.shape[1], max_targets,
+                                bias)
     backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v, sing_p, sing_val, int(max_targets),
-                   float(bias))
+                   float(bias), curves)
     return _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, sing_val)
 
 
