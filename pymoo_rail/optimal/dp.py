@@ -94,7 +94,7 @@ def node_position(top_u, u, k_max, bias):
     return (b1 - math.sqrt(disc)) / (2.0 * bias) * k_max
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@inlined
 def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w):
     """What the simulator's ``run_program`` does in one cell for a program row of its own.
 
@@ -135,7 +135,7 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
     return u1, f, w0
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@inlined
 def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     """Net energy of the cell plus ``time_price_w`` x its time (J), and its time (s).
 
