@@ -602,7 +602,7 @@ def _n_targets(k_lo, k_hi, max_targets):
     return (count + stride - 1) // stride, stride
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
 
@@ -897,11 +897,13 @@ def _toward_states(m, i, v0, lo, hi, steps, price_w, v_next, bias, sing_v, sp_ne
     them and ``best``."""
     k_max = v_next.shape[0] - 1
     top_u = m.envelope_ms[i + 1] ** 2
+    # as a tuple, as :func:`control_table` passes them: one compiled copy of :func:`control_entry`
+    st = (steps[0], steps[1], steps[2], steps[3], steps[4], steps[5], steps[6], steps[7], steps[8])
     for q in range(lo, hi):
         target = sing_v[i + 1, q]
-        if sp_next[q] < 0.0 or out_of_reach(v0, target, steps[0], steps[3]):
+        if sp_next[q] < 0.0 or out_of_reach(v0, target, st[0], st[3]):
             continue
-        e, d, p = control_entry(m, i, v0, np.int64(MODE_TOWARD), target, steps, top_u, k_max, bias)[1:]
+        e, d, p = control_entry(m, i, v0, np.int64(MODE_TOWARD), target, st, top_u, k_max, bias)[1:]
         if e < INF:
             cost = e + price_w * d
             cost += interp_aug(v_next, p, sp_next, sv_next)
@@ -910,7 +912,7 @@ def _toward_states(m, i, v0, lo, hi, steps, price_w, v_next, bias, sing_v, sp_ne
     return best
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val, memo_key,
                    memo_n, memo, memo_steps, curves):
     """Cost-to-go of the extra states at node ``i`` (:func:`backward_sweep`): every control from them.
@@ -1268,14 +1270,14 @@ def part_power_shares(m) -> np.ndarray:
     return PART_POWER_SHARES.copy() if varying_maps(m)[0] else np.empty(0)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def part_power_target(m, cell):
     """The target speed of a part-power row (m/s): the braking envelope at the cell's end, which the
     ``toward`` row lands on rather than overshoot (the envelope would stop it there anyway)."""
     return m.envelope_ms[cell + 1]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def part_power_outcome(m, v0, cell, share):
     """The simulator's cell of a ``toward`` row at traction ``share`` (:func:`part_power_target`):
     ``(u1, force_n, w0_n)``, as :func:`cell_outcome` gives it for a row of full traction."""
@@ -1309,7 +1311,7 @@ def part_power_transitions(m, n_speeds: int, bias: float, first_cell: np.ndarray
     return out
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_p, sing_val):
     """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`entry_cost`'s sum)."""
     u1, f, w0 = part_power_outcome(m, v0, cell, share)
@@ -1319,7 +1321,7 @@ def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_
     return cost
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def best_part_power(m, cell, v0, time_price_w, v_next, bias, sing_p, sing_val, shares):
     """The best traction share from ``v0``: the best of ``shares``, refined by golden section between its
     neighbours (0 and 1 at the ends). Returns ``(total_cost, share)``.
