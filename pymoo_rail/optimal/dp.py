@@ -249,6 +249,28 @@ def interp_split(v_next, p, split, sing_p, sing_val):
     return interp_aug(v_next, p, sing_p, sing_val)
 
 
+@inlined
+def sweep_cost(e, time_cost, position, v_next, split, sing_p, sing_val):
+    """A table entry's cost in the backward sweep: energy ``e`` plus ``time_cost`` (its time priced) plus the
+    cost-to-go at node position ``position`` (single precision, as the tables hold it), the arithmetic of
+    :func:`interp_split`, fused: the sweep's cost-to-go is finite everywhere (``PENALTY_J`` at most), so
+    :func:`interp_at`'s infinity checks never hold there, and the node index is found once."""
+    p = np.float64(position)
+    if p < 0.0:
+        return INF
+    k = int(p)
+    if split[k]:
+        return e + time_cost + interp_aug(v_next, p, sing_p, sing_val)
+    k_max = v_next.shape[0] - 1
+    if k >= k_max:
+        return e + time_cost + v_next[k_max]
+    w = p - k
+    a = v_next[k]
+    if w <= 0.0:
+        return e + time_cost + a
+    return e + time_cost + (a + w * (v_next[k + 1] - a))
+
+
 @njit(cache=True, no_cfunc_wrapper=True)
 def interp_value(v_next, top_u, u, bias):
     """Cost-to-go at kinetic energy ``u`` from the nodes ``v_next`` spread over ``[0, top_u]``."""
@@ -1028,22 +1050,20 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
                 split[int(q)] = True
         _singular_rows(m, i, t, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
                        sing_val, memo_key, memo_n, memo, memo_steps, curves)
+        price = time_price_w[i]
         for j in range(n_speeds):
             best = INF
             for c in range(fixed_e.shape[2]):  # N_FIXED, and the part-power shares where the train has them
                 e = fixed_e[t, j, c]
                 if e < INF:
-                    p_next = np.float64(fixed_u1[t, j, c])
-                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_split(v_next, p_next, split, sp_next,
-                                                                                   sv_next)
+                    cost = sweep_cost(e, price * fixed_dt[t, j, c], fixed_u1[t, j, c], v_next, split, sp_next, sv_next)
                     if cost < best:
                         best = cost
             s = t * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    p_next = np.float64(tgt_u1[p])
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_split(v_next, p_next, split, sp_next, sv_next)
+                    cost = sweep_cost(e, price * tgt_dt[p], tgt_u1[p], v_next, split, sp_next, sv_next)
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
