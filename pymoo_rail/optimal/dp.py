@@ -239,22 +239,14 @@ def interp_aug(v_next, p, sing_p, sing_val):
 
 
 @inlined
-def interp_split(v_next, p, split, sing_p, sing_val):
-    """:func:`interp_aug` where ``split[k]`` says whether a singular speed lies inside the interval
-    ``(k, k + 1)`` of the speed nodes: the others take :func:`interp_at`, the same arithmetic without
-    the search for one: ``benchmarks/peers.py --sweep-cpu``, a sweep of generated seed 21 35 -> 27 ms).
-    The sweep passes its float32 positions as float64 (exact): one compiled copy of the interpolations."""
-    if p >= 0.0 and not split[int(p)]:
-        return interp_at(v_next, p)
-    return interp_aug(v_next, p, sing_p, sing_val)
-
-
-@inlined
 def sweep_cost(e, time_cost, position, v_next, split, sing_p, sing_val):
     """A table entry's cost in the backward sweep: energy ``e`` plus ``time_cost`` (its time priced) plus the
-    cost-to-go at node position ``position`` (single precision, as the tables hold it), the arithmetic of
-    :func:`interp_split`, fused: the sweep's cost-to-go is finite everywhere (``PENALTY_J`` at most), so
-    :func:`interp_at`'s infinity checks never hold there, and the node index is found once."""
+    cost-to-go at node position ``position`` (single precision, as the tables hold it).
+
+    ``split[k]`` says whether a singular speed lies inside the interval ``(k, k + 1)`` of the speed nodes:
+    there :func:`interp_aug`, elsewhere :func:`interp_at`'s arithmetic without the search for one and
+    without its infinity checks, which never hold in the sweep (its cost-to-go is ``PENALTY_J`` at most).
+    """
     p = np.float64(position)
     if p < 0.0:
         return INF
@@ -399,12 +391,19 @@ def constant_holding_speeds(m, time_price_w):
     (``W`` 0 without regeneration or at or below its cut-off speed)."""
     n_cells = time_price_w.shape[0]
     v_hold, v_regen = np.zeros(n_cells), np.zeros(n_cells)
+    last = math.nan  # the price solved last: one price over many cells is solved once
+    hold = regen = 0.0
     for i in range(n_cells):
         price = time_price_w[i]
-        v_hold[i] = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
-        if m.regen_efficiency > 0.0:
-            w = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
-            v_regen[i] = w if w > m.regen_min_speed_ms else 0.0
+        if price != last:
+            last = price
+            hold = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
+            regen = 0.0
+            if m.regen_efficiency > 0.0:
+                w = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
+                regen = w if w > m.regen_min_speed_ms else 0.0
+        v_hold[i] = hold
+        v_regen[i] = regen
     return v_hold, v_regen
 
 
@@ -1033,7 +1032,7 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     n_sing = sing_v.shape[1]
     n_rows = (offsets.shape[0] - 1) // n_speeds * N_SINGULAR
     memo_key = np.full((n_rows, 1 + N_SINGULAR), np.nan)
-    split = np.zeros(n_speeds, dtype=np.bool_)  # :func:`interp_split`
+    split = np.zeros(n_speeds, dtype=np.bool_)  # :func:`sweep_cost`
     memo_n = np.zeros(n_rows, dtype=np.int64)
     memo_steps = np.empty((n_rows, 9))
     size = N_FIXED + N_SINGULAR + max_targets
