@@ -44,7 +44,7 @@ from pymoo_rail.sim.kernel import (
     scaled_step,
     share_above,
 )
-from pymoo_rail.sim.jit import inlined
+from pymoo_rail.sim.jit import called, inlined
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
@@ -238,6 +238,13 @@ def interp_aug(v_next, p, sing_p, sing_val):
     return lv + (p - lp) / (rp - lp) * (rv - lv)
 
 
+@called
+def interp_aug_called(v_next, p, sing_p, sing_val):
+    """:func:`interp_aug`, called rather than inlined: the sweep's rare case (an interval holding a singular
+    speed), compiled once instead of at each of the sweep's two call sites of :func:`sweep_cost`."""
+    return interp_aug(v_next, p, sing_p, sing_val)
+
+
 @inlined
 def sweep_cost(e, time_cost, position, v_next, split, sing_p, sing_val):
     """A table entry's cost in the backward sweep: energy ``e`` plus ``time_cost`` (its time priced) plus the
@@ -252,7 +259,7 @@ def sweep_cost(e, time_cost, position, v_next, split, sing_p, sing_val):
         return INF
     k = int(p)
     if split[k]:
-        return e + time_cost + interp_aug(v_next, p, sing_p, sing_val)
+        return e + time_cost + interp_aug_called(v_next, p, sing_p, sing_val)
     k_max = v_next.shape[0] - 1
     if k >= k_max:
         return e + time_cost + v_next[k_max]
@@ -624,7 +631,7 @@ def _n_targets(k_lo, k_hi, max_targets):
 
 
 @njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
-def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
+def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table, steps_out):
     """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
 
     ``table`` is ``(modes, targets, positions, energies, times, u1)``, arrays of at least
@@ -638,10 +645,13 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     them and holding them exactly), and ``toward`` speed nodes of the next position in reach by
     partial traction (or braking). They depend on the kind of the cell (:func:`cell_types`),
     ``v0`` and the next position's singular speeds, not on the price of time or the cost-to-go.
+    ``steps_out`` (9,) receives the cell's full steps from ``v0`` (:func:`cell_steps`).
     """
     modes, targets, pos, energy, dt, u1s = table
     top_u = m.envelope_ms[cell + 1] ** 2
     steps = cell_steps(m, v0, cell)
+    for q in range(9):  # for a caller that adds controls of its own (:func:`_singular_rows`)
+        steps_out[q] = steps[q]
     tr_u, co_u = steps[0], steps[3]
     n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
     n_sing = sing_v.shape[0]
@@ -664,7 +674,7 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
         else:  # partial traction (or braking) landing exactly on a speed node of the next position
             mode = MODE_TOWARD
             target = math.sqrt(node_u(top_u, k_lo + (c - n_fixed - n_sing) * stride, k_max, bias))
-        u1s[p], energy[p], dt[p], pos[p] = control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias)
+        u1s[p], energy[p], dt[p], pos[p] = control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias, 0.0)
         modes[p] = mode
         targets[p] = target
         p += 1
@@ -689,15 +699,17 @@ def out_of_reach(v0, target, tr_u, co_u):
 
 
 @inlined
-def control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias):
-    """One entry of a control table (:func:`control_table`): ``(u1, energy J, time s, node position)``.
+def control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias, time_price_w):
+    """One control of a cell from ``v0``: ``(u1, cost J, time s, node position)`` (``cell_outcome``, ``cell_cost``).
 
-    The energy is priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price
-    as ``cell_cost`` does; the position is -1 where the train stops in the cell (infinite energy).
+    The cost is the net energy plus ``time_price_w`` x the time: a control table (:func:`control_table`)
+    prices at 0 (``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost``
+    does), the transition tables at the auxiliary power. The position is -1 where the train stops in
+    the cell (infinite cost). ``steps``: the cell's full steps from ``v0`` (:func:`cell_steps`).
     """
     u1, f, w0 = cell_outcome(m, v0, cell, mode, target, steps[0], steps[1], steps[2], steps[3], steps[4], steps[5],
                              steps[6], steps[7], steps[8])
-    e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
+    e, d = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
     return u1, e, d, (value_position(top_u, u1, k_max, bias) if e < INF else -1.0)
 
 
@@ -803,31 +815,31 @@ def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, fixed
         t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
-            tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
-            co_u, co_f, co_w, _ = full_step(m, v0, i, KIND_COAST)
-            br_u, br_f, br_w, _ = full_step(m, v0, i, KIND_BRAKE)
-            for c in range(N_FIXED):
-                u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                         br_u, br_f, br_w)
-                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                fixed_u1[t, j, c] = value_position(top1, u1, k_max, bias)
-                fixed_e[t, j, c] = e
-                fixed_dt[t, j, c] = dt
+            steps = cell_steps(m, v0, i)
             s = t * n_speeds + j
-            if offsets[s + 1] == offsets[s]:
-                continue
-            k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
-            stride = _n_targets(k_lo, k_hi, max_targets)[1]
-            p = offsets[s]
-            for k in range(k_lo, k_hi + 1, stride):
-                target = math.sqrt(node_u(top1, k, k_max, bias))
-                u1, f, w0 = cell_outcome(m, v0, i, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                         br_u, br_f, br_w)
-                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                tgt_u1[p] = value_position(top1, u1, k_max, bias)
-                tgt_e[p] = e
-                tgt_dt[p] = dt
-                p += 1
+            n_tgt = offsets[s + 1] - offsets[s]
+            k_lo, stride = 1, 1
+            if n_tgt > 0:
+                k_lo, k_hi = _target_range(top1, k_max, v0 * v0, steps[0], steps[3], bias)
+                stride = _n_targets(k_lo, k_hi, max_targets)[1]
+            # one loop over the fixed controls and the targets: one inlined copy of the cell's physics
+            for c in range(N_FIXED + n_tgt):
+                if c < N_FIXED:
+                    mode = _fixed_mode(c)
+                    target = 0.0
+                else:
+                    mode = MODE_TOWARD
+                    target = math.sqrt(node_u(top1, k_lo + (c - N_FIXED) * stride, k_max, bias))
+                _, e, dt, pos = control_entry(m, i, v0, mode, target, steps, top1, k_max, bias, aux)
+                if c < N_FIXED:
+                    fixed_u1[t, j, c] = pos
+                    fixed_e[t, j, c] = e
+                    fixed_dt[t, j, c] = dt
+                else:
+                    q = offsets[s] + c - N_FIXED
+                    tgt_u1[q] = pos
+                    tgt_e[q] = e
+                    tgt_dt[q] = dt
 
 
 def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = True):
@@ -908,18 +920,15 @@ def _fill_curve_controls(m, curve_v, curve_p, row, k_max, max_targets, bias, n_e
             if r < 0:
                 continue
             v0 = curve_v[i, c]
-            count = control_table(m, i, v0, curve_v[i + 1], curve_p[i + 1], k_max, max_targets, bias, table)
+            count = control_table(m, i, v0, curve_v[i + 1], curve_p[i + 1], k_max, max_targets, bias, table, steps[r])
             n_entries[r] = count
             for p in range(count):
                 entries[r, 0, p] = table[2][p]
                 entries[r, 1, p] = table[3][p]
                 entries[r, 2, p] = table[4][p]
-            st = cell_steps(m, v0, i)
-            for q in range(9):
-                steps[r, q] = st[q]
 
 
-@inlined
+@called
 def _toward_states(m, i, v0, lo, hi, steps, price_w, v_next, bias, sing_v, sp_next, sv_next, best):
     """:func:`_singular_rows`' entries ``toward`` the next position's extra states ``lo .. hi - 1`` from ``v0``
     (those in reach, :func:`out_of_reach`), each priced as :func:`entry_cost` prices it: the least of
@@ -932,7 +941,7 @@ def _toward_states(m, i, v0, lo, hi, steps, price_w, v_next, bias, sing_v, sp_ne
         target = sing_v[i + 1, q]
         if sp_next[q] < 0.0 or out_of_reach(v0, target, st[0], st[3]):
             continue
-        e, d, p = control_entry(m, i, v0, np.int64(MODE_TOWARD), target, st, top_u, k_max, bias)[1:]
+        e, d, p = control_entry(m, i, v0, np.int64(MODE_TOWARD), target, st, top_u, k_max, bias, 0.0)[1:]
         if e < INF:
             cost = e + price_w * d
             cost += interp_aug(v_next, p, sp_next, sv_next)
@@ -977,10 +986,7 @@ def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v,
                 same = same and key[q + 1] == (sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0)
             if not same:
                 memo_n[row] = control_table(m, i, v0, sing_v[i + 1, :n_own], sp_next[:n_own], v_next.shape[0] - 1,
-                                            max_targets, bias, table)
-                st = cell_steps(m, v0, i)
-                for q in range(9):
-                    memo_steps[row, q] = st[q]
+                                            max_targets, bias, table, memo_steps[row])
                 key[0] = v0
                 for q in range(n_own):
                     key[q + 1] = sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0
@@ -999,8 +1005,9 @@ def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v,
                     cost += interp_aug(v_next, curve_entries[r, 0, p], sp_next, sv_next)
                     if cost < best:
                         best = cost
-            best = _toward_states(m, i, v0, 0, n_own, curve_steps[r], price_w, v_next, bias, sing_v, sp_next, sv_next,
-                                  best)
+            # np.int64(0): a run-time int, not a literal (one compiled copy of _toward_states)
+            best = _toward_states(m, i, v0, np.int64(0), n_own, curve_steps[r], price_w, v_next, bias, sing_v, sp_next,
+                                  sv_next, best)
         sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
 
 
@@ -1117,6 +1124,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     size = N_FIXED + sp_all.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
     table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
              np.empty(size))
+    steps = np.empty(9)  # the cell's full steps (:func:`control_table`), not read here
     k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
@@ -1126,7 +1134,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     previous = MODE_TRACTION
     for i in range(n - 1):
         v_next, sp_next, sval_next = value[i + 1], sp_all[i + 1], sval_all[i + 1]
-        n_entries = control_table(m, i, v, sv_all[i + 1], sp_next, k_max, max_targets, bias, table)
+        n_entries = control_table(m, i, v, sv_all[i + 1], sp_next, k_max, max_targets, bias, table, steps)
         cost, p = table_minimum(table, n_entries, time_price_w[i], v_next, sp_next, sval_next)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
@@ -1404,6 +1412,7 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     size = N_FIXED + sing_v.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
     table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
              np.empty(size))
+    steps = np.empty(9)  # the cell's full steps (:func:`control_table`), not read here
     k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
@@ -1411,7 +1420,7 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     previous, previous_share = MODE_TRACTION, 1.0  # the control of the cell before
     for i in range(n - 1):
         price = time_price_w[i]
-        n_entries = control_table(m, i, v, sing_v[i + 1], sing_p[i + 1], k_max, max_targets, bias, table)
+        n_entries = control_table(m, i, v, sing_v[i + 1], sing_p[i + 1], k_max, max_targets, bias, table, steps)
         cost, p = table_minimum(table, n_entries, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
