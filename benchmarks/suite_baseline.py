@@ -33,8 +33,9 @@ from pathlib import Path
 import numba
 
 from pymoo_rail.experiments import read_study, run_study
-from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, convergence, cut_study,
-                                             indicator_frame, performance_profile, projected_cpu_h)
+from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, convergence,
+                                             cpu_per_evaluation_ms, cut_study, indicator_frame, performance_profile,
+                                             projected_cpu_h)
 from pymoo_rail.experiments.report import write_filled
 from pymoo_rail.experiments.results import load_records
 from pymoo_rail.experiments.run_cost import PARTS, cpu_profile, cpu_shares
@@ -130,6 +131,7 @@ def main(argv=None) -> int:
     print(f"wrote {out / 'suite_baseline.md'}")
     if args.estimate:
         hours, sizes = projected_cpu_h(frame, read_study(STUDY_FILE))
+        print("median CPU ms per evaluation\n" + cpu_per_evaluation_ms(frame).round(3).to_string())
         print(f"the whole study (measured n_var {sizes}): {hours:.1f} CPU hours, {hours / 2:.1f} h on 2 cores")
     if args.archive:
         print(f"archive {args.archive}: sha256 {archive_records(args.work, args.archive)}")

@@ -170,6 +170,20 @@ def cut_study(study, families=None, ladder=None, seeds: int | None = None, n_eva
     return replace(study, budget=Budget("n_eval", n_eval)) if n_eval else study
 
 
+def cpu_per_evaluation_ms(frame: pd.DataFrame) -> pd.DataFrame:
+    """Median CPU milliseconds per evaluation of the stored runs, one row per algorithm, one column per n_var.
+
+    The median over the families and seeds of each (algorithm, n_var) keeps out the first run of a
+    process, which pays the compilation (the input of :func:`projected_cpu_h`).
+    """
+    return _median_ms(frame).unstack("n_var")
+
+
+def _median_ms(frame: pd.DataFrame) -> pd.Series:
+    ms = frame.assign(ms=1000.0 * frame["cpu_time_s"] / frame["n_eval"])
+    return ms.groupby(["algorithm", "n_var"])["ms"].median()
+
+
 def projected_cpu_h(frame: pd.DataFrame, full) -> tuple[float, str]:
     """CPU hours of the ``full`` study from measured CPU per evaluation (linear in n_var between measured sizes).
 
@@ -178,7 +192,7 @@ def projected_cpu_h(frame: pd.DataFrame, full) -> tuple[float, str]:
     multiplied by the full study's evaluations, problems and seeds. The median keeps out the first
     run of a process, which pays the compilation. Returns the hours and the measured sizes.
     """
-    per_eval = frame.assign(s=frame["cpu_time_s"] / frame["n_eval"]).groupby(["algorithm", "n_var"])["s"].median()
+    per_eval = _median_ms(frame) / 1000.0
     total_s = 0.0
     for a in full.algorithms:
         if a.display not in per_eval.index.get_level_values(0):
@@ -203,4 +217,5 @@ def archive_records(work: str | Path, path: str | Path, top: str = "suite_baseli
 
 
 __all__ = ["INDICATORS", "RANK_INDICATOR", "instance_of", "baseline_indicators", "indicator_frame", "baseline_table",
-           "performance_profile", "convergence", "cut_study", "projected_cpu_h", "archive_records"]
+           "performance_profile", "convergence", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
+           "archive_records"]

@@ -10,12 +10,18 @@ seed and budget. The result also depends on things a spec only names:
   a record computed on one content and labelled with another;
 - any other file a problem or algorithm parameter names (its bytes);
 - the definition checksum of a suite family instance (``problem = "suite_family"``), so a record
-  computed on another definition of ``(family, n_var, seed)`` is redone;
+  computed on another definition of ``(family, n_var, seed)`` is redone, and the digest of the
+  *content* of the reference front the run is scored and logged against (:func:`front_digest`),
+  so a solver change that leaves the front as it was changes nothing;
 - the module of a ``"package.module:factory"`` spec (its source bytes; looked up only when the
   study is trusted, since finding a module imports its parent packages);
 - the code that computes the result: a digest of the package's own source and data files
   (:func:`package_digest`, computed once per process), and the versions of pymoo-rail, pymoo,
-  numpy and numba.
+  numpy and numba. For a suite family instance the digest covers only the parts a run executes
+  (:func:`code_parts`: :data:`SUITE_RUN_PARTS`, and :data:`TRIP_RUN_PARTS` for the ``-trip``
+  families), so a commit elsewhere in the package (the exact solver, the controllers, the CLI,
+  the plots) keeps the stored runs of a long study; every other problem keeps the digest of the
+  whole package.
 
 :func:`run_inputs` returns these as a flat dict of strings stored with each record;
 :func:`changed_inputs` says, in words, what differs between a stored and a current fingerprint.
@@ -30,6 +36,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
+
+from pymoo_rail.experiments.metrics import true_front_and_reason
 from pymoo_rail.experiments.registry import canonical_name
 from pymoo_rail.experiments.spec import AlgorithmSpec, ProblemSpec, RunSpec, canonical_json
 
@@ -84,14 +93,45 @@ def _module_digest(path: str) -> str | None:
     return _digest(Path(found.origin).read_bytes())
 
 
-def _instance_checksum(params: Mapping[str, Any]) -> str:
-    """The definition checksum of the suite family instance ``params`` name (or why it has none)."""
+def front_digest(problem) -> str:
+    """The digest of the content of the reference front a run of ``problem`` is scored and logged against.
+
+    A front the exact solver certified counts as the file it is cached in (its nodes to 9
+    significant digits, :meth:`~pymoo_rail.optimal.reference.CertifiedFront.to_csv_text`): the
+    process that computes a front holds its nodes to the last bit, every later one reads them back
+    from the cache, and both must give one digest. The ``-bi`` and ``-single`` fronts
+    (``pareto_front()``) are computed from those nodes by code in :data:`SUITE_RUN_PARTS`. Any
+    other front counts by its array as the run reads it (shape and float64 bytes): a ``-3obj``
+    instance's inner points (cached to 17 digits, exact) next to its line's certified front, a
+    trip's exact optimum. A problem without a front gives the reason instead.
+    """
+    pf, reason = true_front_and_reason(problem)
+    if pf is None:
+        return f"none: {reason}"
+    pf = np.ascontiguousarray(pf, dtype=float)
+    array = str(pf.shape).encode() + pf.tobytes()
+    certified = getattr(problem, "certified_front", None)
+    if not callable(certified):
+        return _digest(array)
+    nodes = certified().to_csv_text().encode()
+    derived = len(problem.objectives) < 3  # -bi, -single: pareto_front() comes from the nodes
+    return _digest(nodes if derived else nodes + b"\0" + array)
+
+
+def _instance_inputs(params: Mapping[str, Any]) -> dict[str, str]:
+    """The definition checksum of the suite family instance ``params`` name and the digest of its
+    reference front (or why it has neither)."""
     from pymoo_rail.suite import get_problem
 
     try:
-        return get_problem(params.get("family"), n_var=params.get("n_var"), seed=params.get("seed")).checksum
+        instance = get_problem(params.get("family"), n_var=params.get("n_var"), seed=params.get("seed"))
     except Exception as err:  # noqa: BLE001 - the run itself will report the error
-        return f"unbuildable: {type(err).__name__}"
+        return {"problem instance checksum": f"unbuildable: {type(err).__name__}"}
+    try:
+        front = front_digest(instance)
+    except Exception as err:  # noqa: BLE001 - the run itself will report the error
+        front = f"unavailable: {type(err).__name__}"
+    return {"problem instance checksum": instance.checksum, "problem reference front": front}
 
 
 def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
@@ -107,7 +147,7 @@ def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
         if digest is not None:
             out[f"{kind} module {spec.name.partition(':')[0]}"] = digest
     if kind == "problem" and canonical_name(spec.name) == "suite_family":
-        out["problem instance checksum"] = _instance_checksum(spec.params)
+        out.update(_instance_inputs(spec.params))
     for key, value in spec.params.items():
         if not isinstance(value, str):
             continue
@@ -125,6 +165,55 @@ def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
     return dict(resolve_spec(spec).fingerprint)
 
 
+# The parts of the package (paths relative to it, as package_digest takes them) whose code computes
+# the numbers of a suite family run: the model and the simulator, the problem that evaluates an
+# instance, the family definitions, the algorithms and indicators, and the runner's loop (building
+# the problem and the algorithm, the penalty, the history and the record's indicators). Not in it,
+# because a run never executes them or gets their output only as content fingerprinted on its own:
+# cases (the generated line and train are in the instance checksum, by content), optimal (the
+# planner's window and time tolerance are in the checksum, the front by the digest of its content;
+# only optimal/reference/front.py, which turns a front's nodes into pareto_front(), is a part),
+# control (imported for a type; a suite instance has no tracker), journeys (for the -trip families
+# only), suite's loggers and shipped files, cli, plotting and the other studies.
+# tests/experiments/test_suite_fingerprint.py runs suite runs in a fresh interpreter and fails if
+# a run executes code outside these parts that is not listed there with its reason.
+SUITE_RUN_PARTS = (
+    "constants.py", "model", "sim",
+    "problems/__init__.py", "problems/lazy.py", "problems/speed_profile.py", "problems/objectives.py",
+    "problems/reference.py", "problems/encodings", "optimal/reference/front.py",
+    "suite/families.py", "suite/comfort.py", "suite/trips.py", "suite/identity.py", "suite/problems.py",
+    "algorithms", "indicators",
+    "experiments/runner.py", "experiments/registry.py", "experiments/spec.py", "experiments/penalty.py",
+    "experiments/metrics.py", "experiments/fronts.py",
+)
+# a -trip family's problem is the journeys' running-time allocation problem
+TRIP_RUN_PARTS = (*SUITE_RUN_PARTS, "journeys")
+
+
+def code_parts(spec: ProblemSpec) -> tuple[str, ...] | None:
+    """The package parts whose digest is a run's ``pymoo-rail code``: :data:`SUITE_RUN_PARTS` (or
+    :data:`TRIP_RUN_PARTS`) for a suite family instance, None (the whole package) for any other problem.
+
+    Named rail problems and the others keep the whole package: they reach cases, controllers or
+    solvers in too many ways to list, and their studies are short.
+    """
+    if canonical_name(spec.name) != "suite_family":
+        return None
+    from pymoo_rail.suite.families import family
+
+    try:
+        form = family(spec.params.get("family")).form
+    except ValueError:  # an unknown family: the run reports it
+        return SUITE_RUN_PARTS
+    return TRIP_RUN_PARTS if form == "trip" else SUITE_RUN_PARTS
+
+
+def in_parts(path: str, parts: tuple[str, ...] | None) -> bool:
+    """True when ``path`` (relative to the package, ``/``-separated) is one of ``parts`` or inside
+    one of them (None: the whole package)."""
+    return parts is None or any(path == part or path.startswith(part.rstrip("/") + "/") for part in parts)
+
+
 @functools.lru_cache(maxsize=8)
 def package_digest(parts: tuple[str, ...] | None = None) -> str:
     """A digest of pymoo-rail's own source and data files (path and bytes of each, in path order).
@@ -137,13 +226,8 @@ def package_digest(parts: tuple[str, ...] | None = None) -> str:
 
     root = Path(pymoo_rail.__file__).resolve().parent
     sha = hashlib.sha256()
-
-    def inside(path: Path) -> bool:
-        rel = path.relative_to(root).as_posix()
-        return parts is None or any(rel == part or rel.startswith(part.rstrip("/") + "/") for part in parts)
-
     for path in sorted(p for p in root.rglob("*") if p.suffix in _PACKAGE_SUFFIXES and p.is_file()
-                       and "__pycache__" not in p.parts and inside(p)):
+                       and "__pycache__" not in p.parts and in_parts(p.relative_to(root).as_posix(), parts)):
         sha.update(path.relative_to(root).as_posix().encode() + b"\0")
         sha.update(hashlib.sha256(path.read_bytes()).digest())
     return "sha256:" + sha.hexdigest()[:32]
@@ -170,7 +254,7 @@ def resolve_run(run: RunSpec, cache: dict[Any, RunInputs] | None = None) -> RunI
     problem runs on the same loaded case.
     """
     cache = {} if cache is None else cache
-    fingerprint = dict(versions_input())
+    fingerprint = dict(versions_input(code_parts(run.problem)))
     cases: dict[str, Any] = {}
     for spec in (run.problem, run.algorithm):
         key = canonical_json(spec.identity())  # holds the kind: {"problem": ...} or {"algorithm": ...}

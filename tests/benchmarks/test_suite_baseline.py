@@ -6,6 +6,7 @@ from __future__ import annotations
 import hashlib
 import tarfile
 
+import numpy as np
 import pytest
 
 
@@ -62,7 +63,7 @@ def test_the_archive_holds_the_records_and_its_checksum_is_the_files(tmp_path):
 def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
     import pandas as pd
 
-    from pymoo_rail.experiments.baseline import projected_cpu_h
+    from pymoo_rail.experiments.baseline import cpu_per_evaluation_ms, projected_cpu_h
 
     full = _study(["generated-metro-bi"], [10, 30, 100], 2, 1000)
     names = [a.display for a in full.algorithms]
@@ -75,6 +76,9 @@ def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
     per_algorithm_s = (1e-3 + (1e-3 + 20 / 90 * 2e-3) + 3e-3) * 1000 * 2
     assert hours == pytest.approx(len(names) * per_algorithm_s / 3600)
     assert sizes == "10, 100"
+    table = cpu_per_evaluation_ms(frame)  # what --estimate prints: the medians, ms, algorithm x n_var
+    assert list(table.columns) == [10, 100] and sorted(table.index) == sorted(names)
+    np.testing.assert_allclose(table.to_numpy(), [[1.0, 3.0]] * len(names))
 
 
 def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():

@@ -1,4 +1,4 @@
-"""COCO logs of pymoo runs: written in cocoex's bbob-biobj format, read back by cocopp, indicators recomputed."""
+"""COCO logs of pymoo runs: written in cocoex's bbob-biobj and bbob formats, read back by cocopp, indicators recomputed."""
 
 import os
 import subprocess
@@ -8,13 +8,16 @@ import warnings
 import numpy as np
 import pytest
 from pymoo.algorithms.moo.nsga2 import NSGA2
+from pymoo.algorithms.soo.nonconvex.ga import GA
 from pymoo.indicators.hv import HV
 from pymoo.optimize import minimize
 from pymoo.problems import get_problem as pymoo_problem
 from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
 
-from pymoo_rail.suite import COCOLogger, get_problem
+from pymoo_rail.journeys import BudgetRepair
+from pymoo_rail.suite import COCOLogger, get_problem, list_families
 from pymoo_rail.suite.coco_logger import (
+    COCO_SINGLE_SUITE,
     COCO_SUITE,
     INFINITE_VALUE,
     evaluation_triggers,
@@ -94,6 +97,75 @@ def test_a_bi_objective_log_round_trips_through_cocopp(tmp_path):
                        for f in results[run].F])
 
 
+@pytest.mark.parametrize("family, repair", [("generated-metro-single", None), ("generated-metro-trip", BudgetRepair())])
+def test_a_single_objective_log_round_trips_through_cocopp(tmp_path, family, repair):
+    problem = get_problem(family, n_var=10, seed=1)  # the metro front is shipped; the trip's optimum is exact
+    logger = Recorder(tmp_path, "GA", "population 12, 5 generations")
+    logger.seen = {}
+    with logger:
+        for seed in (1, 2):
+            minimize(problem, GA(pop_size=12, repair=repair) if repair else GA(pop_size=12), ("n_gen", 5), seed=seed,
+                     callback=logger)
+    data = _read(tmp_path / "GA")
+    assert len(data) == 1
+    ds = data[0]
+    fid = list_families().index(family) + 1
+    assert (ds.suite_name, ds.funcId, ds.dim, ds.algId) == (COCO_SINGLE_SUITE, fid, 10, "GA")
+    assert list(ds.instancenumbers) == [1, 1] and list(ds.maxevals) == [60, 60]
+    f_opt = float(problem.pareto_front()[0, 0])
+    for run, points in enumerate(logger.seen.values()):
+        F = np.array([f[0] for f, _ in points])
+        CV = np.array([cv for _, cv in points])
+        assert len(F) == 60 and (CV <= 0).any()
+        # the final value is the best feasible energy minus the certified optimum (kWh), recomputed here
+        assert ds.finalfunvals[run] == pytest.approx(F[CV <= 0].min() - f_opt, abs=1e-8)
+        evals, values = ds.funvals[:, 0], ds.funvals[:, 1 + run]
+        assert evals[0] == 1 and evals[-1] == 60 and np.all(np.diff(values) <= 0)
+    # every .dat line: evaluation, 0 constraint evaluations, value, the point's energy, the best feasible energy, x
+    dat = np.loadtxt(tmp_path / "GA" / f"data_f{fid}" / f"bbobexp_f{fid}_DIM10.dat", comments="%")
+    assert np.all(dat[:, 1] == 0) and dat.shape[1] == 5 + problem.n_var
+    finite = dat[:, 2] < INFINITE_VALUE
+    np.testing.assert_allclose(dat[finite, 4] - f_opt, dat[finite, 2], atol=1e-8)
+    header = (tmp_path / "GA" / f"bbobexp_f{fid}.info").read_text().splitlines()[0]
+    assert f"suite = '{COCO_SINGLE_SUITE}', funcId = {fid}, DIM = 10" in header and "algId = 'GA'" in header
+
+
+def test_the_single_objective_files_are_those_cocoex_writes(tmp_path, monkeypatch):
+    """cocoex's own bbob observer: the same .info header keys, run header and columns; its .dat targets are ours."""
+    monkeypatch.chdir(tmp_path)
+    rng = np.random.default_rng(3)
+    suite = cocoex.Suite("bbob", "", "dimensions: 5 instance_indices: 1 function_indices: 1")
+    observer = cocoex.Observer("bbob", "result_folder: ours algorithm_name: RS")
+    f = suite.get_problem(0)
+    f.observe_with(observer)
+    measured = [f(rng.uniform(-5, 5, 5)) for _ in range(300)]
+    f.free()
+    folder = tmp_path / "exdata" / "ours"
+    theirs_info = (folder / "bbobexp_f1.info").read_text().splitlines()[0]
+    keys = [part.split(" = ")[0] for part in theirs_info.split(", ")]
+    problem = get_problem("generated-metro-single", n_var=5, seed=1)
+    with COCOLogger(tmp_path, "GA") as logger:
+        minimize(problem, GA(pop_size=10), ("n_gen", 3), seed=1, callback=logger)
+    fid = function_id(problem)
+    ours_info = (tmp_path / "GA" / f"bbobexp_f{fid}.info").read_text().splitlines()[0]
+    assert [part.split(" = ")[0] for part in ours_info.split(", ")] == keys
+    theirs_dat = (folder / "data_f1" / "bbobexp_f1_DIM5.dat").read_text().splitlines()
+    ours_dat = (tmp_path / "GA" / f"data_f{fid}" / f"bbobexp_f{fid}_DIM5.dat").read_text().splitlines()
+    assert ours_dat[0].split("(")[0] == theirs_dat[0].split("(")[0]
+    assert ours_dat[0].split(")")[1] == theirs_dat[0].split(")")[1]
+    assert len(ours_dat[1].split()) == len(theirs_dat[1].split())  # 5 columns and the 5 decisions
+    # cocoex writes a .dat line where our rule does: the best value minus Fopt reaches a new target
+    f_opt = float(theirs_dat[0].split("(")[1].split(")")[0])
+    best, last, expected = np.inf, np.inf, []
+    for evaluation, value in enumerate(measured, start=1):
+        best = min(best, value)
+        if target_of(best - f_opt) < last:
+            expected.append(evaluation)
+            last = target_of(best - f_opt)
+    written = np.loadtxt(folder / "data_f1" / "bbobexp_f1_DIM5.dat", comments="%", ndmin=2)[:, 0].astype(int)
+    assert list(written) == expected + [300]
+
+
 def _adat_runs(path):
     runs, rows = [], []
     for line in path.read_text().splitlines():
@@ -165,9 +237,9 @@ def test_a_second_logger_in_the_same_folder_numbers_its_data(tmp_path):
 def test_problems_coco_cannot_hold_are_refused(tmp_path):
     with pytest.raises(ValueError, match="algorithm_name = 'my alg'"):
         COCOLogger(tmp_path, "my alg")
-    with pytest.raises(ValueError, match="n_obj = 1"):
-        minimize(get_problem("generated-metro-single", n_var=6, seed=1), NSGA2(pop_size=8), ("n_gen", 1),
-                 callback=COCOLogger(tmp_path, "GA"))
+    with pytest.raises(ValueError, match="n_obj = 3"):
+        minimize(get_problem("generated-metro-3obj", n_var=10, seed=1), NSGA2(pop_size=8), ("n_gen", 1),
+                 callback=COCOLogger(tmp_path, "three"))
     with pytest.raises(ValueError, match="'ZDT1' is not a family instance"):
         function_id(pymoo_problem("zdt1"))
     assert function_id(get_problem("generated-metro-bi", n_var=10, seed=1)) == 1
@@ -180,17 +252,20 @@ def test_problems_coco_cannot_hold_are_refused(tmp_path):
 
 
 @pytest.mark.slow
-def test_cocopp_main_post_processes_a_log(tmp_path):
+@pytest.mark.parametrize("family", ["generated-metro-bi", "generated-metro-single"])
+def test_cocopp_main_post_processes_a_log(tmp_path, family):
     """cocopp's whole post-processing (figures, tables, HTML) on a log, in a fresh process."""
-    problem = get_problem("generated-metro-bi", n_var=10, seed=1)
-    with COCOLogger(tmp_path / "data", "NSGA2") as logger:
+    problem = get_problem(family, n_var=10, seed=1)
+    name = "NSGA2" if problem.n_obj == 2 else "GA"
+    with COCOLogger(tmp_path / "data", name) as logger:
         for seed in (1, 2, 3):
-            minimize(problem, NSGA2(pop_size=12), ("n_gen", 5), seed=seed, callback=logger)
+            algorithm = NSGA2(pop_size=12) if problem.n_obj == 2 else GA(pop_size=12)
+            minimize(problem, algorithm, ("n_gen", 5), seed=seed, callback=logger)
     script = ("import warnings; warnings.simplefilter('ignore'); import cocopp; "
               "from pymoo_rail.suite.coco_logger import register_cocopp_suite; register_cocopp_suite(); "
-              f"cocopp.main('-o {tmp_path / 'pp'} {tmp_path / 'data' / 'NSGA2'}')")
+              f"cocopp.main('-o {tmp_path / 'pp'} {tmp_path / 'data' / name}')")
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path,
                           env={**os.environ, "MPLBACKEND": "Agg"})
     assert done.returncode == 0, done.stderr[-3000:]
     pages = list((tmp_path / "pp").rglob("index1.html"))
-    assert pages and "NSGA2" in pages[0].read_text()
+    assert pages and name in pages[0].read_text()

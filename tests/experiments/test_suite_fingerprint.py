@@ -1,0 +1,200 @@
+"""A suite family run's fingerprint covers exactly the code it executes and its front by content.
+
+The first test runs suite runs in a fresh interpreter (``suite_run_probe.py``) and checks that
+every package file a run executes is inside the parts its ``pymoo-rail code`` digest covers
+(:func:`pymoo_rail.experiments.inputs.code_parts`) or listed below with why its output is
+fingerprinted otherwise, and that every other package module loaded is listed as only imported,
+with the reason. The others check that a change outside the parts keeps stored records current
+and a change inside (or of the front's content) redoes them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+import pymoo_rail
+from pymoo_rail.experiments import inputs as inputs_module
+from pymoo_rail.experiments.inputs import (SUITE_RUN_PARTS, TRIP_RUN_PARTS, code_parts, front_digest, in_parts,
+                                           resolve_run)
+from pymoo_rail.experiments.runner import run_study
+from pymoo_rail.experiments.spec import Budget, RunSpec, Study, algorithm, problem
+from pymoo_rail.suite import get_problem
+from pymoo_rail.suite.families import FamilyProblem
+
+PACKAGE = Path(pymoo_rail.__file__).resolve().parent
+PROBE = Path(__file__).with_name("suite_run_probe.py")
+FAMILY = "generated-metro-bi"
+
+# executed by a run, but what they give it is fingerprinted by content, or is not one of its numbers
+EXECUTED_OUTSIDE = {
+    "cases": "generate the instance's line and train, whose content is in the instance checksum (case_hash)",
+    "optimal/reference": "the planner's window and the time tolerance are in the instance checksum; the front "
+                         "is read (or computed) here, and its content is in 'problem reference front' (front.py, "
+                         "which turns its nodes into pareto_front(), is a part)",
+    "experiments/inputs.py": "computes the fingerprint itself, not a number of the run",
+    "atomic.py": "writes a computed inner front of a -3obj instance to the cache, whose content is fingerprinted",
+}
+# loaded with the modules a run uses, but never on a run's path (a run calling them fails the test)
+IMPORTED_ONLY = {
+    "__init__.py": "the version string, in the fingerprint as 'pymoo-rail version'",
+    "control": "problems/speed_profile.py imports Tracker for a tracked problem; a suite instance has no tracker",
+    "journeys": "suite/families.py imports the trip module; only the -trip families run it (TRIP_RUN_PARTS)",
+    "optimal": "the exact solver, imported by optimal.reference; a run gets its front by content (above)",
+    "suite/__init__.py": "re-exports the suite's names",
+    "suite/coco_logger.py": "a logger callback a study run does not use",
+    "suite/ioh_logger.py": "a logger callback a study run does not use",
+    "suite/run_log.py": "the loggers' base",
+    "suite/fronts_io.py": "the named problems' shipped fronts (re-exported by suite/__init__.py)",
+    "rowcache.py": "the exact solver's row cache (optimal)",
+    "lockfiles.py": "the study store's locks, not a number of a run",
+    "experiments/__init__.py": "re-exports the study runner's names",
+    "experiments/results.py": "reads stored records (imported by experiments/__init__.py)",
+    "experiments/store.py": "stores records, not their numbers",
+    "experiments/study_file.py": "reads and writes study files (imported by experiments/__init__.py)",
+}
+# one run of each algorithm of the baseline table, and one run of each other form
+PROBE_RUNS = [
+    *[[FAMILY, name, params] for name, params in (
+        ("nsga2", {"pop_size": 10}), ("sms-emoa", {"pop_size": 10}), ("nsga3", {"pop_size": 10}),
+        ("ctaea", {"pop_size": 10}), ("moead", {"pop_size": 10}), ("age-moea", {"pop_size": 10}),
+        ("moabc", {}), ("grnsga2", {"pop_size": 20}), ("random", {"n_points_per_iteration": 10}))],
+    ["generated-metro-3obj", "nsga2", {"pop_size": 10}],
+    ["generated-metro-single", "ga", {"pop_size": 10}],
+    ["generated-metro-trip", "ga", {"pop_size": 10}],
+]
+
+
+def _listed(path: str, listing) -> bool:
+    return in_parts(path, tuple(listing))
+
+
+def test_every_part_and_listed_path_exists():
+    for path in (*TRIP_RUN_PARTS, *EXECUTED_OUTSIDE, *IMPORTED_ONLY):
+        assert (PACKAGE / path).exists(), f"{path} is not a file or folder of the package"
+
+
+def test_a_suite_run_executes_only_code_its_fingerprint_covers():
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(PACKAGE.parent), os.environ.get("PYTHONPATH", "")])}
+    done = subprocess.run([sys.executable, str(PROBE), json.dumps(PROBE_RUNS)], capture_output=True, text=True,
+                          env=env, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    probe = json.loads(done.stdout.splitlines()[-1])
+    for (family, name, params), executed in zip(PROBE_RUNS, probe["executed"]):
+        parts = code_parts(problem("suite_family", family=family))
+        # the probe sees the run: the simulator, or for a trip the journeys' allocation problem
+        assert ("journeys/problem.py" if family.endswith("-trip") else "sim/simulator.py") in executed, executed
+        missed = [path for path in executed if not in_parts(path, parts) and not _listed(path, EXECUTED_OUTSIDE)]
+        assert not missed, f"{family} / {name} executes {missed}: add them to the parts or list them here with why"
+    modules = set(probe["modules"])
+    unlisted = sorted(path for path in modules if not in_parts(path, TRIP_RUN_PARTS)
+                      and not _listed(path, EXECUTED_OUTSIDE) and not _listed(path, IMPORTED_ONLY))
+    assert not unlisted, f"loaded but neither in the parts nor listed with a reason: {unlisted}"
+    # journeys is a part for the -trip runs only: the other runs never execute it
+    others = [set(e) for (family, _, _), e in zip(PROBE_RUNS, probe["executed"]) if not family.endswith("-trip")]
+    assert not any(in_parts(path, ("journeys",)) for e in others for path in e)
+
+
+def test_code_parts_per_problem_kind():
+    assert code_parts(problem("suite_family", family=FAMILY)) == SUITE_RUN_PARTS
+    assert code_parts(problem("suite_family", family="generated-suburban-trip")) == TRIP_RUN_PARTS
+    assert code_parts(problem("suite_family", family="atlantis-bi")) == SUITE_RUN_PARTS  # the run reports it
+    assert code_parts(problem("zdt1")) is None
+    assert code_parts(problem("rail_suite", suite_problem="yizhuang-bi")) is None
+    for path in ("control", "optimal/dp.py", "optimal/reference/store.py", "cli", "plotting", "journeys", "cases",
+                 "suite/coco_logger.py"):
+        assert not in_parts(path, SUITE_RUN_PARTS)
+    assert in_parts("journeys/problem.py", TRIP_RUN_PARTS)
+
+
+@pytest.mark.parametrize("edited, suite_changes, trip_changes", [
+    ("control/controllers.py", False, False), ("optimal/dp.py", False, False), ("cli/app.py", False, False),
+    ("optimal/reference/store.py", False, False), ("optimal/reference/front.py", True, True),
+    ("plotting/fronts.py", False, False), ("suite/coco_logger.py", False, False), ("cases/railjson.py", False, False),
+    ("journeys/allocation.py", False, True),
+    ("sim/kernel.py", True, True), ("constants.py", True, True), ("algorithms/moabc.py", True, True),
+    ("experiments/penalty.py", True, True), ("problems/encodings/speed_codes.py", True, True),
+    ("suite/families.py", True, True), ("indicators/spacing.py", True, True)])
+def test_an_edit_outside_the_parts_keeps_the_digest_and_one_inside_changes_it(tmp_path, monkeypatch, edited,
+                                                                                suite_changes, trip_changes):
+    copy = tmp_path / "pymoo_rail"
+    shutil.copytree(PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(pymoo_rail, "__file__", str(copy / "__init__.py"))
+    digest = inputs_module.package_digest.__wrapped__
+    before = digest(SUITE_RUN_PARTS), digest(TRIP_RUN_PARTS), digest()
+    with (copy / edited).open("a", encoding="utf-8") as file:
+        file.write("\nEDITED_IN_A_TEST = 1\n")
+    after = digest(SUITE_RUN_PARTS), digest(TRIP_RUN_PARTS), digest()
+    assert (after[0] != before[0], after[1] != before[1], after[2] != before[2]) == (suite_changes, trip_changes, True)
+
+
+def _suite_study() -> Study:
+    return Study("fingerprint", problems=[problem("suite_family", family=FAMILY, n_var=10, seed=1)],
+                 algorithms=[algorithm("nsga2", pop_size=10)], seeds=1, budget={"n_eval": 40})
+
+
+def test_stored_suite_runs_stay_current_after_a_change_outside_and_are_redone_after_one_inside(tmp_path,
+                                                                                            monkeypatch):
+    study = _suite_study()
+    assert run_study(study, tmp_path, workers=1, progress=False).n_finished == 1
+    real = inputs_module.package_digest
+
+    def elsewhere(parts=None):  # the whole package changed (a controller fix), the parts did not
+        return "sha256:" + "1" * 32 if parts is None else real(parts)
+
+    monkeypatch.setattr(inputs_module, "package_digest", elsewhere)
+    assert run_study(study, tmp_path, workers=1, progress=False).n_skipped == 1
+
+    def inside(parts=None):  # the simulator changed
+        return "sha256:" + "2" * 32 if parts is not None and "sim" in parts else real(parts)
+
+    monkeypatch.setattr(inputs_module, "package_digest", inside)
+    report = run_study(study, tmp_path, workers=1, progress=False)
+    assert report.n_finished == 1 and "pymoo-rail code changed" in report.redone[0]
+
+
+def _scaled_front(front, factor: float):
+    """The front with every node's energy times ``factor`` (another solver's answer)."""
+    table = front.table.copy()
+    table["energy_kwh"] = table["energy_kwh"] * factor
+    return replace(front, table=table)
+
+
+def test_stored_suite_runs_are_redone_when_the_front_content_changes(tmp_path, monkeypatch):
+    study = _suite_study()
+    run_study(study, tmp_path, workers=1, progress=False)
+    real = FamilyProblem.certified_front
+    # another front (a solver that finds 1 % lower energies): the same code digest
+    monkeypatch.setattr(FamilyProblem, "certified_front", lambda self: _scaled_front(real(self), 0.99))
+    report = run_study(study, tmp_path, workers=1, progress=False)
+    assert report.n_finished == 1 and "problem reference front changed" in report.redone[0]
+
+
+def test_a_front_counts_as_cached_so_the_process_that_computed_it_agrees_with_later_ones(monkeypatch):
+    """The cache holds a front's nodes to 9 digits: a difference below that is no change, one above is."""
+    problem = get_problem(FAMILY, n_var=10, seed=1)
+    before = front_digest(problem)
+    real = FamilyProblem.certified_front
+    for factor, same in ((1 + 1e-12, True), (1 + 1e-6, False)):
+        monkeypatch.setattr(FamilyProblem, "certified_front", lambda self, f=factor: _scaled_front(real(self), f))
+        assert (front_digest(get_problem(FAMILY, n_var=10, seed=1)) == before) is same
+    monkeypatch.setattr(FamilyProblem, "certified_front", real)
+    # a -3obj front is its inner points (cached exactly) with its line's certified front
+    inner = front_digest(get_problem("generated-metro-3obj", n_var=10, seed=1))
+    assert inner.startswith("sha256:") and inner != before
+
+
+def test_the_front_digest_is_of_its_content():
+    fingerprint = resolve_run(RunSpec(problem("suite_family", family=FAMILY, n_var=10, seed=1), algorithm("nsga2"),
+                                      1, Budget("n_eval", 40))).fingerprint
+    small, large = get_problem(FAMILY, n_var=10, seed=1), get_problem(FAMILY, n_var=30, seed=1)
+    assert fingerprint["problem reference front"] == front_digest(small)
+    assert front_digest(small) == front_digest(large)  # every dimension of a line has the same front
+    assert front_digest(small) != front_digest(get_problem(FAMILY, n_var=10, seed=7))  # another line
