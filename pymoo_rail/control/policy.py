@@ -357,7 +357,9 @@ class OptimalPolicy:
         tables = line.tables[:-1] + (np.ascontiguousarray(line.tables[-1][node:]),)
         dp.singular_speeds(ahead, prices + m.aux_power_w, self.n_speeds, self.bias, sing_v[node:], sing_p[node:])
         dp.backward_sweep(ahead, prices, *tables, value[node:], np.zeros(n - node, dtype=np.int64), line.terminal_j,
-                          sing_v[node:], sing_p[node:], sing_val[node:], self.max_targets, self.bias)
+                          sing_v[node:], sing_p[node:], sing_val[node:], self.max_targets, self.bias,
+                          dp.curve_controls(ahead, sing_v[node:, dp.N_SINGULAR:], sing_p[node:, dp.N_SINGULAR:],
+                                            self.n_speeds, self.max_targets, self.bias))
         self.n_sweeps += 1
         line.values[k] = (node, arrays)
         if len(line.values) > MAX_PRICES_KEPT:  # forget the price farthest from this one

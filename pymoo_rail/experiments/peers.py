@@ -237,7 +237,9 @@ def sweep_cpu(seed: int, factor: float, repeats: int = 5) -> list[str]:
     """CPU time of one backward sweep and one forward run of the exact solver, as report lines.
 
     On ``comparable_case(seed)`` at the price of time of its optimum at ``factor`` x the minimum running
-    time, each the best of ``repeats``, with the singular speeds as states and with the speed grid alone
+    time, each the best of ``repeats``: with the singular speeds and the coast curves as states (what
+    ``OptimalSolver`` solves; the curves' controls tabulated beforehand, ``dp.curve_controls``, as the
+    solver keeps them across prices), with the singular speeds alone, and with the speed grid alone
     (``OptimalSolver(singular=False)``), alternated twice.
     """
     from pymoo_rail.optimal import OptimalSolver, dp, min_running_time
@@ -248,21 +250,26 @@ def sweep_cpu(seed: int, factor: float, repeats: int = 5) -> list[str]:
     model, tables, n_speeds, bias = solver.simulator.model, solver.transition_tables(), solver.n_speeds, solver.top_bias
     n = model.position_m.shape[0]
     prices, floor_k = np.full(n - 1, lambda_w), np.zeros(n, dtype=np.int64)
-    sing_v, sing_p, sing_val, value = np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2)), np.empty((n, n_speeds))
+    value = np.empty((n, n_speeds))
     terminal_j = dp.terminal_cost(model, n_speeds, bias, solver.end_speed_ms[0])
-    lines = [f"{case.name}: {n - 1} cells, {tables[0].shape[0]} kinds of cell, {n_speeds} speed nodes, lambda "
-             f"{lambda_w:.0f} W (load average {os.getloadavg()[0]:.1f})"]
-    for singular in (True, False, True, False):
-        if singular:
-            dp.singular_speeds(model, prices + model.aux_power_w, n_speeds, bias, sing_v, sing_p)
-        else:
+    curve_v, curve_p = dp.coast_curves(model, float(solver.end_speed_ms[0]), n_speeds, bias)
+    lines = [f"{case.name}: {n - 1} cells, {tables[0].shape[0]} kinds of cell, {n_speeds} speed nodes, "
+             f"{curve_v.shape[1]} coast curves, lambda {lambda_w:.0f} W (load average {os.getloadavg()[0]:.1f})"]
+    for states in ("singular speeds and coast curves", "singular speeds", "speed grid alone") * 2:
+        n_curves = curve_v.shape[1] if states.endswith("curves") else 0
+        sing_v, sing_p, sing_val = (np.empty((n, dp.N_SINGULAR + n_curves)) for _ in range(3))
+        if states == "speed grid alone":
             sing_v[:], sing_p[:] = 0.0, -1.0
+        else:
+            dp.singular_speeds(model, prices + model.aux_power_w, n_speeds, bias, sing_v, sing_p)
+            sing_v[:, dp.N_SINGULAR:], sing_p[:, dp.N_SINGULAR:] = curve_v[:, :n_curves], curve_p[:, :n_curves]
+        curves = dp.curve_controls(model, sing_v[:, dp.N_SINGULAR:], sing_p[:, dp.N_SINGULAR:], n_speeds,
+                                   solver.max_targets, bias)
         sweep_s = best_cpu_s(lambda: dp.backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v,
-                                                       sing_p, sing_val, solver.max_targets, bias), repeats)
+                                                       sing_p, sing_val, solver.max_targets, bias, curves), repeats)
         run_s = best_cpu_s(lambda: dp.forward_run(model, prices + model.aux_power_w, value, solver.max_targets, bias,
                                                   solver.tie_j, sing_v, sing_p, sing_val), repeats)
-        lines.append(f"singular speeds {'on ' if singular else 'off'}: backward sweep {sweep_s * 1e3:.1f} ms, "
-                     f"forward run {run_s * 1e3:.1f} ms")
+        lines.append(f"{states}: backward sweep {sweep_s * 1e3:.1f} ms, forward run {run_s * 1e3:.1f} ms")
     return lines
 
 

@@ -44,7 +44,7 @@ from pymoo_rail.sim.kernel import (
     scaled_step,
     share_above,
 )
-from pymoo_rail.sim.jit import inlined
+from pymoo_rail.sim.jit import called, inlined
 from pymoo_rail.sim.physics import (
     davis_force,
     electric_braking_capped,
@@ -94,7 +94,7 @@ def node_position(top_u, u, k_max, bias):
     return (b1 - math.sqrt(disc)) / (2.0 * bias) * k_max
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@inlined
 def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w):
     """What the simulator's ``run_program`` does in one cell for a program row of its own.
 
@@ -135,7 +135,7 @@ def cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, 
     return u1, f, w0
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@inlined
 def cell_cost(m, v0, u1, f, w0, cell, time_price_w):
     """Net energy of the cell plus ``time_price_w`` x its time (J), and its time (s).
 
@@ -238,15 +238,36 @@ def interp_aug(v_next, p, sing_p, sing_val):
     return lv + (p - lp) / (rp - lp) * (rv - lv)
 
 
-@inlined
-def interp_split(v_next, p, split, sing_p, sing_val):
-    """:func:`interp_aug` where ``split[k]`` says whether a singular speed lies inside the interval
-    ``(k, k + 1)`` of the speed nodes: the others take :func:`interp_at`, the same arithmetic without
-    the search for one: ``benchmarks/peers.py --sweep-cpu``, a sweep of generated seed 21 35 -> 27 ms).
-    The sweep passes its float32 positions as float64 (exact): one compiled copy of the interpolations."""
-    if p >= 0.0 and not split[int(p)]:
-        return interp_at(v_next, p)
+@called
+def interp_aug_called(v_next, p, sing_p, sing_val):
+    """:func:`interp_aug`, called rather than inlined: the sweep's rare case (an interval holding a singular
+    speed), compiled once instead of at each of the sweep's two call sites of :func:`sweep_cost`."""
     return interp_aug(v_next, p, sing_p, sing_val)
+
+
+@inlined
+def sweep_cost(e, time_cost, position, v_next, split, sing_p, sing_val):
+    """A table entry's cost in the backward sweep: energy ``e`` plus ``time_cost`` (its time priced) plus the
+    cost-to-go at node position ``position`` (single precision, as the tables hold it).
+
+    ``split[k]`` says whether a singular speed lies inside the interval ``(k, k + 1)`` of the speed nodes:
+    there :func:`interp_aug`, elsewhere :func:`interp_at`'s arithmetic without the search for one and
+    without its infinity checks, which never hold in the sweep (its cost-to-go is ``PENALTY_J`` at most).
+    """
+    p = np.float64(position)
+    if p < 0.0:
+        return INF
+    k = int(p)
+    if split[k]:
+        return e + time_cost + interp_aug_called(v_next, p, sing_p, sing_val)
+    k_max = v_next.shape[0] - 1
+    if k >= k_max:
+        return e + time_cost + v_next[k_max]
+    w = p - k
+    a = v_next[k]
+    if w <= 0.0:
+        return e + time_cost + a
+    return e + time_cost + (a + w * (v_next[k + 1] - a))
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
@@ -377,12 +398,19 @@ def constant_holding_speeds(m, time_price_w):
     (``W`` 0 without regeneration or at or below its cut-off speed)."""
     n_cells = time_price_w.shape[0]
     v_hold, v_regen = np.zeros(n_cells), np.zeros(n_cells)
+    last = math.nan  # the price solved last: one price over many cells is solved once
+    hold = regen = 0.0
     for i in range(n_cells):
         price = time_price_w[i]
-        v_hold[i] = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
-        if m.regen_efficiency > 0.0:
-            w = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
-            v_regen[i] = w if w > m.regen_min_speed_ms else 0.0
+        if price != last:
+            last = price
+            hold = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, m.traction_efficiency * price)
+            regen = 0.0
+            if m.regen_efficiency > 0.0:
+                w = psi_speed(m.davis_b_nsm, m.davis_c_ns2m2, price / m.regen_efficiency)
+                regen = w if w > m.regen_min_speed_ms else 0.0
+        v_hold[i] = hold
+        v_regen[i] = regen
     return v_hold, v_regen
 
 
@@ -602,8 +630,8 @@ def _n_targets(k_lo, k_hi, max_targets):
     return (count + stride - 1) // stride, stride
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
-def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
+def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table, steps_out):
     """Every control of one cell from speed ``v0``, written into ``table``; returns their number.
 
     ``table`` is ``(modes, targets, positions, energies, times, u1)``, arrays of at least
@@ -617,12 +645,14 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
     them and holding them exactly), and ``toward`` speed nodes of the next position in reach by
     partial traction (or braking). They depend on the kind of the cell (:func:`cell_types`),
     ``v0`` and the next position's singular speeds, not on the price of time or the cost-to-go.
+    ``steps_out`` (9,) receives the cell's full steps from ``v0`` (:func:`cell_steps`).
     """
     modes, targets, pos, energy, dt, u1s = table
     top_u = m.envelope_ms[cell + 1] ** 2
-    tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
-    co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
-    br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
+    steps = cell_steps(m, v0, cell)
+    for q in range(9):  # for a caller that adds controls of its own (:func:`_singular_rows`)
+        steps_out[q] = steps[q]
+    tr_u, co_u = steps[0], steps[3]
     n_fixed = N_FIXED if v0 > 0.0 else N_FIXED - 1  # holding needs a speed to hold
     n_sing = sing_v.shape[0]
     k_lo, stride, n_nodes = 1, 1, 0
@@ -639,23 +669,48 @@ def control_table(m, cell, v0, sing_v, sing_p, k_max, max_targets, bias, table):
             target = sing_v[c - n_fixed]
             if sing_p[c - n_fixed] < 0.0:
                 continue
-            # out of reach (``cell_outcome``'s rule): ``toward`` is the traction or coast step, entries already
-            if (tr_u <= target * target) if v0 < target else (co_u >= target * target):
+            if out_of_reach(v0, target, tr_u, co_u):
                 continue
         else:  # partial traction (or braking) landing exactly on a speed node of the next position
             mode = MODE_TOWARD
             target = math.sqrt(node_u(top_u, k_lo + (c - n_fixed - n_sing) * stride, k_max, bias))
-        u1, f, w0 = cell_outcome(m, v0, cell, mode, target, tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)
-        # priced at 0: ``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost`` does
-        e, d = cell_cost(m, v0, u1, f, w0, cell, 0.0)
+        u1s[p], energy[p], dt[p], pos[p] = control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias, 0.0)
         modes[p] = mode
         targets[p] = target
-        u1s[p] = u1
-        energy[p] = e
-        dt[p] = d
-        pos[p] = value_position(top_u, u1, k_max, bias) if e < INF else -1.0
         p += 1
     return p
+
+
+@inlined
+def cell_steps(m, v0, cell):
+    """The cell's full traction, coast and brake steps from ``v0`` (``full_step``), shared by every control:
+    ``(tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w)``."""
+    tr_u, tr_f, tr_w, _ = full_step(m, v0, cell, KIND_TRACTION)
+    co_u, co_f, co_w, _ = full_step(m, v0, cell, KIND_COAST)
+    br_u, br_f, br_w, _ = full_step(m, v0, cell, KIND_BRAKE)
+    return tr_u, tr_f, tr_w, co_u, co_f, co_w, br_u, br_f, br_w
+
+
+@inlined
+def out_of_reach(v0, target, tr_u, co_u):
+    """Whether ``toward target`` from ``v0`` is only the traction or coast step (``cell_outcome``'s rule), an
+    entry of the control table already: then it is not a control of its own."""
+    return (tr_u <= target * target) if v0 < target else (co_u >= target * target)
+
+
+@inlined
+def control_entry(m, cell, v0, mode, target, steps, top_u, k_max, bias, time_price_w):
+    """One control of a cell from ``v0``: ``(u1, cost J, time s, node position)`` (``cell_outcome``, ``cell_cost``).
+
+    The cost is the net energy plus ``time_price_w`` x the time: a control table (:func:`control_table`)
+    prices at 0 (``e + 0.0 x dt`` is ``e`` exactly, and :func:`entry_cost` adds the price as ``cell_cost``
+    does), the transition tables at the auxiliary power. The position is -1 where the train stops in
+    the cell (infinite cost). ``steps``: the cell's full steps from ``v0`` (:func:`cell_steps`).
+    """
+    u1, f, w0 = cell_outcome(m, v0, cell, mode, target, steps[0], steps[1], steps[2], steps[3], steps[4], steps[5],
+                             steps[6], steps[7], steps[8])
+    e, d = cell_cost(m, v0, u1, f, w0, cell, time_price_w)
+    return u1, e, d, (value_position(top_u, u1, k_max, bias) if e < INF else -1.0)
 
 
 @inlined
@@ -712,11 +767,19 @@ def cell_types(m) -> tuple[np.ndarray, np.ndarray]:
                                  m.envelope_ms[:n_cells], m.envelope_ms[1:n_cells + 1], last])
     # compared as bit patterns: -0.0 and 0.0 may not give the same bits downstream
     bits = np.ascontiguousarray(signature).view(np.int64)
-    _, first, inverse = np.unique(bits, axis=0, return_index=True, return_inverse=True)
+    # a stable sort of the rows (np.lexsort: 8 times faster than np.unique(axis=0)); a kind begins where a
+    # row differs from the one before, and its first cell comes first (stable)
+    by_row = np.lexsort(bits.T[::-1])
+    rows = bits[by_row]
+    starts = np.ones(n_cells, dtype=bool)
+    np.any(rows[1:] != rows[:-1], axis=1, out=starts[1:])
+    inverse = np.empty(n_cells, dtype=np.int64)
+    inverse[by_row] = np.cumsum(starts) - 1
+    first = by_row[starts]
     order = np.argsort(first)  # kinds in order of first appearance: the sweep reads them in line order
     rank = np.empty_like(order)
     rank[order] = np.arange(order.shape[0])
-    return rank[inverse.ravel()].astype(np.int64), first[order].astype(np.int64)
+    return rank[inverse].astype(np.int64), first[order].astype(np.int64)
 
 
 @inlined
@@ -727,10 +790,12 @@ def _kind_cell(m, first_cell, p_type):
     return t, i, m.envelope_ms[i] ** 2, m.envelope_ms[i + 1] ** 2
 
 
-@njit(cache=True, no_cfunc_wrapper=True, parallel=True)
+# serial: some 25 ns a state, and a parallel region's threads cost more CPU than they save here
+# (generated seeds 0, 1, 5, 10 at 200 nodes, best of 7 under load: 6-16 ms of CPU in parallel, 2.5-8 ms serial)
+@njit(cache=True, no_cfunc_wrapper=True)
 def _count_targets(m, n_speeds, max_targets, bias, first_cell, counts):
     k_max = n_speeds - 1
-    for p_type in prange(first_cell.shape[0]):
+    for p_type in range(first_cell.shape[0]):
         t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             counts[t * n_speeds + j] = 0
@@ -752,31 +817,31 @@ def _fill_transitions(m, n_speeds, max_targets, bias, first_cell, offsets, fixed
         t, i, top0, top1 = _kind_cell(m, first_cell, np.int64(p_type))
         for j in range(n_speeds):
             v0 = math.sqrt(node_u(top0, j, k_max, bias))
-            tr_u, tr_f, tr_w, _ = full_step(m, v0, i, KIND_TRACTION)
-            co_u, co_f, co_w, _ = full_step(m, v0, i, KIND_COAST)
-            br_u, br_f, br_w, _ = full_step(m, v0, i, KIND_BRAKE)
-            for c in range(N_FIXED):
-                u1, f, w0 = cell_outcome(m, v0, i, _fixed_mode(c), 0.0, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                         br_u, br_f, br_w)
-                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                fixed_u1[t, j, c] = value_position(top1, u1, k_max, bias)
-                fixed_e[t, j, c] = e
-                fixed_dt[t, j, c] = dt
+            steps = cell_steps(m, v0, i)
             s = t * n_speeds + j
-            if offsets[s + 1] == offsets[s]:
-                continue
-            k_lo, k_hi = _target_range(top1, k_max, v0 * v0, tr_u, co_u, bias)
-            stride = _n_targets(k_lo, k_hi, max_targets)[1]
-            p = offsets[s]
-            for k in range(k_lo, k_hi + 1, stride):
-                target = math.sqrt(node_u(top1, k, k_max, bias))
-                u1, f, w0 = cell_outcome(m, v0, i, np.int64(MODE_TOWARD), target, tr_u, tr_f, tr_w, co_u, co_f, co_w,
-                                         br_u, br_f, br_w)
-                e, dt = cell_cost(m, v0, u1, f, w0, i, aux)
-                tgt_u1[p] = value_position(top1, u1, k_max, bias)
-                tgt_e[p] = e
-                tgt_dt[p] = dt
-                p += 1
+            n_tgt = offsets[s + 1] - offsets[s]
+            k_lo, stride = 1, 1
+            if n_tgt > 0:
+                k_lo, k_hi = _target_range(top1, k_max, v0 * v0, steps[0], steps[3], bias)
+                stride = _n_targets(k_lo, k_hi, max_targets)[1]
+            # one loop over the fixed controls and the targets: one inlined copy of the cell's physics
+            for c in range(N_FIXED + n_tgt):
+                if c < N_FIXED:
+                    mode = _fixed_mode(c)
+                    target = 0.0
+                else:
+                    mode = MODE_TOWARD
+                    target = math.sqrt(node_u(top1, k_lo + (c - N_FIXED) * stride, k_max, bias))
+                _, e, dt, pos = control_entry(m, i, v0, mode, target, steps, top1, k_max, bias, aux)
+                if c < N_FIXED:
+                    fixed_u1[t, j, c] = pos
+                    fixed_e[t, j, c] = e
+                    fixed_dt[t, j, c] = dt
+                else:
+                    q = offsets[s] + c - N_FIXED
+                    tgt_u1[q] = pos
+                    tgt_e[q] = e
+                    tgt_dt[q] = dt
 
 
 def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = True):
@@ -815,46 +880,142 @@ def transitions(m, n_speeds: int, max_targets: int, bias: float, share: bool = T
     return (*fixed, offsets, *tgt, cell_type)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
-def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val, memo_key,
-                   memo_n, memo):
-    """Cost-to-go of the singular speeds at node ``i`` (:func:`backward_sweep`): every control from them.
+def curve_controls(m, curve_v: np.ndarray, curve_p: np.ndarray, n_speeds: int, max_targets: int, bias: float) -> tuple:
+    """The controls from the coast curves' states that do not depend on the price of time, built once per grid.
 
-    The least :func:`entry_cost` of their control tables (:func:`control_table`), kept per kind of cell
-    ``t`` and singular speed ``s`` in row ``t * n_singular + s`` of ``memo``: a cell of the kind last
-    tabulated from the same singular speed with the same next singular speeds (``memo_key``) reuses the
-    table, the same numbers bit for bit, so a sweep pays the simulator's steps once per kind of cell
-    rather than once per cell and price of time (``benchmarks/peers.py --sweep-cpu``: with :func:`interp_split`, a
-    sweep of the 32 km generated line of seed 21 takes 27 ms against 74 ms, 22 ms without them).
+    ``curve_v``, ``curve_p`` (n_nodes, n_curves): the curves' speeds and node positions (:func:`coast_curves`,
+    -1: no state). A curve's speed changes from node to node, so its control table
+    (:func:`control_table`) is its own at every node; it depends on the price only through its
+    ``toward`` entries onto the singular speeds ``V``, ``W`` of the next position. The rest (fixed
+    controls, node targets, ``toward`` the next position's curve speeds) is tabulated here, once, rather
+    than in every sweep (:func:`backward_sweep` adds the ``V``, ``W`` entries per price, from the cell's
+    full steps kept here).
+
+    Returns ``(row, n_entries, entries, steps)``: ``row`` (n_nodes, n_curves) the row of each state (-1:
+    none), per row its number of entries, ``entries`` (n_rows, 3, size): node position, net energy
+    (J, without the price of time) and time (s) of each entry, and ``steps`` (n_rows, 9), the cell's full
+    steps from the state (:func:`cell_steps`).
+    """
+    n, n_curves = curve_v.shape
+    active = curve_p >= 0.0
+    active[-1] = False  # no cell after the last node
+    row = np.full((n, n_curves), -1, dtype=np.int64)
+    n_rows = int(active.sum())
+    row[active] = np.arange(n_rows)
+    n_entries = np.zeros(n_rows, dtype=np.int64)
+    entries = np.empty((n_rows, 3, N_FIXED + n_curves + max_targets))
+    steps = np.empty((n_rows, 9))
+    if n_rows > 0:  # a case without curves compiles nothing here
+        _fill_curve_controls(m, np.ascontiguousarray(curve_v), np.ascontiguousarray(curve_p), row, n_speeds - 1,
+                             max_targets, bias, n_entries, entries, steps)
+    return row, n_entries, entries, steps
+
+
+@njit(cache=True, no_cfunc_wrapper=True)
+def _fill_curve_controls(m, curve_v, curve_p, row, k_max, max_targets, bias, n_entries, entries, steps):
+    size = entries.shape[2]
+    table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
+             np.empty(size))
+    for i in range(row.shape[0] - 1):
+        for c in range(row.shape[1]):
+            r = row[i, c]
+            if r < 0:
+                continue
+            v0 = curve_v[i, c]
+            count = control_table(m, i, v0, curve_v[i + 1], curve_p[i + 1], k_max, max_targets, bias, table, steps[r])
+            n_entries[r] = count
+            for p in range(count):
+                entries[r, 0, p] = table[2][p]
+                entries[r, 1, p] = table[3][p]
+                entries[r, 2, p] = table[4][p]
+
+
+@called
+def _toward_states(m, i, v0, lo, hi, steps, price_w, v_next, bias, sing_v, sp_next, sv_next, best):
+    """:func:`_singular_rows`' entries ``toward`` the next position's extra states ``lo .. hi - 1`` from ``v0``
+    (those in reach, :func:`out_of_reach`), each priced as :func:`entry_cost` prices it: the least of
+    them and ``best``."""
+    k_max = v_next.shape[0] - 1
+    top_u = m.envelope_ms[i + 1] ** 2
+    # as a tuple, as :func:`control_table` passes them: one compiled copy of :func:`control_entry`
+    st = (steps[0], steps[1], steps[2], steps[3], steps[4], steps[5], steps[6], steps[7], steps[8])
+    for q in range(lo, hi):
+        target = sing_v[i + 1, q]
+        if sp_next[q] < 0.0 or out_of_reach(v0, target, st[0], st[3]):
+            continue
+        e, d, p = control_entry(m, i, v0, np.int64(MODE_TOWARD), target, st, top_u, k_max, bias, 0.0)[1:]
+        if e < INF:
+            cost = e + price_w * d
+            cost += interp_aug(v_next, p, sp_next, sv_next)
+            if cost < best:
+                best = cost
+    return best
+
+
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
+def _singular_rows(m, i, t, price_w, v_next, max_targets, bias, floor_k, sing_v, sing_p, sing_val, memo_key,
+                   memo_n, memo, memo_steps, curves):
+    """Cost-to-go of the extra states at node ``i`` (:func:`backward_sweep`): every control from them.
+
+    The least :func:`entry_cost` of their control tables (:func:`control_table`), as a set (the least
+    cost does not depend on the order of the entries). For the singular speeds ``V``, ``W`` the table
+    without the ``toward`` entries onto the coast curves is kept per kind of cell ``t`` and singular
+    speed ``s`` in row ``t * N_SINGULAR + s`` of ``memo``: a cell of the kind last tabulated from the
+    same singular speed with the same next singular speeds (``memo_key``) reuses it, the same numbers bit
+    for bit, so a sweep pays the simulator's steps once per kind of cell rather than once per cell and
+    price of time (``benchmarks/peers.py --sweep-cpu``). The coast curves' entries (their speeds change
+    per node) are added per node from the cell's full steps kept in ``memo_steps``. A coast curve's own
+    table comes from ``curves`` (:func:`curve_controls`, built once per grid), its ``toward`` entries
+    onto ``V``, ``W`` added here.
     """
     sp_next = sing_p[i + 1]
     sv_next = sing_val[i + 1]
     n_sing = sing_v.shape[1]
+    n_own = min(n_sing, N_SINGULAR)
+    curve_row, curve_n, curve_entries, curve_steps = curves
     for s in range(n_sing):
         sing_val[i, s] = PENALTY_J
         if sing_p[i, s] < 0.0 or sing_p[i, s] < floor_k:
             continue
         v0 = sing_v[i, s]
-        row = t * n_sing + s
-        table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row], memo[5][row])
-        # the table's key: the speed held and the next position's singular targets (-1: none there)
-        key = memo_key[row]
-        same = key[0] == v0
-        for q in range(n_sing):
-            same = same and key[q + 1] == (sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0)
-        if not same:
-            memo_n[row] = control_table(m, i, v0, sing_v[i + 1], sp_next, v_next.shape[0] - 1, max_targets, bias,
-                                        table)
-            key[0] = v0
-            for q in range(n_sing):
-                key[q + 1] = sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0
-        best = table_minimum(table, memo_n[row], price_w, v_next, sp_next, sv_next)[0]
+        if s < N_SINGULAR:
+            row = t * N_SINGULAR + s
+            table = (memo[0][row], memo[1][row], memo[2][row], memo[3][row], memo[4][row], memo[5][row])
+            # the table's key: the speed held and the next position's singular targets (-1: none there)
+            key = memo_key[row]
+            same = key[0] == v0
+            for q in range(n_own):
+                same = same and key[q + 1] == (sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0)
+            if not same:
+                memo_n[row] = control_table(m, i, v0, sing_v[i + 1, :n_own], sp_next[:n_own], v_next.shape[0] - 1,
+                                            max_targets, bias, table, memo_steps[row])
+                key[0] = v0
+                for q in range(n_own):
+                    key[q + 1] = sing_v[i + 1, q] if sp_next[q] >= 0.0 else -1.0
+            best = table_minimum(table, memo_n[row], price_w, v_next, sp_next, sv_next)[0]
+            best = _toward_states(m, i, v0, n_own, n_sing, memo_steps[row], price_w, v_next, bias, sing_v, sp_next,
+                                  sv_next, best)
+        else:
+            r = curve_row[i, s - N_SINGULAR]
+            if r < 0:  # not a state of ``curves``: the sweep's extra states and ``curves`` come from one arrival
+                continue
+            best = INF
+            for p in range(curve_n[r]):
+                e = curve_entries[r, 1, p]
+                if e < INF:
+                    cost = e + price_w * curve_entries[r, 2, p]
+                    cost += interp_aug(v_next, curve_entries[r, 0, p], sp_next, sv_next)
+                    if cost < best:
+                        best = cost
+            # np.int64(0): a run-time int, not a literal (one compiled copy of _toward_states)
+            best = _toward_states(m, i, v0, np.int64(0), n_own, curve_steps[r], price_w, v_next, bias, sing_v, sp_next,
+                                  sv_next, best)
         sing_val[i, s] = best if best < PENALTY_J else PENALTY_J
 
 
 @njit(cache=True, no_cfunc_wrapper=True)
 def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1, tgt_e, tgt_dt, cell_type, value,
-                   floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias):
+                   floor_k, terminal_j, sing_v, sing_p, sing_val, max_targets, bias, curves):
     """Fill ``value`` (n_nodes, n_speeds) with the cost-to-go, from the end of the line backwards.
 
     ``time_price_w`` (n_cells,) is each cell's price of time beyond the auxiliary power (already in
@@ -871,7 +1032,9 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     from them with the simulator's steps (:func:`control_table`, as in the forward run, prices
     ``time_price_w`` + the auxiliary power), and every interpolation between regular nodes passes
     through them (:func:`interp_aug`). A speed grid meets them only by luck: this way the DP holds
-    them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone.
+    them exactly. Singular arrays with every ``sing_p`` at -1 give the speed grid alone. Their columns
+    after the first ``N_SINGULAR`` are the coast curves (:func:`coast_curves`), whose price-independent
+    controls ``curves`` holds (:func:`curve_controls` of those columns, built once per grid).
     """
     n, n_speeds = value.shape
     # at the end of the line the top node is the final speed (the envelope ends there; 0 at a
@@ -884,11 +1047,12 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
     # the singular speeds' control tables, one per kind of cell and singular speed, filled as the sweep
     # meets them (:func:`_singular_rows`); a key of NaN matches nothing
     n_sing = sing_v.shape[1]
-    n_rows = (offsets.shape[0] - 1) // n_speeds * n_sing
-    memo_key = np.full((n_rows, 1 + n_sing), np.nan)
-    split = np.zeros(n_speeds, dtype=np.bool_)  # :func:`interp_split`
+    n_rows = (offsets.shape[0] - 1) // n_speeds * N_SINGULAR
+    memo_key = np.full((n_rows, 1 + N_SINGULAR), np.nan)
+    split = np.zeros(n_speeds, dtype=np.bool_)  # :func:`sweep_cost`
     memo_n = np.zeros(n_rows, dtype=np.int64)
-    size = N_FIXED + n_sing + max_targets
+    memo_steps = np.empty((n_rows, 9))
+    size = N_FIXED + N_SINGULAR + max_targets
     memo = (np.empty((n_rows, size), dtype=np.int64), np.empty((n_rows, size)), np.empty((n_rows, size)),
             np.empty((n_rows, size)), np.empty((n_rows, size)), np.empty((n_rows, size)))
     for i in range(n - 2, -1, -1):
@@ -901,23 +1065,21 @@ def backward_sweep(m, time_price_w, fixed_u1, fixed_e, fixed_dt, offsets, tgt_u1
             if q >= 0.0 and q != math.floor(q):
                 split[int(q)] = True
         _singular_rows(m, i, t, time_price_w[i] + m.aux_power_w, v_next, max_targets, bias, floor_k[i], sing_v, sing_p,
-                       sing_val, memo_key, memo_n, memo)
+                       sing_val, memo_key, memo_n, memo, memo_steps, curves)
+        price = time_price_w[i]
         for j in range(n_speeds):
             best = INF
             for c in range(fixed_e.shape[2]):  # N_FIXED, and the part-power shares where the train has them
                 e = fixed_e[t, j, c]
                 if e < INF:
-                    p_next = np.float64(fixed_u1[t, j, c])
-                    cost = e + time_price_w[i] * fixed_dt[t, j, c] + interp_split(v_next, p_next, split, sp_next,
-                                                                                   sv_next)
+                    cost = sweep_cost(e, price * fixed_dt[t, j, c], fixed_u1[t, j, c], v_next, split, sp_next, sv_next)
                     if cost < best:
                         best = cost
             s = t * n_speeds + j
             for p in range(offsets[s], offsets[s + 1]):
                 e = tgt_e[p]
                 if e < INF:
-                    p_next = np.float64(tgt_u1[p])
-                    cost = e + time_price_w[i] * tgt_dt[p] + interp_split(v_next, p_next, split, sp_next, sv_next)
+                    cost = sweep_cost(e, price * tgt_dt[p], tgt_u1[p], v_next, split, sp_next, sv_next)
                     if cost < best:
                         best = cost
             value[i, j] = best if best < PENALTY_J and j >= floor_k[i] else PENALTY_J
@@ -964,6 +1126,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     size = N_FIXED + sp_all.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
     table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
              np.empty(size))
+    steps = np.empty(9)  # the cell's full steps (:func:`control_table`), not read here
     k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
@@ -973,7 +1136,7 @@ def forward_rollout(m, time_price_w, value, max_targets, bias, tie_j, modes, tar
     previous = MODE_TRACTION
     for i in range(n - 1):
         v_next, sp_next, sval_next = value[i + 1], sp_all[i + 1], sval_all[i + 1]
-        n_entries = control_table(m, i, v, sv_all[i + 1], sp_next, k_max, max_targets, bias, table)
+        n_entries = control_table(m, i, v, sv_all[i + 1], sp_next, k_max, max_targets, bias, table, steps)
         cost, p = table_minimum(table, n_entries, time_price_w[i], v_next, sp_next, sval_next)
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost
@@ -1020,7 +1183,7 @@ def terminal_cost(model, n_speeds: int, bias: float, end_lo_ms: float) -> np.nda
 
 def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, value: np.ndarray,
           floor_k: np.ndarray | None = None, terminal_j: np.ndarray | None = None, singular: bool = True,
-          sing: tuple | None = None, reuse: bool = False, arrival: tuple | None = None):
+          sing: tuple | None = None, reuse: bool = False, arrival: tuple | None = None, curves: tuple | None = None):
     """One DP solve at a price of time ``lambda_w`` (W, i.e. J per second of running time).
 
     ``lambda_w`` is one price, or one per cell (n_cells,): a journey's timing points give each
@@ -1042,7 +1205,8 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     earlier solve at the same price and settings: only the forward run is made (the certificate's run
     without the tie rule reuses the chosen run's sweep). ``arrival``: ``(curve_v, curve_p)`` of
     :func:`coast_curves`, the coast curves as further states (the columns of ``sing`` after the first
-    ``N_SINGULAR``; with ``singular`` only).
+    ``N_SINGULAR``; with ``singular`` only). ``curves``: :func:`curve_controls` of ``arrival`` on this grid
+    (the caller keeps them across prices; default: built here).
     """
     n = model.position_m.shape[0]
     if sing is None:
@@ -1064,8 +1228,11 @@ def solve(model, tables, lambda_w, max_targets: int, bias: float, tie_j: float, 
     else:
         sing_v[:] = 0.0
         sing_p[:] = -1.0
+    if curves is None or not singular:
+        curves = curve_controls(model, sing_v[:, N_SINGULAR:], sing_p[:, N_SINGULAR:], value.shape[1], max_targets,
+                                bias)
     backward_sweep(model, prices, *tables, value, floor_k, terminal_j, sing_v, sing_p, sing_val, int(max_targets),
-                   float(bias))
+                   float(bias), curves)
     return _rollout(model, lambda_w, max_targets, bias, tie_j, value, sing_v, sing_p, sing_val)
 
 
@@ -1140,14 +1307,14 @@ def part_power_shares(m) -> np.ndarray:
     return PART_POWER_SHARES.copy() if varying_maps(m)[0] else np.empty(0)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def part_power_target(m, cell):
     """The target speed of a part-power row (m/s): the braking envelope at the cell's end, which the
     ``toward`` row lands on rather than overshoot (the envelope would stop it there anyway)."""
     return m.envelope_ms[cell + 1]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def part_power_outcome(m, v0, cell, share):
     """The simulator's cell of a ``toward`` row at traction ``share`` (:func:`part_power_target`):
     ``(u1, force_n, w0_n)``, as :func:`cell_outcome` gives it for a row of full traction."""
@@ -1181,7 +1348,7 @@ def part_power_transitions(m, n_speeds: int, bias: float, first_cell: np.ndarray
     return out
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_p, sing_val):
     """Cell cost plus interpolated cost-to-go of traction at ``share`` from ``v0`` (:func:`entry_cost`'s sum)."""
     u1, f, w0 = part_power_outcome(m, v0, cell, share)
@@ -1191,7 +1358,7 @@ def part_power_cost(m, v0, cell, share, time_price_w, v_next, top_u, bias, sing_
     return cost
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(cache=True, no_cfunc_wrapper=True, _nrt=False)
 def best_part_power(m, cell, v0, time_price_w, v_next, bias, sing_p, sing_val, shares):
     """The best traction share from ``v0``: the best of ``shares``, refined by golden section between its
     neighbours (0 and 1 at the ends). Returns ``(total_cost, share)``.
@@ -1247,6 +1414,7 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     size = N_FIXED + sing_v.shape[1] + max_targets  # a control table (:func:`control_table`), rewritten every cell
     table = (np.empty(size, dtype=np.int64), np.empty(size), np.empty(size), np.empty(size), np.empty(size),
              np.empty(size))
+    steps = np.empty(9)  # the cell's full steps (:func:`control_table`), not read here
     k_max = value.shape[1] - 1
     v = m.initial_speed_ms
     speeds[0] = v
@@ -1254,7 +1422,7 @@ def forward_rollout_part_power(m, time_price_w, value, max_targets, bias, tie_j,
     previous, previous_share = MODE_TRACTION, 1.0  # the control of the cell before
     for i in range(n - 1):
         price = time_price_w[i]
-        n_entries = control_table(m, i, v, sing_v[i + 1], sing_p[i + 1], k_max, max_targets, bias, table)
+        n_entries = control_table(m, i, v, sing_v[i + 1], sing_p[i + 1], k_max, max_targets, bias, table, steps)
         cost, p = table_minimum(table, n_entries, price, value[i + 1], sing_p[i + 1], sing_val[i + 1])
         if cost >= PENALTY_J:  # every control leads to a stop short of the platform
             return i, energy, time, tie_cost

@@ -151,6 +151,7 @@ class OptimalSolver:
         self._arrival = dp.coast_curves(self.simulator.model, float(self.end_speed_ms[0]), self.n_speeds,
                                         self.top_bias)
         self._sing = tuple(np.empty((n_nodes, dp.N_SINGULAR + self._arrival[0].shape[1])) for _ in range(3))
+        self._curves = None  # the curves' price-independent controls (dp.curve_controls), built on the first sweep
         self.speed_floor_ms: np.ndarray | None = None
         self._floor_k: np.ndarray | None = None
         self.set_speed_floor(speed_floor_ms)
@@ -230,9 +231,12 @@ class OptimalSolver:
         prices = lambda_w if self.price_shape is None else lambda_w * self.price_shape
         # the cost-to-go of the last sweep still holds at its price and settings: only the forward run
         key = (lambda_w, id(self.price_shape), id(self._floor_k))
+        if self._curves is None and self.singular:
+            self._curves = dp.curve_controls(self.simulator.model, *self._arrival, self.n_speeds, self.max_targets,
+                                             self.top_bias)
         run = dp.solve(self.simulator.model, self._tables, prices, self.max_targets, self.top_bias, tie_j,
                        self._value, self._floor_k, self._terminal_j, self.singular, self._sing, self._swept == key,
-                       self._arrival)
+                       self._arrival, self._curves)
         self._swept = key
         return run
 

@@ -73,3 +73,34 @@ def test_value_of_a_moving_end_matches_its_run(moving_end_case):
     run = solver.solve_price(lam)
     gap_kwh = (run.value_j - (run.energy_j + lam * run.time_s)) / J_PER_KWH
     assert -0.01 < gap_kwh < 0.1
+
+
+def test_extra_states_cost_to_go_is_the_least_cost_of_their_whole_control_table(moving_end_case):
+    """The sweep keeps the coast curves' price-independent controls across prices (``dp.curve_controls``) and
+    shares the singular speeds' tables per kind of cell without their ``toward``-curve entries: at every extra
+    state its cost-to-go is still, bit for bit, the least cost of the state's whole control table
+    (``dp.control_table`` with every extra state of the next node as a target)."""
+    solver = OptimalSolver(moving_end_case, certify=False)
+    m, tables = solver.simulator.model, solver.transition_tables()
+    n, n_speeds, bias, max_targets = m.position_m.shape[0], solver.n_speeds, solver.top_bias, solver.max_targets
+    curve_v, curve_p = dp.coast_curves(m, float(solver.end_speed_ms[0]), n_speeds, bias)
+    value = np.empty((n, n_speeds))
+    sing_v, sing_p, sing_val = (np.empty((n, dp.N_SINGULAR + curve_v.shape[1])) for _ in range(3))
+    terminal_j = dp.terminal_cost(m, n_speeds, bias, solver.end_speed_ms[0])
+    lam = 6.0e5
+    dp.solve(m, tables, lam, max_targets, bias, solver.tie_j, value, terminal_j=terminal_j,
+             sing=(sing_v, sing_p, sing_val), arrival=(curve_v, curve_p))
+    size = dp.N_FIXED + sing_v.shape[1] + max_targets
+    table = (np.empty(size, dtype=np.int64), *(np.empty(size) for _ in range(5)))
+    steps = np.empty(9)
+    checked = {"singular": 0, "curve": 0}
+    for i in range(n - 1):
+        for s in range(sing_v.shape[1]):
+            if sing_p[i, s] < 0.0 or (s < dp.N_SINGULAR and i % 5):
+                continue
+            count = dp.control_table(m, i, sing_v[i, s], sing_v[i + 1], sing_p[i + 1], n_speeds - 1, max_targets, bias,
+                                     table, steps)
+            best = dp.table_minimum(table, count, lam + m.aux_power_w, value[i + 1], sing_p[i + 1], sing_val[i + 1])[0]
+            assert sing_val[i, s] == min(best, dp.PENALTY_J), (i, s)
+            checked["singular" if s < dp.N_SINGULAR else "curve"] += 1
+    assert checked["singular"] > 100 and checked["curve"] > 100, checked
