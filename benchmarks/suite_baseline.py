@@ -33,7 +33,7 @@ from pathlib import Path
 import numba
 
 from pymoo_rail.experiments import read_study, run_study
-from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, convergence,
+from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, checkpoints_kb, convergence,
                                              cpu_per_evaluation_ms, cut_study, front_versions, fronts_statement,
                                              indicator_frame, performance_profile, projected_cpu_h)
 from pymoo_rail.experiments.report import write_filled
@@ -72,6 +72,7 @@ def report_values(study, frame, records, pictures, command: str) -> dict:
             "runs": len(frame), "cpu_min": f"{frame['cpu_time_s'].sum() / 60:.1f}",
             "cpu_mean": f"{frame['cpu_time_s'].mean():.2f}", "indicators": ", ".join(INDICATORS),
             "table": to_markdown(table, bold_marker=None), "fronts": fronts_statement(front_versions(records)),
+            "checkpoints_kb": checkpoints_kb(records),
             "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
 
 

@@ -29,6 +29,7 @@ scores the checkpoints the same way (the convergence figure).
 from __future__ import annotations
 
 import hashlib
+import json
 import tarfile
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -145,6 +146,12 @@ def front_versions(records: Iterable[dict]) -> pd.DataFrame:
         rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
                      "front_version": problem.front_version, "front_digest": front_digest(problem)})
     return pd.DataFrame(rows).sort_values(["family", "n_var", "instance_seed"]).reset_index(drop=True)
+
+
+def checkpoints_kb(records: Iterable[dict]) -> str:
+    """The size of the records' ``checkpoints`` (compact JSON, kB): median and largest, for the report."""
+    sizes = np.array([len(json.dumps(r.get("checkpoints"), separators=(",", ":"))) / 1000 for r in records])
+    return f"median {np.median(sizes):.1f} kB, largest {sizes.max():.1f} kB" if len(sizes) else "no records"
 
 
 def fronts_statement(fronts: pd.DataFrame) -> str:
@@ -286,6 +293,6 @@ def archive_records(work: str | Path, path: str | Path, top: str = "suite_baseli
 
 
 __all__ = ["INDICATORS", "RANK_INDICATOR", "instance_of", "FrontScorer", "front_scorer", "baseline_indicators",
-           "indicator_frame", "front_versions", "fronts_statement", "baseline_table",
+           "indicator_frame", "front_versions", "fronts_statement", "checkpoints_kb", "baseline_table",
            "performance_profile", "convergence", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
            "archive_records"]

@@ -21,7 +21,8 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
         for name, runs in cell.groupby("algorithm"):
             median = runs.groupby("n_eval")[indicator].median()
             ax.plot(median.index, median.to_numpy(), label=name)
-        ax.set(title=f"{family} n_var={n_var}", xlabel="evaluations", ylabel=f"median {indicator}", yscale="log")
+        ax.set(title=f"{family} n_var={n_var}", xlabel="evaluations", ylabel=f"median {indicator}", xscale="log",
+               yscale="log")  # the checkpoints are a log ladder
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
     return fig

@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, convergence, indicator_frame,
-                                             instance_of, performance_profile)
+from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, checkpoints_kb, convergence,
+                                             indicator_frame, instance_of, performance_profile)
 from pymoo_rail.experiments.runner import execute_run
 from pymoo_rail.experiments.spec import Budget, RunSpec, algorithm, problem
 from pymoo_rail.suite import get_problem
@@ -86,8 +86,8 @@ def test_a_suite_record_holds_raw_vectors_and_nothing_scored_against_the_front(r
 
 
 def test_convergence_scores_each_checkpoint_and_the_final_front(records):
-    longer = execute_run(RunSpec(problem("suite_family", family=FAMILY, n_var=10, seed=1), algorithm("nsga2", pop_size=50),
-                                 1, Budget("n_eval", 1200)))
+    spec = problem("suite_family", family=FAMILY, n_var=10, seed=1)
+    longer = execute_run(RunSpec(spec, algorithm("nsga2", pop_size=50), 1, Budget("n_eval", 1200)))
     assert longer["checkpoints"]["target_n_eval"] == [200, 500, 1000]
     assert longer["checkpoints"]["n_eval"] == [200, 500, 1000]
     history = convergence([{**longer, "algorithm_label": "nsga2"}])
@@ -149,3 +149,12 @@ def test_a_record_with_malformed_checkpoints_is_refused_naming_the_field(records
     store.write({**good, "checkpoints": checkpoints})
     with pytest.raises(RecordError, match="field 'checkpoints'"):
         store.load(good["run_id"])
+
+
+def test_the_report_states_the_size_of_the_checkpoints(records):
+    import json
+
+    sizes = sorted(len(json.dumps(r["checkpoints"], separators=(",", ":"))) / 1000 for r in records)
+    assert checkpoints_kb(records) == f"median {np.median(sizes):.1f} kB, largest {sizes[-1]:.1f} kB"
+    assert 0 < sizes[-1] < 30
+    assert checkpoints_kb([]) == "no records"

@@ -174,7 +174,8 @@ def test_stored_suite_runs_stay_current_when_the_front_improves_and_their_scores
     run_study(study, tmp_path, workers=1, progress=False)
     records = load_records(tmp_path, study)
     before = indicator_frame(records).iloc[0]
-    digest, version = front_digest(get_problem(FAMILY, n_var=10, seed=1)), get_problem(FAMILY, n_var=10, seed=1).front_version
+    instance = get_problem(FAMILY, n_var=10, seed=1)
+    digest, version = front_digest(instance), instance.front_version
     real = FamilyProblem.certified_front
     # another front (a solver that finds 1 % lower energies) under a new front version: the same code digest
     monkeypatch.setattr(FamilyProblem, "certified_front", lambda self: _scaled_front(real(self), 0.99))
@@ -199,8 +200,8 @@ def test_a_suite_run_never_reads_its_front(monkeypatch, family):
 
     for name in ("certified_front", "bounded_front", "_calc_pareto_front", "hv_reference_point"):
         monkeypatch.setattr(FamilyProblem, name, refuse)
-    record = execute_run(RunSpec(problem("suite_family", family=family, n_var=10, seed=1), algorithm("nsga2", pop_size=10),
-                                 1, Budget("n_eval", 220)))
+    spec = problem("suite_family", family=family, n_var=10, seed=1)
+    record = execute_run(RunSpec(spec, algorithm("nsga2", pop_size=10), 1, Budget("n_eval", 220)))
     assert record["checkpoints"]["target_n_eval"] == [200] and len(record["checkpoints"]["F"][0][0]) == record["n_obj"]
 
 
