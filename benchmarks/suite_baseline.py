@@ -33,9 +33,9 @@ from pathlib import Path
 import numba
 
 from pymoo_rail.experiments import read_study, run_study
-from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, convergence,
-                                             cpu_per_evaluation_ms, cut_study, indicator_frame, performance_profile,
-                                             projected_cpu_h)
+from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, checkpoints_kb, convergence,
+                                             cpu_per_evaluation_ms, cut_study, front_versions, fronts_statement,
+                                             indicator_frame, performance_profile, projected_cpu_h)
 from pymoo_rail.experiments.report import write_filled
 from pymoo_rail.experiments.results import load_records
 from pymoo_rail.experiments.run_cost import PARTS, cpu_profile, cpu_shares
@@ -48,7 +48,8 @@ TEMPLATE = ROOT / "benchmarks" / "templates" / "suite_baseline.md"
 
 
 def figures(records, frame, out: Path) -> list[str]:
-    """Median IGD vs evaluations per (family, n_var), and the performance profile on IGD+ (PNG files)."""
+    """Median IGD+ vs evaluations per (family, n_var) (the records' checkpoints scored now), and the
+    performance profile on IGD+ (PNG files)."""
     import matplotlib.pyplot as plt
 
     plot_cell_convergence(convergence(records)).savefig(out / "suite_baseline_convergence.png", dpi=110)
@@ -58,7 +59,7 @@ def figures(records, frame, out: Path) -> list[str]:
     return ["suite_baseline_convergence.png", "suite_baseline_profile.png"]
 
 
-def report_values(study, frame, pictures, command: str) -> dict:
+def report_values(study, frame, records, pictures, command: str) -> dict:
     """The report's numbers: what ran, its CPU, the table and the figures."""
     table = baseline_table(frame)
     table["friedman_p"] = table["friedman_p"].map(lambda p: f"{p:.2g}")
@@ -70,7 +71,9 @@ def report_values(study, frame, pictures, command: str) -> dict:
             "seeds": len(study.seeds), "budget_kind": study.budget.kind, "budget": f"{study.budget.value:,}",
             "runs": len(frame), "cpu_min": f"{frame['cpu_time_s'].sum() / 60:.1f}",
             "cpu_mean": f"{frame['cpu_time_s'].mean():.2f}", "indicators": ", ".join(INDICATORS),
-            "table": to_markdown(table, bold_marker=None), "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
+            "table": to_markdown(table, bold_marker=None), "fronts": fronts_statement(front_versions(records)),
+            "checkpoints_kb": checkpoints_kb(records),
+            "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
 
 
 def profile(study, algorithms, threads: int) -> int:
@@ -127,7 +130,7 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     command = "python benchmarks/suite_baseline.py " + " ".join(argv if argv is not None else sys.argv[1:])
     pictures = figures(records, frame, out)
-    write_filled(out / "suite_baseline.md", TEMPLATE, report_values(study, frame, pictures, command.strip()))
+    write_filled(out / "suite_baseline.md", TEMPLATE, report_values(study, frame, records, pictures, command.strip()))
     print(f"wrote {out / 'suite_baseline.md'}")
     if args.estimate:
         hours, sizes = projected_cpu_h(frame, read_study(STUDY_FILE))

@@ -1,8 +1,11 @@
 """The suite's baseline table: indicators of study runs on family instances, ranks and profiles.
 
 A baseline study (``benchmarks/suite_baseline.toml``) runs algorithms on instances
-``problem = "suite_family"`` (family, n_var, seed). Each record is scored here against its
-instance's certified front:
+``problem = "suite_family"`` (family, n_var, seed). A record holds raw objective vectors only: its
+final front and the non-dominated feasible vectors at a few evaluation checkpoints
+(:data:`pymoo_rail.experiments.runner.CHECKPOINTS_EVAL`). They are scored here against the
+instance's front of the version this code has (:func:`front_versions` says which, for the report),
+so records stay current when the exact solver improves and their scores follow its fronts:
 
 - ``igd_plus``: pymoo's IGD+ of the feasible final front to the certified front (raw units);
 - ``hv_norm``: hypervolume at the family's fixed reference point
@@ -17,7 +20,8 @@ lies between the inner points' value and 1), and ``gap_kwh`` is to the line's ce
 running-time front, which bounds the energy of any run whatever its comfort.
 
 A record whose instance checksum (``inputs["problem instance checksum"]``) differs from the
-instance this code builds is refused: it was computed on another definition.
+instance this code builds is refused: it was computed on another definition. :func:`convergence`
+scores the checkpoints the same way (the convergence figure).
 :func:`baseline_table` ranks the algorithms per (family, n_var) with
 :func:`.stats.friedman_holm`; :func:`performance_profile` gives Dolan & More's (2002) profile.
 """
@@ -25,14 +29,16 @@ instance this code builds is refused: it was computed on another definition.
 from __future__ import annotations
 
 import hashlib
+import json
 import tarfile
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterable, Sequence
 
 import numpy as np
 import pandas as pd
 
+from pymoo_rail.experiments.inputs import front_digest
 from pymoo_rail.experiments.registry import canonical_name
 from pymoo_rail.experiments.spec import Budget
 from pymoo_rail.experiments.stats import friedman_holm
@@ -59,41 +65,103 @@ def instance_of(record: dict):
     return problem
 
 
-def baseline_indicators(record: dict, problem=None) -> dict[str, float]:
-    """IGD+, normalised HV and median energy gap of one record (NaN where no member is feasible)."""
-    from pymoo.indicators.hv import HV
-    from pymoo.indicators.igd_plus import IGDPlus
+@dataclass(frozen=True)
+class FrontScorer:
+    """The fronts one instance's runs are scored against, read once (:func:`front_scorer`)."""
 
-    problem = instance_of(record) if problem is None else problem
-    F = np.asarray(record["front"]["F"], dtype=float).reshape(-1, problem.n_obj)
-    F = F[np.asarray(record["front"]["CV"], dtype=float).reshape(-1) <= 0]
-    out = dict.fromkeys(INDICATORS, float("nan"))
-    if len(F) == 0:
+    problem: object
+    pf: np.ndarray
+    hv_reference_point: np.ndarray
+    hv_whole: float  # the certified front's hypervolume, or the outer bound's for a bounded front
+
+    def score(self, F: np.ndarray) -> dict[str, float]:
+        """IGD+, normalised HV and median energy gap of the feasible objective vectors ``F`` (NaN for none)."""
+        from pymoo.indicators.hv import HV
+        from pymoo.indicators.igd_plus import IGDPlus
+
+        F = np.asarray(F, dtype=float).reshape(-1, self.problem.n_obj)
+        out = dict.fromkeys(INDICATORS, float("nan"))
+        if len(F) == 0:
+            return out
+        objectives = list(self.problem.objectives)
+        gap = certified_gap(self.problem.certified_front(), F[:, objectives.index("running_time")],
+                            F[:, objectives.index("energy")])
+        hv = HV(ref_point=self.hv_reference_point)
+        out.update(igd_plus=float(IGDPlus(self.pf)(F)), hv_norm=float(hv(F) / self.hv_whole),
+                   gap_kwh=gap["gap_median_kwh"])
         return out
-    pf = problem.pareto_front()
-    hv = HV(ref_point=problem.hv_reference_point())
-    objectives = list(problem.objectives)
-    gap = certified_gap(problem.certified_front(), F[:, objectives.index("running_time")],
-                        F[:, objectives.index("energy")])
+
+
+def front_scorer(problem) -> FrontScorer:
+    """The current front of a family instance, its fixed HV reference point and the HV that counts as 1."""
+    from pymoo.indicators.hv import HV
+
+    pf, ref = problem.pareto_front(), problem.hv_reference_point()
     # a bounded front (the -3obj families): HV over the outer bound's, so 1 is out of reach of any run
-    whole = problem.bounded_front().hv_outer if problem.objectives == COMFORT_OBJECTIVES else hv(pf)
-    out.update(igd_plus=float(IGDPlus(pf)(F)), hv_norm=float(hv(F) / whole), gap_kwh=gap["gap_median_kwh"])
-    return out
+    whole = problem.bounded_front().hv_outer if problem.objectives == COMFORT_OBJECTIVES else HV(ref_point=ref)(pf)
+    return FrontScorer(problem, pf, ref, float(whole))
+
+
+def baseline_indicators(record: dict, problem=None, scorer: FrontScorer | None = None) -> dict[str, float]:
+    """IGD+, normalised HV and median energy gap of one record's final front (NaN where no member is feasible)."""
+    problem = scorer.problem if scorer is not None else instance_of(record) if problem is None else problem
+    scorer = front_scorer(problem) if scorer is None else scorer
+    F = np.asarray(record["front"]["F"], dtype=float).reshape(-1, problem.n_obj)
+    return scorer.score(F[np.asarray(record["front"]["CV"], dtype=float).reshape(-1) <= 0])
+
+
+def _scorers(records: Iterable[dict]) -> dict:
+    """One :class:`FrontScorer` per distinct instance of ``records``, by the record's problem parameters."""
+    scorers = {}
+    for record in records:
+        key = tuple(sorted(record["problem"].items()))
+        if key not in scorers:
+            scorers[key] = front_scorer(instance_of(record))
+    return scorers
 
 
 def indicator_frame(records: Iterable[dict]) -> pd.DataFrame:
     """One row per record: family, n_var, instance seed, run seed, algorithm, the indicators, CPU and evaluations."""
-    rows, instances = [], {}
+    records = list(records)
+    scorers, rows = _scorers(records), []
     for record in records:
-        key = tuple(sorted(record["problem"].items()))
-        if key not in instances:
-            instances[key] = instance_of(record)
-        problem = instances[key]
+        scorer = scorers[tuple(sorted(record["problem"].items()))]
+        problem = scorer.problem
         rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
                      "seed": int(record["seed"]), "algorithm": record["algorithm_label"],
-                     **baseline_indicators(record, problem),
+                     **baseline_indicators(record, scorer=scorer),
                      "cpu_time_s": float(record["cpu_time_s"]), "n_eval": int(record["n_eval"])})
     return pd.DataFrame(rows)
+
+
+def front_versions(records: Iterable[dict]) -> pd.DataFrame:
+    """The fronts a report scores ``records`` against: per instance its front version and content digest.
+
+    ``front_version``: :attr:`pymoo_rail.suite.FamilyProblem.front_version`; ``front_digest``:
+    :func:`pymoo_rail.experiments.inputs.front_digest`. Neither is part of a record: a report states them.
+    """
+    rows = []
+    for scorer in _scorers(records).values():
+        problem = scorer.problem
+        rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
+                     "front_version": problem.front_version, "front_digest": front_digest(problem)})
+    return pd.DataFrame(rows).sort_values(["family", "n_var", "instance_seed"]).reset_index(drop=True)
+
+
+def checkpoints_kb(records: Iterable[dict]) -> str:
+    """The size of the records' ``checkpoints`` (compact JSON, kB): median and largest, for the report."""
+    sizes = np.array([len(json.dumps(r.get("checkpoints"), separators=(",", ":"))) / 1000 for r in records])
+    return f"median {np.median(sizes):.1f} kB, largest {sizes.max():.1f} kB" if len(sizes) else "no records"
+
+
+def fronts_statement(fronts: pd.DataFrame) -> str:
+    """A report's sentence on the fronts it scored against (:func:`front_versions`): their versions and
+    one digest of their content digests, so two reports say whether they scored against the same fronts."""
+    digest = hashlib.sha256("\n".join(fronts["front_digest"]).encode()).hexdigest()[:16]
+    versions = ", ".join(f"{v} ({n} instance{'s' if n > 1 else ''})"
+                         for v, n in fronts["front_version"].value_counts().sort_index().items())
+    return (f"Scored against the fronts of version {versions}; their content digests "
+            f"(`pymoo_rail.experiments.inputs.front_digest`, one per instance) hash to `{digest}`.")
 
 
 def _cell(values: pd.Series) -> str:
@@ -142,16 +210,24 @@ def performance_profile(frame: pd.DataFrame, indicator: str = RANK_INDICATOR,
                         index=pd.Index(taus, name="tau"))
 
 
-def convergence(records: Iterable[dict], indicator: str = "igd") -> pd.DataFrame:
-    """The per-generation history of the records: family, n_var, algorithm, seed, n_eval and ``indicator``."""
-    rows = []
+def convergence(records: Iterable[dict]) -> pd.DataFrame:
+    """The records' indicators against the current fronts at each checkpoint and at the end of the run.
+
+    One row per record and checkpoint (``checkpoints`` of a suite run: the non-dominated feasible
+    objective vectors at the first generation past each of
+    :data:`~pymoo_rail.experiments.runner.CHECKPOINTS_EVAL` evaluations), and one for its final front
+    at its ``n_eval``: family, n_var, algorithm, seed, n_eval and the :data:`INDICATORS`.
+    """
+    records = list(records)
+    scorers, rows = _scorers(records), []
     for record in records:
-        history = record.get("history") or {}
-        values = history.get(indicator) or []
-        params = record["problem"]
-        rows += [{"family": params["family"], "n_var": params.get("n_var"), "algorithm": record["algorithm_label"],
-                  "seed": record["seed"], "n_eval": n_eval, indicator: value}
-                 for n_eval, value in zip(history.get("n_eval", []), values) if value is not None]
+        scorer = scorers[tuple(sorted(record["problem"].items()))]
+        checkpoints = record.get("checkpoints") or {"n_eval": [], "F": []}
+        cell = {"family": scorer.problem.family, "n_var": int(scorer.problem.n_var),
+                "algorithm": record["algorithm_label"], "seed": int(record["seed"])}
+        rows += [{**cell, "n_eval": int(n_eval), **scorer.score(F)}
+                 for n_eval, F in zip(checkpoints["n_eval"], checkpoints["F"]) if n_eval < record["n_eval"]]
+        rows.append({**cell, "n_eval": int(record["n_eval"]), **baseline_indicators(record, scorer=scorer)})
     return pd.DataFrame(rows)
 
 
@@ -216,6 +292,7 @@ def archive_records(work: str | Path, path: str | Path, top: str = "suite_baseli
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-__all__ = ["INDICATORS", "RANK_INDICATOR", "instance_of", "baseline_indicators", "indicator_frame", "baseline_table",
+__all__ = ["INDICATORS", "RANK_INDICATOR", "instance_of", "FrontScorer", "front_scorer", "baseline_indicators",
+           "indicator_frame", "front_versions", "fronts_statement", "checkpoints_kb", "baseline_table",
            "performance_profile", "convergence", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
            "archive_records"]

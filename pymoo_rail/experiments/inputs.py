@@ -10,9 +10,10 @@ seed and budget. The result also depends on things a spec only names:
   a record computed on one content and labelled with another;
 - any other file a problem or algorithm parameter names (its bytes);
 - the definition checksum of a suite family instance (``problem = "suite_family"``), so a record
-  computed on another definition of ``(family, n_var, seed)`` is redone, and the digest of the
-  *content* of the reference front the run is scored and logged against (:func:`front_digest`),
-  so a solver change that leaves the front as it was changes nothing;
+  computed on another definition of ``(family, n_var, seed)`` is redone. Not its front: a suite
+  family run keeps raw objective vectors and computes nothing against the front
+  (:func:`.runner.execute_run`); the report scores them against the front of its own time and
+  states its version and :func:`front_digest`, so a better exact solver keeps every stored run;
 - the module of a ``"package.module:factory"`` spec (its source bytes; looked up only when the
   study is trusted, since finding a module imports its parent packages);
 - the code that computes the result: a digest of the package's own source and data files
@@ -39,7 +40,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from pymoo_rail.experiments.metrics import true_front_and_reason
-from pymoo_rail.experiments.registry import canonical_name
+from pymoo_rail.experiments.registry import is_suite_family
 from pymoo_rail.experiments.spec import AlgorithmSpec, ProblemSpec, RunSpec, canonical_json
 
 # fingerprint keys that describe the code rather than the data of a run (see ``code_only``)
@@ -94,7 +95,10 @@ def _module_digest(path: str) -> str | None:
 
 
 def front_digest(problem) -> str:
-    """The digest of the content of the reference front a run of ``problem`` is scored and logged against.
+    """The digest of the content of the reference front the runs of ``problem`` are scored against.
+
+    Stated by the baseline report (:func:`pymoo_rail.experiments.baseline.front_versions`), not in
+    a suite run's fingerprint: its record holds raw objective vectors only.
 
     A front the exact solver certified counts as the file it is cached in (its nodes to 9
     significant digits, :meth:`~pymoo_rail.optimal.reference.CertifiedFront.to_csv_text`): the
@@ -119,19 +123,14 @@ def front_digest(problem) -> str:
 
 
 def _instance_inputs(params: Mapping[str, Any]) -> dict[str, str]:
-    """The definition checksum of the suite family instance ``params`` name and the digest of its
-    reference front (or why it has neither)."""
+    """The definition checksum of the suite family instance ``params`` name (or why it has none)."""
     from pymoo_rail.suite import get_problem
 
     try:
         instance = get_problem(params.get("family"), n_var=params.get("n_var"), seed=params.get("seed"))
     except Exception as err:  # noqa: BLE001 - the run itself will report the error
         return {"problem instance checksum": f"unbuildable: {type(err).__name__}"}
-    try:
-        front = front_digest(instance)
-    except Exception as err:  # noqa: BLE001 - the run itself will report the error
-        front = f"unavailable: {type(err).__name__}"
-    return {"problem instance checksum": instance.checksum, "problem reference front": front}
+    return {"problem instance checksum": instance.checksum}
 
 
 def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
@@ -146,7 +145,7 @@ def resolve_spec(spec: ProblemSpec | AlgorithmSpec) -> RunInputs:
         digest = _module_digest(spec.name)
         if digest is not None:
             out[f"{kind} module {spec.name.partition(':')[0]}"] = digest
-    if kind == "problem" and canonical_name(spec.name) == "suite_family":
+    if kind == "problem" and is_suite_family(spec):
         out.update(_instance_inputs(spec.params))
     for key, value in spec.params.items():
         if not isinstance(value, str):
@@ -168,19 +167,18 @@ def spec_inputs(spec: ProblemSpec | AlgorithmSpec) -> dict[str, str]:
 # The parts of the package (paths relative to it, as package_digest takes them) whose code computes
 # the numbers of a suite family run: the model and the simulator, the problem that evaluates an
 # instance, the family definitions, the algorithms and indicators, and the runner's loop (building
-# the problem and the algorithm, the penalty, the history and the record's indicators). Not in it,
-# because a run never executes them or gets their output only as content fingerprinted on its own:
-# cases (the generated line and train are in the instance checksum, by content), optimal (the
-# planner's window and time tolerance are in the checksum, the front by the digest of its content;
-# only optimal/reference/front.py, which turns a front's nodes into pareto_front(), is a part),
-# control (imported for a type; a suite instance has no tracker), journeys (for the -trip families
+# the problem and the algorithm, the penalty, the history and its checkpoints). Not in it, because
+# a run never executes them or gets their output only as content fingerprinted on its own: cases
+# (the generated line and train are in the instance checksum, by content), optimal (the planner's
+# window and time tolerance are in the checksum; a run never reads the front: its record holds raw
+# objective vectors, scored by the report against the front of its time), control (imported for a type; a suite instance has no tracker), journeys (for the -trip families
 # only), suite's loggers and shipped files, cli, plotting and the other studies.
 # tests/experiments/test_suite_fingerprint.py runs suite runs in a fresh interpreter and fails if
 # a run executes code outside these parts that is not listed there with its reason.
 SUITE_RUN_PARTS = (
     "constants.py", "model", "sim",
     "problems/__init__.py", "problems/lazy.py", "problems/speed_profile.py", "problems/objectives.py",
-    "problems/reference.py", "problems/encodings", "optimal/reference/front.py",
+    "problems/reference.py", "problems/encodings",
     "suite/families.py", "suite/comfort.py", "suite/trips.py", "suite/identity.py", "suite/problems.py",
     "algorithms", "indicators",
     "experiments/runner.py", "experiments/registry.py", "experiments/spec.py", "experiments/penalty.py",
@@ -197,7 +195,7 @@ def code_parts(spec: ProblemSpec) -> tuple[str, ...] | None:
     Named rail problems and the others keep the whole package: they reach cases, controllers or
     solvers in too many ways to list, and their studies are short.
     """
-    if canonical_name(spec.name) != "suite_family":
+    if not is_suite_family(spec):
         return None
     from pymoo_rail.suite.families import family
 

@@ -609,6 +609,11 @@ def canonical_name(name: str) -> str:
     return ALIASES.get(key.replace("_", "-"), key)
 
 
+def is_suite_family(spec) -> bool:
+    """True when a problem spec names a suite family instance (``problem = "suite_family"``)."""
+    return canonical_name(spec.name) == "suite_family"
+
+
 def _import_path(path: str, kind: str, trusted: bool) -> Callable[..., Any]:
     if not trusted:
         raise UntrustedCodeError(kind, path, TRUST_HINT)

@@ -42,7 +42,8 @@ from pymoo_rail.experiments.inputs import RunInputs, changed_inputs, resolve_run
 from pymoo_rail.experiments.metrics import (convergence_point, front_indicators, true_front_and_reason,
                                             unavailable_indicators)
 from pymoo_rail.experiments.penalty import DEFAULT_PENALTY, PenalisedConstraints, handles_constraints
-from pymoo_rail.experiments.registry import build_algorithm, build_problem, check_parameters, check_trust
+from pymoo_rail.experiments.registry import (build_algorithm, build_problem, check_parameters, check_trust,
+                                             is_suite_family)
 from pymoo_rail.experiments.spec import RunSpec, Study, StudyError
 from pymoo_rail.experiments.store import (CORRUPT_DIR, RECORD_FORMAT, STALE_DIR, STUDY_FILE, LegacyRecordError,
                                           RecordError, ResultStore, writing)
@@ -50,6 +51,8 @@ from pymoo_rail.lockfiles import release_removing
 
 # per-individual outputs a rail problem puts next to F (DESIGN.md section 3); kept with the front
 EXTRA_KEYS = ("energy_kwh", "running_time_s", "stop_error_m")
+RAW_RECORD_REASON = ("a suite family run keeps raw objective vectors; the report scores them against the front of "
+                     "its version (pymoo_rail.experiments.baseline)")
 
 
 def versions() -> dict[str, str]:
@@ -77,19 +80,68 @@ def _extras(problem, opt, X: np.ndarray) -> dict[str, list[float]]:
     return extras
 
 
-class _History:
-    """pymoo callback: per generation, evaluations so far and cheap indicators of the feasible front."""
+CHECKPOINTS_EVAL = (200, 500, 1000, 2000, 5000)
+"""Evaluations at which a suite family run keeps its non-dominated feasible objective vectors
+(the final front, at the budget, is the record's ``front``)."""
+CHECKPOINT_DIGITS = 10
+"""Significant digits of the objective vectors kept at the checkpoints (a record stays small)."""
 
-    def __init__(self, pf: np.ndarray | None):
+
+def true_objectives(pop, penalised: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Objectives and constraint violation of ``pop`` on the problem itself (not the penalised one)."""
+    if not penalised:
+        F, CV = pop.get("F", "CV")
+        return np.asarray(F, dtype=float), np.asarray(CV, dtype=float).reshape(-1)
+    from pymoo.core.individual import calc_cv
+
+    F, G, H = pop.get("__F__", "__G__", "__H__")  # kept by PenalisedConstraints next to the penalised F
+    G = None if G is None or np.size(G) == 0 else np.asarray(G, dtype=float).reshape(len(pop), -1)
+    H = None if H is None or np.size(H) == 0 else np.asarray(H, dtype=float).reshape(len(pop), -1)
+    return np.asarray(F, dtype=float), np.asarray(calc_cv(G=G, H=H), dtype=float).reshape(-1)
+
+
+def non_dominated_feasible(F: np.ndarray, CV: np.ndarray, digits: int = CHECKPOINT_DIGITS) -> np.ndarray:
+    """The distinct non-dominated objective vectors among the feasible rows of ``F``, rounded to ``digits``
+    significant digits (rows sorted)."""
+    from pymoo.util.nds.non_dominated_sorting import NonDominatedSorting
+
+    F = np.asarray(F, dtype=float)[np.asarray(CV).reshape(-1) <= 0.0]
+    if len(F) == 0:
+        return F.reshape(0, np.shape(F)[1] if np.ndim(F) == 2 else 0)
+    F = np.unique(np.array([[float(f"{v:.{digits}g}") for v in row] for row in F]), axis=0)
+    return F[NonDominatedSorting().do(F, only_non_dominated_front=True)] if len(F) > 1 else F
+
+
+class _History:
+    """pymoo callback: per generation, evaluations so far and cheap indicators of the feasible front.
+
+    Given ``checkpoints`` (evaluations, a suite family run: :data:`CHECKPOINTS_EVAL`), it also keeps
+    the non-dominated feasible objective vectors of the first generation at or past each of them,
+    raw, for the report to score against the front of its time; ``pf`` is then None, so nothing of
+    the record depends on the front. ``snapshots`` (the record's ``checkpoints``): ``target_n_eval``
+    (the largest checkpoint a generation reached), ``n_eval`` (that generation's) and ``F``.
+    """
+
+    def __init__(self, pf: np.ndarray | None, checkpoints: tuple[int, ...] = (), penalised: bool = False):
         self.pf = pf
         self.rows: list[dict[str, float]] = []
+        self.targets = sorted(checkpoints)
+        self.penalised = penalised
+        self.snapshots: dict[str, list] = {"target_n_eval": [], "n_eval": [], "F": []}
 
     def __call__(self, algorithm) -> None:
         opt = algorithm.opt
-        row: dict[str, float] = {"n_gen": float(algorithm.n_iter), "n_eval": float(algorithm.evaluator.n_eval)}
+        n_eval = int(algorithm.evaluator.n_eval)
+        row: dict[str, float] = {"n_gen": float(algorithm.n_iter), "n_eval": float(n_eval)}
         if opt is not None and len(opt):
-            F, CV = opt.get("F", "CV")
-            row.update(convergence_point(F[CV.reshape(-1) <= 0.0], self.pf))
+            F, CV = true_objectives(opt, self.penalised)
+            row.update(convergence_point(F[CV <= 0.0], self.pf))
+            reached = [t for t in self.targets if t <= n_eval]
+            if reached:
+                self.targets = self.targets[len(reached):]
+                self.snapshots["target_n_eval"].append(reached[-1])
+                self.snapshots["n_eval"].append(n_eval)
+                self.snapshots["F"].append(non_dominated_feasible(F, CV).tolist())
         self.rows.append(row)
 
     def columns(self) -> dict[str, list[float | None]]:
@@ -139,6 +191,9 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
     (``unavailable``), the evaluations used, the wall and CPU time (CPU time of this process, all
     its threads), the algorithm's :func:`run_counters`, the per-generation history and the versions
     of pymoo and pymoo-rail.
+
+    A suite family run reads no front: no front indicator, no IGD / HV in ``history``, but ``checkpoints``
+    (:class:`_History`), which :mod:`pymoo_rail.experiments.baseline` scores against the front of its time.
     """
     from pymoo.core.evaluator import Evaluator
     from pymoo.core.population import Population
@@ -147,14 +202,16 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
     inputs = _as_inputs(inputs, run)
     problem = build_problem(run.problem, trusted, inputs.cases)
     algorithm = build_algorithm(run.algorithm, problem, trusted)
-    pf, front_reason = true_front_and_reason(problem)
-    history = _History(pf) if run.history else None
-    start, start_cpu = time.perf_counter(), time.process_time()
-    # pymoo 0.6.2 calls algorithm.callback unconditionally once given one: pass it only when recording
-    callback = {"callback": history} if history is not None else {}
     # an algorithm without constraint handling (MOEA/D) searches the penalised problem; its front is
     # then evaluated again on the problem itself, so the record holds true objectives and violations
     penalised = problem.has_constraints() and not handles_constraints(algorithm)
+    # a suite run keeps raw vectors, scored by the report: a better exact solver keeps the record
+    raw = is_suite_family(run.problem)
+    pf, front_reason = (None, RAW_RECORD_REASON) if raw else true_front_and_reason(problem)
+    history = _History(pf, CHECKPOINTS_EVAL if raw else (), penalised) if run.history else None
+    start, start_cpu = time.perf_counter(), time.process_time()
+    # pymoo 0.6.2 calls algorithm.callback unconditionally once given one: pass it only when recording
+    callback = {"callback": history} if history is not None else {}
     searched = PenalisedConstraints(problem, DEFAULT_PENALTY) if penalised else problem
     res = minimize(searched, algorithm, run.budget.termination, seed=run.seed, verbose=False,
                    copy_algorithm=False, **callback)
@@ -194,6 +251,7 @@ def execute_run(run: RunSpec, inputs: RunInputs | Mapping[str, str] | None = Non
         "front": {"F": F.tolist(), "X": X.tolist(), "CV": CV.tolist(),
                   "extras": _extras(problem, opt, X) if len(X) else {}},
         "history": history.columns() if history is not None else None,
+        **({"checkpoints": history.snapshots} if raw and history is not None else {}),
         "versions": versions(),
         "inputs": dict(inputs.fingerprint),
         "host": socket.gethostname(),

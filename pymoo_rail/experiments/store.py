@@ -188,6 +188,15 @@ def _check_fields(path: Path, record: dict) -> None:
     history = record.get("history")
     if history is not None and not (isinstance(history, dict) and all(isinstance(v, list) for v in history.values())):
         raise bad("history", "must be a table of lists (or null)")
+    checkpoints = record.get("checkpoints")
+    if checkpoints is not None:
+        try:
+            if len(checkpoints["n_eval"]) != len(checkpoints["F"]) or not all(
+                    np.asarray(F, dtype=float).reshape(len(F), -1).shape[1] in (0, record["n_obj"])
+                    for F in checkpoints["F"]):
+                raise ValueError("one F of n_obj columns per n_eval")
+        except (KeyError, TypeError, ValueError) as err:
+            raise bad("checkpoints", f"must hold n_eval and one objective array per n_eval ({err})") from None
 
 
 def _stamp() -> str:

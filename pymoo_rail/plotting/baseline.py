@@ -5,11 +5,12 @@ from __future__ import annotations
 import pandas as pd
 
 
-def plot_cell_convergence(history: pd.DataFrame):
-    """Median IGD vs evaluations, one panel per (family, n_var), one line per algorithm.
+def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
+    """Median ``indicator`` vs evaluations, one panel per (family, n_var), one line per algorithm.
 
     ``history``: ``pymoo_rail.experiments.baseline.convergence`` (columns family, n_var, algorithm,
-    n_eval, igd). Returns the matplotlib ``Figure``.
+    n_eval and the indicator: each run's checkpoints scored against the current front). Returns the
+    matplotlib ``Figure``.
     """
     import matplotlib.pyplot as plt
 
@@ -18,9 +19,10 @@ def plot_cell_convergence(history: pd.DataFrame):
     for ax, (family, n_var) in zip(axes[0], cells):
         cell = history[(history["family"] == family) & (history["n_var"] == n_var)]
         for name, runs in cell.groupby("algorithm"):
-            median = runs.groupby("n_eval")["igd"].median()
+            median = runs.groupby("n_eval")[indicator].median()
             ax.plot(median.index, median.to_numpy(), label=name)
-        ax.set(title=f"{family} n_var={n_var}", xlabel="evaluations", ylabel="median IGD", yscale="log")
+        ax.set(title=f"{family} n_var={n_var}", xlabel="evaluations", ylabel=f"median {indicator}", xscale="log",
+               yscale="log")  # the checkpoints are a log ladder
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
     return fig

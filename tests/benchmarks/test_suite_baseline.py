@@ -86,7 +86,7 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
 
     from pymoo_rail.plotting import plot_cell_convergence, plot_performance_profile
 
-    history = pd.DataFrame([{"family": f, "n_var": n, "algorithm": a, "seed": s, "n_eval": e, "igd": 1.0 / e}
+    history = pd.DataFrame([{"family": f, "n_var": n, "algorithm": a, "seed": s, "n_eval": e, "igd_plus": 1.0 / e}
                             for f in ("x-bi", "y-bi") for n in (10, 30) for a in ("A", "B") for s in (1, 2)
                             for e in (100, 200)])
     fig = plot_cell_convergence(history)

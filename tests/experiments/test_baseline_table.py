@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, convergence, indicator_frame,
-                                             instance_of, performance_profile)
+from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, checkpoints_kb, convergence,
+                                             indicator_frame, instance_of, performance_profile)
 from pymoo_rail.experiments.runner import execute_run
 from pymoo_rail.experiments.spec import Budget, RunSpec, algorithm, problem
 from pymoo_rail.suite import get_problem
@@ -74,10 +74,29 @@ def test_performance_profile_reaches_one_for_the_best_at_tau_one():
     assert profile["b"].tolist() == [0.0, 0.5, 0.5, 1.0]
 
 
-def test_convergence_holds_each_generation(records):
-    history = convergence(records)
-    assert set(history["algorithm"]) == {"nsga2", "random"}
-    assert history.groupby(["algorithm", "seed"])["n_eval"].max().max() <= 200
+def test_a_suite_record_holds_raw_vectors_and_nothing_scored_against_the_front(records):
+    record = records[0]
+    assert not {"igd", "hv", "gd"} & set(record["indicators"]) and "igd" in record["unavailable"]
+    assert not {"igd", "hv", "error"} & set(record["history"])
+    checkpoints = record["checkpoints"]
+    assert checkpoints["target_n_eval"] == [200] and checkpoints["n_eval"] == [200]  # 200 of the ladder, then the end
+    F = np.asarray(checkpoints["F"][0])
+    assert F.shape[1] == 2 and len(np.unique(F, axis=0)) == len(F)
+    assert not any((F[j] <= F[i]).all() and (F[j] < F[i]).any() for i in range(len(F)) for j in range(len(F)))
+
+
+def test_convergence_scores_each_checkpoint_and_the_final_front(records):
+    spec = problem("suite_family", family=FAMILY, n_var=10, seed=1)
+    longer = execute_run(RunSpec(spec, algorithm("nsga2", pop_size=50), 1, Budget("n_eval", 1200)))
+    assert longer["checkpoints"]["target_n_eval"] == [200, 500, 1000]
+    assert longer["checkpoints"]["n_eval"] == [200, 500, 1000]
+    history = convergence([{**longer, "algorithm_label": "nsga2"}])
+    assert history["n_eval"].tolist() == [200, 500, 1000, 1200]
+    final = baseline_indicators(longer)
+    assert history.iloc[-1]["igd_plus"] == final["igd_plus"]
+    # elitist NSGA-II: its front at 1000 evaluations is no worse than at 200 (it keeps its non-dominated members)
+    assert history.iloc[2]["hv_norm"] >= history.iloc[0]["hv_norm"]
+    assert set(convergence(records)["algorithm"]) == {"nsga2", "random"}
 
 
 def test_a_3obj_record_scores_against_its_bounded_front(tmp_path, monkeypatch):
@@ -94,3 +113,48 @@ def test_a_3obj_record_scores_against_its_bounded_front(tmp_path, monkeypatch):
     best = baseline_indicators(inner)  # the inner points: IGD+ 0, HV their share of the outer bound's
     assert best["igd_plus"] == pytest.approx(0.0, abs=1e-9)
     assert best["hv_norm"] == pytest.approx(bounded.hv_inner / bounded.hv_outer)
+
+
+def test_the_checkpoints_of_a_penalised_search_hold_true_objectives_and_violations():
+    from pymoo.core.evaluator import Evaluator
+    from pymoo.core.population import Population
+
+    from pymoo_rail.experiments.penalty import PenalisedConstraints
+    from pymoo_rail.experiments.runner import non_dominated_feasible, true_objectives
+
+    instance = get_problem(FAMILY, n_var=10, seed=1)
+    X = np.vstack([instance.xl, instance.xu, (instance.xl + instance.xu) / 2,
+                   np.random.default_rng(3).uniform(instance.xl, instance.xu, (20, 10))])
+    truth = Evaluator().eval(instance, Population.new(X=X))
+    searched = Evaluator().eval(PenalisedConstraints(instance), Population.new(X=X))
+    F, CV = true_objectives(searched, penalised=True)
+    np.testing.assert_array_equal(F, truth.get("F"))
+    np.testing.assert_allclose(CV, truth.get("CV").reshape(-1))
+    assert (CV > 0).any() and not np.array_equal(searched.get("F"), F)  # the corners are infeasible, penalised
+    kept = non_dominated_feasible(F, CV)
+    feasible = F[CV <= 0]
+    assert len(kept) <= len(feasible) and all(np.isclose(feasible, row, rtol=1e-9).all(axis=1).any() for row in kept)
+
+
+@pytest.mark.parametrize("checkpoints", [{"n_eval": [200], "F": []}, {"n_eval": [200], "F": [[[1.0, 2.0, 3.0]]]},
+                                         {"F": [[[1.0, 2.0]]]}, "200", {"n_eval": [200], "F": [[["a", 2.0]]]}])
+def test_a_record_with_malformed_checkpoints_is_refused_naming_the_field(records, tmp_path, checkpoints):
+    from pymoo_rail.experiments.store import RecordError, ResultStore
+
+    store = ResultStore(tmp_path)
+    store.prepare()
+    good = copy.deepcopy(records[0])
+    store.write(good)
+    assert store.load(good["run_id"])["checkpoints"] == records[0]["checkpoints"]
+    store.write({**good, "checkpoints": checkpoints})
+    with pytest.raises(RecordError, match="field 'checkpoints'"):
+        store.load(good["run_id"])
+
+
+def test_the_report_states_the_size_of_the_checkpoints(records):
+    import json
+
+    sizes = sorted(len(json.dumps(r["checkpoints"], separators=(",", ":"))) / 1000 for r in records)
+    assert checkpoints_kb(records) == f"median {np.median(sizes):.1f} kB, largest {sizes[-1]:.1f} kB"
+    assert 0 < sizes[-1] < 30
+    assert checkpoints_kb([]) == "no records"

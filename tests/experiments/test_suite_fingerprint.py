@@ -1,11 +1,11 @@
-"""A suite family run's fingerprint covers exactly the code it executes and its front by content.
+"""A suite family run's fingerprint covers exactly the code it executes, and not its front (raw records).
 
 The first test runs suite runs in a fresh interpreter (``suite_run_probe.py``) and checks that
 every package file a run executes is inside the parts its ``pymoo-rail code`` digest covers
 (:func:`pymoo_rail.experiments.inputs.code_parts`) or listed below with why its output is
 fingerprinted otherwise, and that every other package module loaded is listed as only imported,
 with the reason. The others check that a change outside the parts keeps stored records current
-and a change inside (or of the front's content) redoes them.
+and a change inside redoes them, while a new front (content or version) keeps them and changes their scores.
 """
 
 from __future__ import annotations
@@ -24,9 +24,12 @@ import pymoo_rail
 from pymoo_rail.experiments import inputs as inputs_module
 from pymoo_rail.experiments.inputs import (SUITE_RUN_PARTS, TRIP_RUN_PARTS, code_parts, front_digest, in_parts,
                                            resolve_run)
-from pymoo_rail.experiments.runner import run_study
+from pymoo_rail.experiments.baseline import front_versions, fronts_statement, indicator_frame
+from pymoo_rail.experiments.results import load_records
+from pymoo_rail.experiments.runner import execute_run, run_study
 from pymoo_rail.experiments.spec import Budget, RunSpec, Study, algorithm, problem
 from pymoo_rail.suite import get_problem
+from pymoo_rail.suite import families as families_module
 from pymoo_rail.suite.families import FamilyProblem
 
 PACKAGE = Path(pymoo_rail.__file__).resolve().parent
@@ -36,11 +39,9 @@ FAMILY = "generated-metro-bi"
 # executed by a run, but what they give it is fingerprinted by content, or is not one of its numbers
 EXECUTED_OUTSIDE = {
     "cases": "generate the instance's line and train, whose content is in the instance checksum (case_hash)",
-    "optimal/reference": "the planner's window and the time tolerance are in the instance checksum; the front "
-                         "is read (or computed) here, and its content is in 'problem reference front' (front.py, "
-                         "which turns its nodes into pareto_front(), is a part)",
+    "optimal/reference": "the planner's window and the time tolerance are in the instance checksum (a run never "
+                         "reads the front: its record holds raw objective vectors)",
     "experiments/inputs.py": "computes the fingerprint itself, not a number of the run",
-    "atomic.py": "writes a computed inner front of a -3obj instance to the cache, whose content is fingerprinted",
 }
 # loaded with the modules a run uses, but never on a run's path (a run calling them fails the test)
 IMPORTED_ONLY = {
@@ -55,6 +56,7 @@ IMPORTED_ONLY = {
     "suite/fronts_io.py": "the named problems' shipped fronts (re-exported by suite/__init__.py)",
     "rowcache.py": "the exact solver's row cache (optimal)",
     "lockfiles.py": "the study store's locks, not a number of a run",
+    "atomic.py": "atomic file writes (the study store, the fronts' caches); a run reads no front and writes no cache",
     "experiments/__init__.py": "re-exports the study runner's names",
     "experiments/results.py": "reads stored records (imported by experiments/__init__.py)",
     "experiments/store.py": "stores records, not their numbers",
@@ -116,7 +118,7 @@ def test_code_parts_per_problem_kind():
 
 @pytest.mark.parametrize("edited, suite_changes, trip_changes", [
     ("control/controllers.py", False, False), ("optimal/dp.py", False, False), ("cli/app.py", False, False),
-    ("optimal/reference/store.py", False, False), ("optimal/reference/front.py", True, True),
+    ("optimal/reference/store.py", False, False), ("optimal/reference/front.py", False, False),
     ("plotting/fronts.py", False, False), ("suite/coco_logger.py", False, False), ("cases/railjson.py", False, False),
     ("journeys/allocation.py", False, True),
     ("sim/kernel.py", True, True), ("constants.py", True, True), ("algorithms/moabc.py", True, True),
@@ -167,14 +169,40 @@ def _scaled_front(front, factor: float):
     return replace(front, table=table)
 
 
-def test_stored_suite_runs_are_redone_when_the_front_content_changes(tmp_path, monkeypatch):
+def test_stored_suite_runs_stay_current_when_the_front_improves_and_their_scores_follow_it(tmp_path, monkeypatch):
     study = _suite_study()
     run_study(study, tmp_path, workers=1, progress=False)
+    records = load_records(tmp_path, study)
+    before = indicator_frame(records).iloc[0]
+    instance = get_problem(FAMILY, n_var=10, seed=1)
+    digest, version = front_digest(instance), instance.front_version
     real = FamilyProblem.certified_front
-    # another front (a solver that finds 1 % lower energies): the same code digest
+    # another front (a solver that finds 1 % lower energies) under a new front version: the same code digest
     monkeypatch.setattr(FamilyProblem, "certified_front", lambda self: _scaled_front(real(self), 0.99))
+    monkeypatch.setattr(families_module, "FRONT_VERSION", "99")
+    instance = get_problem(FAMILY, n_var=10, seed=1)
+    assert instance.front_version == "99" != version and front_digest(instance) != digest
     report = run_study(study, tmp_path, workers=1, progress=False)
-    assert report.n_finished == 1 and "problem reference front changed" in report.redone[0]
+    assert report.n_skipped == 1 and report.n_finished == 0 and not report.redone
+    after = indicator_frame(load_records(tmp_path, study)).iloc[0]
+    # the same raw vectors, scored against the lower front: farther from it, less of its hypervolume
+    assert after["igd_plus"] > before["igd_plus"] and after["gap_kwh"] > before["gap_kwh"]
+    assert after["hv_norm"] != before["hv_norm"]
+    fronts = front_versions(records)
+    assert fronts["front_version"].tolist() == ["99"] and fronts["front_digest"].tolist() == [front_digest(instance)]
+    assert "version 99 (1 instance)" in fronts_statement(fronts)
+
+
+@pytest.mark.parametrize("family", [FAMILY, "generated-metro-3obj"])
+def test_a_suite_run_never_reads_its_front(monkeypatch, family):
+    def refuse(self, *args, **kwargs):
+        raise AssertionError("a suite run read its front")
+
+    for name in ("certified_front", "bounded_front", "_calc_pareto_front", "hv_reference_point"):
+        monkeypatch.setattr(FamilyProblem, name, refuse)
+    spec = problem("suite_family", family=family, n_var=10, seed=1)
+    record = execute_run(RunSpec(spec, algorithm("nsga2", pop_size=10), 1, Budget("n_eval", 220)))
+    assert record["checkpoints"]["target_n_eval"] == [200] and len(record["checkpoints"]["F"][0][0]) == record["n_obj"]
 
 
 def test_a_front_counts_as_cached_so_the_process_that_computed_it_agrees_with_later_ones(monkeypatch):
@@ -195,6 +223,6 @@ def test_the_front_digest_is_of_its_content():
     fingerprint = resolve_run(RunSpec(problem("suite_family", family=FAMILY, n_var=10, seed=1), algorithm("nsga2"),
                                       1, Budget("n_eval", 40))).fingerprint
     small, large = get_problem(FAMILY, n_var=10, seed=1), get_problem(FAMILY, n_var=30, seed=1)
-    assert fingerprint["problem reference front"] == front_digest(small)
+    assert "problem reference front" not in fingerprint  # the record holds raw vectors: no front in it
     assert front_digest(small) == front_digest(large)  # every dimension of a line has the same front
     assert front_digest(small) != front_digest(get_problem(FAMILY, n_var=10, seed=7))  # another line
