@@ -146,16 +146,18 @@ def test_the_certificate_compares_with_twice_the_speed_nodes():
     assert OptimalSolver(case, n_speeds=3).grid_check_solver().n_speeds == 6
 
 
+# generated line 5 at 1.5 x its minimum time + 0.2 s: 100 and 200 speed nodes agree (-53.29 and -53.34 kWh through
+# the supporting line), 400 nodes give -53.47; the half-grid certificate was 0.088 kWh, 0.072 kWh short of ms-eetc.
+# Line 7 at 1.4 x: 57.224 +- 0.087 kWh with the half grid, ms-eetc 56.941 (0.196 kWh short); with twice the nodes
+# +- 0.370 (benchmarks/certificate_shifted.py)
 @pytest.mark.slow
-def test_the_certificate_holds_where_the_half_grid_agreed_by_coincidence():
-    """Generated line 5 at 1.5 x its minimum time + 0.2 s: 100 and 200 speed nodes agree (-53.29 and -53.34 kWh
-    through the supporting line), 400 nodes give -53.47; ms-eetc N=2000 -53.4741 kWh. The half-grid
-    certificate was 0.062 kWh, 0.07 kWh short of the truth."""
+@pytest.mark.parametrize("seed, factor, plus_s, mseetc_n2000_kwh", [(5, 1.5, 0.2, -53.4741), (7, 1.4, 0.0, 56.9409)])
+def test_the_certificate_holds_where_the_half_grid_agreed_by_coincidence(seed, factor, plus_s, mseetc_n2000_kwh):
     from pymoo_rail.experiments.peers import comparable_case
     from pymoo_rail.optimal import min_running_time
 
-    case = comparable_case(5)
-    target = 1.5 * min_running_time(case) + 0.2
+    case = comparable_case(seed)
+    target = factor * min_running_time(case) + plus_s
     tr = OptimalSolver(case).profile(target)
     moved_kwh = tr.summary["lambda_w"] / 3.6e6 * (tr.running_time_s - target)
-    assert tr.energy.net_kwh + moved_kwh - tr.summary["energy_bound_kwh"] - abs(moved_kwh) <= -53.4741
+    assert tr.energy.net_kwh + moved_kwh - tr.summary["energy_bound_kwh"] - abs(moved_kwh) <= mseetc_n2000_kwh
