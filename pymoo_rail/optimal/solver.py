@@ -288,8 +288,9 @@ class OptimalSolver:
         """The solver the certificate compares with: twice the speed nodes (half at ``MAX_N_SPEEDS``), same positions.
 
         Twice, not half: a grid of half the nodes can agree with this one by coincidence where both
-        miss the optimum alike (generated line 5 at 1.5 x its minimum time + 0.2 s: 100 and 200 nodes
-        within 0.05 kWh of each other, 0.13 kWh above ms-eetc; 400 nodes 0.13 kWh lower).
+        miss the optimum alike (generated lines 5 at 1.5 x its minimum time + 0.2 s and 7 at 1.4 x: the
+        half grid's certificates 0.088 and 0.087 kWh, ms-eetc 0.160 and 0.283 kWh below the runs;
+        ``benchmarks/certificate_shifted.py``, ``docs/optimal.md``).
         """
         if self._grid_check is None:
             n_speeds = 2 * self.n_speeds if 2 * self.n_speeds <= MAX_N_SPEEDS else max(self.n_speeds // 2, 3)

@@ -146,8 +146,8 @@ def test_the_certificate_compares_with_twice_the_speed_nodes():
     assert OptimalSolver(case, n_speeds=3).grid_check_solver().n_speeds == 6
 
 
-# generated line 5 at 1.5 x its minimum time + 0.2 s: 100 and 200 speed nodes agree (-53.29 and -53.34 kWh through
-# the supporting line), 400 nodes give -53.47; the half-grid certificate was 0.088 kWh, 0.072 kWh short of ms-eetc.
+# generated line 5 at 1.5 x its minimum time + 0.2 s: -53.315 +- 0.088 kWh with the half grid's check (at the requested
+# time), 0.072 kWh short of ms-eetc N=2000.
 # Line 7 at 1.4 x: 57.224 +- 0.087 kWh with the half grid, ms-eetc 56.941 (0.196 kWh short); with twice the nodes
 # +- 0.370 (benchmarks/certificate_shifted.py)
 @pytest.mark.slow
