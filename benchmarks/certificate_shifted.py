@@ -3,7 +3,7 @@
 Usage (resumable: ms-eetc's answers are cached in the CSV)::
 
     nice -n 10 python benchmarks/certificate_shifted.py --fill --mseetc /path/to/ms-eetc --cache runs/mseetc_shifted.csv
-    nice -n 10 python benchmarks/certificate_shifted.py --cache runs/mseetc_shifted.csv [--out ours.csv]
+    nice -n 10 python benchmarks/certificate_shifted.py --cache benchmarks/reports/certificate_shifted_mseetc_N2000.csv
     nice -n 10 python benchmarks/certificate_shifted.py --benchmark-times --cache benchmarks/reports/peers_mseetc_N2000.csv
     nice -n 10 python benchmarks/certificate_shifted.py --cpu --seeds 6
 """
