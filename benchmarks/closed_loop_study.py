@@ -44,6 +44,7 @@ from pymoo_rail.experiments.loop_study import (
     summary_markdown,
     tests_markdown,
 )
+from pymoo_rail.experiments.loop_late import late_worlds_markdown
 from pymoo_rail.experiments.report import lower_priority, write_filled
 from pymoo_rail.plotting import plot_gap_lateness, save_figure
 
@@ -69,7 +70,7 @@ def report(runs: pd.DataFrame, seconds: float | None, args) -> str:
         "tuning": f", {seconds:.0f} s in the main process (the tuning)." if seconds else ".",
         "worlds": ", ".join(f"{c} {n}" for c, n in per_case.size().items()),
         "world_cpu": ", ".join(f"{c} {v:.1f} s" for c, v in per_case.median().items()),
-        "summary": summary_markdown(summary), "advice": advice_markdown(runs),
+        "summary": summary_markdown(summary), "advice": advice_markdown(runs), "late": late_worlds_markdown(runs),
         "tests": tests_markdown(loop_tests(runs, TRACKING))})
 
 
