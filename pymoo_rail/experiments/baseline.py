@@ -110,14 +110,19 @@ def baseline_indicators(record: dict, problem=None, scorer: FrontScorer | None =
     return scorer.score(F[np.asarray(record["front"]["CV"], dtype=float).reshape(-1) <= 0])
 
 
-def _scorers(records: Iterable[dict]) -> dict:
-    """One :class:`FrontScorer` per distinct instance of ``records``, by the record's problem parameters."""
-    scorers = {}
+def _instances(records: Iterable[dict]) -> dict:
+    """One problem per distinct instance of ``records``, by the record's problem parameters."""
+    instances = {}
     for record in records:
         key = tuple(sorted(record["problem"].items()))
-        if key not in scorers:
-            scorers[key] = front_scorer(instance_of(record))
-    return scorers
+        if key not in instances:
+            instances[key] = instance_of(record)
+    return instances
+
+
+def _scorers(records: Iterable[dict]) -> dict:
+    """One :class:`FrontScorer` per distinct instance of ``records``, by the record's problem parameters."""
+    return {key: front_scorer(problem) for key, problem in _instances(records).items()}
 
 
 def indicator_frame(records: Iterable[dict]) -> pd.DataFrame:
@@ -141,8 +146,7 @@ def front_versions(records: Iterable[dict]) -> pd.DataFrame:
     :func:`pymoo_rail.experiments.inputs.front_digest`. Neither is part of a record: a report states them.
     """
     rows = []
-    for scorer in _scorers(records).values():
-        problem = scorer.problem
+    for problem in _instances(records).values():  # no scorer: the front's hypervolume is not needed here
         rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
                      "front_version": problem.front_version, "front_digest": front_digest(problem)})
     return pd.DataFrame(rows).sort_values(["family", "n_var", "instance_seed"]).reset_index(drop=True)
