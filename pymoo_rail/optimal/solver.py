@@ -45,7 +45,7 @@ from pymoo_rail.optimal.price_search import (
 )
 from pymoo_rail.sim import Simulator, Trajectory
 
-SOLVER_VERSION = "4"
+SOLVER_VERSION = "5"
 """Version of the solver's answers: bump it whenever a run the solver returns for a case can change
 (DP, search, certificate, or the simulator that replays the run), so on-disk caches of its runs
 (:func:`pymoo_rail.optimal.reference.exact_points`, :func:`pymoo_rail.journeys.section_fronts`)
@@ -56,7 +56,8 @@ most 0.0045 kWh, 0.005 %, within their certificates: not recomputed); 3: the cer
 least 5e-4 of the run's traction energy, runs unchanged (fronts recomputed as version 7 for their
 certificates); 4: the coast curves into the braking envelope's corners and the end speed, and the
 full-traction start, as states of the DP (``dp.coast_curves``; runs change where they coast into a
-lower limit or a moving end, fronts recomputed as version 8)."""
+lower limit or a moving end, fronts recomputed as version 8); 5: the certificate compares a grid of
+twice the speed nodes, not half (runs unchanged, fronts recomputed as version 9 for their certificates)."""
 DEFAULT_N_SPEEDS = 200
 DEFAULT_MAX_TARGETS = 16
 DEFAULT_TIME_TOL_S = 0.05
