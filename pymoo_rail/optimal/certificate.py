@@ -1,7 +1,7 @@
 """The certificate of an optimal run: an estimated bound on its energy above the optimum at its time.
 
 :meth:`~pymoo_rail.optimal.solver.OptimalSolver.energy_bound_kwh` adds the parts computed here
-(``docs/optimal.md``, "Certificate"): the change when the speed grid is halved, a floor, and how
+(``docs/optimal.md``, "Certificate"): the change when the speed grid is doubled, a floor, and how
 far the run lies above the front's supporting line at its price of time. :func:`move_remainder_j`
 bounds the error of moving a run along that line to another running time.
 """
@@ -18,7 +18,7 @@ from pymoo_rail.optimal.price_search import Solve
 if TYPE_CHECKING:
     from pymoo_rail.optimal.solver import OptimalSolver
 
-# The certificate is this many times the change when the speed grid is halved (see bound_parts_kwh)
+# The certificate is this many times the change when the speed nodes are doubled (see bound_parts_kwh)
 CERTIFICATE_FACTOR = 2.0
 # ... plus this share of the run's net energy: the two grids can agree by coincidence where a grid
 # of twice the nodes or the uniform node placement still differs (at 2 of 861 times of
@@ -34,17 +34,18 @@ CERTIFICATE_FLOOR_REL = 1.0e-4
 CERTIFICATE_FLOOR_TRACTION_REL = 5.0e-4
 
 
-def bound_parts_kwh(solution: Solve, coarse: Solve, untied_j: float, traction_kwh: float = 0.0) -> dict[str, float]:
+def bound_parts_kwh(solution: Solve, other: Solve, untied_j: float, traction_kwh: float = 0.0) -> dict[str, float]:
     """The parts of the certificate of ``solution`` (kWh): grid, floor, moved run, kept regimes, untied run.
 
-    ``coarse`` is the optimum at the same price on a speed grid of half the nodes; moved along the
-    slope ``lambda`` to this run's time it is the coarse front's supporting line there (one solve,
-    and no search that a jump of the coarse optimum could end on a run far from this time: measured
-    8.1 kWh of "grid error" on wuguang-crh3 at 1110 s from a moved coarse run, against 0.16 kWh
-    through the supporting line). ``untied_j``: :func:`untied_excess_j`. ``traction_kwh``: the run's
-    traction energy, for the floor (0: the floor is a share of the net energy alone).
+    ``other`` is the optimum at the same price on a speed grid of twice the nodes (half at the
+    finest grid); moved along the slope ``lambda`` to this run's time it is the other grid's
+    supporting line there (one solve, and no search that a jump of the other grid's optimum could
+    end on a run far from this time: measured 8.1 kWh of "grid error" on wuguang-crh3 at 1110 s
+    from a moved coarse run, against 0.16 kWh through the supporting line). ``untied_j``:
+    :func:`untied_excess_j`. ``traction_kwh``: the run's traction energy, for the floor (0: the
+    floor is a share of the net energy alone).
     """
-    moved_j = coarse.energy_j + solution.lambda_w * (coarse.time_s - solution.time_s)
+    moved_j = other.energy_j + solution.lambda_w * (other.time_s - solution.time_s)
     return {"grid_kwh": CERTIFICATE_FACTOR * abs(moved_j - solution.energy_j) / J_PER_KWH,
             "floor_kwh": max(CERTIFICATE_FLOOR_REL * abs(solution.energy_j) / J_PER_KWH,
                              CERTIFICATE_FLOOR_TRACTION_REL * traction_kwh),

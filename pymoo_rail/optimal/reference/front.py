@@ -25,7 +25,7 @@ class NoExactFrontError(NotImplementedError):
     """The problem has no exact front (e.g. three or more objectives); the message says what exists."""
 
 
-FRONT_VERSION = "8"
+FRONT_VERSION = "9"
 """Version of the front computation; bump it when the solver (with
 :data:`pymoo_rail.optimal.solver.SOLVER_VERSION`) or the node choice changes
 (4: every node solved in the sweep and alone, the lower kept, the bound at least their difference;
@@ -34,7 +34,8 @@ the half grid at the run's price and has a floor of 1e-4 of the energy;
 6: nodes also at the ends of the punctuality window, so that the optimum of a single-objective
 form is a solved run, not a point on a chord;
 7: solver version 3, the certificate's floor on the traction energy;
-8: solver version 4, the coast curves and the full-traction start as states)."""
+8: solver version 4, the coast curves and the full-traction start as states;
+9: solver version 5, the certificate compares a grid of twice the speed nodes)."""
 COLUMNS = ("requested_time_s", "running_time_s", "energy_kwh", "lambda_kwh_per_s", "energy_bound_kwh")
 
 
