@@ -19,11 +19,17 @@ PUNCTUAL_TOLERANCE_MIN_S = 1.0
 FRONT_SPAN = 1.3
 """Fronts cover running times from the minimum to ``FRONT_SPAN`` x the planned time."""
 DEFAULT_N_TIMES = 33
-"""Nodes of a front on lines up to :data:`LONG_LINE_M`; longer lines get :data:`LONG_LINE_N_TIMES` (DP cost).
-Each node's solve warm-starts the next one's: 33 nodes (not 17) keep the warm start close enough that the
-yizhuang front no longer lies above members of the suite study by more than its bound."""
+"""Nodes of a front. Each node's solve warm-starts the next one's: 33 nodes (not 17) keep the warm
+start close enough that the yizhuang front no longer lies above members of the suite study by more
+than its bound."""
 LONG_LINE_M = 10_000.0
-LONG_LINE_N_TIMES = 9
+LONG_LINE_N_TIMES = DEFAULT_N_TIMES
+"""Nodes of a front on lines longer than :data:`LONG_LINE_M`: as many as on short lines. It was 9
+(each DP solve cost more) until the suite's baseline table scored runs on such fronts: between 9
+nodes the chord lay above the convex front by up to 4.8 kWh on a 32.9 km high-speed line (median
+3.1 kWh, 8 times the nodes' median certificate of 0.38 kWh), so the members of good runs lay below
+the interpolated front and an energy gap to it meant little; with 33 nodes the chord's excess is at
+most 0.27 kWh there, for 18.9 s of CPU instead of 6.8 s (``docs/suite.md``, "Families")."""
 
 
 def default_window(min_time_s: float, planned_time_s: float) -> tuple[float, float]:
@@ -59,5 +65,5 @@ def front_times(min_time_s: float, planned_time_s: float, n_times: int = DEFAULT
 
 
 def n_times_for(case: Case) -> int:
-    """Default number of front nodes of a case (fewer on long lines, where each DP solve costs more)."""
+    """Default number of front nodes of a case (:data:`DEFAULT_N_TIMES`, :data:`LONG_LINE_N_TIMES` beyond :data:`LONG_LINE_M`)."""
     return DEFAULT_N_TIMES if case.line.length_m <= LONG_LINE_M else LONG_LINE_N_TIMES
