@@ -28,8 +28,8 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
     return fig
 
 
-def plot_performance_profile(profile: pd.DataFrame):
-    """The share of runs within tau of the best IGD+, one step line per algorithm.
+def plot_performance_profile(profile: pd.DataFrame, indicator: str = "IGD+"):
+    """The share of runs within tau of the best ``indicator`` (its name on the axis), one step line per algorithm.
 
     ``profile``: ``pymoo_rail.experiments.baseline.performance_profile`` (index tau, one column per
     algorithm). Returns the matplotlib ``Figure``.
@@ -39,7 +39,7 @@ def plot_performance_profile(profile: pd.DataFrame):
     fig, ax = plt.subplots(figsize=(5, 3.5))
     for name in profile.columns:
         ax.step(profile.index, profile[name], where="post", label=name)
-    ax.set(xscale="log", xlabel="tau (IGD+ / best IGD+ on the run's instance and seed)", ylabel="share of runs")
+    ax.set(xscale="log", xlabel=f"tau ({indicator} / best on the run's instance and seed)", ylabel="share of runs")
     ax.legend(fontsize=7)
     fig.tight_layout()
     return fig

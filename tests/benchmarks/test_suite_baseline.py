@@ -12,11 +12,11 @@ import pytest
 
 def _study(*cut):
     """The study file cut to (families, ladder, seeds, n_eval)."""
-    from benchmarks.suite_baseline import STUDY_FILE
+    from benchmarks.suite_baseline import ROOT, STUDIES
     from pymoo_rail.experiments import read_study
     from pymoo_rail.experiments.baseline import cut_study
 
-    return cut_study(read_study(STUDY_FILE), *cut)
+    return cut_study(read_study(ROOT / "benchmarks" / f"{STUDIES['table']}.toml"), *cut)
 
 
 def test_the_full_study_is_every_multi_objective_family_on_the_ladder_with_nine_algorithms_and_31_seeds():
@@ -111,3 +111,19 @@ def test_the_profile_mode_splits_a_run_and_leaves_the_thread_count(capsys):
     assert values[8] == pytest.approx(sum(values[:8]), abs=6e-3)  # printed to 3 decimals
     with pytest.raises(SystemExit, match="none of the study's"):
         main(["--profile", "--ladder", "10", "--algorithms", "no-such-algorithm"])
+
+
+def test_the_single_study_runs_and_reports_the_gap_to_the_optimum(tmp_path, capsys):
+    from benchmarks.suite_baseline import main
+
+    work, out = tmp_path / "work", tmp_path / "reports"
+    assert main(["--study", "single", "--families", "generated-metro-single", "--ladder", "10", "--seeds", "2",
+                 "--n-eval", "200", "--workers", "1", "--work", str(work), "--out", str(out), "--estimate"]) == 0
+    report = (out / "suite_baseline_single.md").read_text()
+    assert report.startswith("# Suite baseline table, one-objective families (reduced run")
+    assert "gap_kwh" in report and "igd_plus" not in report and "${" not in report
+    assert "from `benchmarks/suite_baseline_single.toml`: 1 (family, n_var) cells x 5 algorithms x 2 seeds" in report
+    rows = [line for line in report.splitlines() if line.startswith("| generated-metro-single")]
+    assert len(rows) == 5 and all(line.count("|") > 8 for line in rows)
+    assert (out / "suite_baseline_single_convergence.png").is_file() and (out / "suite_baseline_single_profile.png").is_file()
+    assert "the whole study (measured n_var 10)" in capsys.readouterr().out

@@ -67,7 +67,7 @@ def test_the_table_ranks_every_algorithm_of_a_cell(records):
 
 
 def test_performance_profile_reaches_one_for_the_best_at_tau_one():
-    frame = pd.DataFrame({"family": "f", "n_var": 10, "instance_seed": 1, "seed": [1, 1, 2, 2],
+    frame = pd.DataFrame({"family": "f", "n_var": 10, "n_obj": 2, "instance_seed": 1, "seed": [1, 1, 2, 2],
                           "algorithm": ["a", "b", "a", "b"], "igd_plus": [1.0, 2.0, 1.0, 4.0]})
     profile = performance_profile(frame, taus=[1.0, 2.0, 3.0, 4.0])
     assert profile["a"].tolist() == [1.0, 1.0, 1.0, 1.0]
