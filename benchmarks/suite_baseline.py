@@ -124,7 +124,8 @@ def main(argv=None) -> int:
     if args.estimate:
         hours, sizes = projected_cpu_h(frame, full)
         print("median CPU ms per evaluation\n" + cpu_per_evaluation_ms(frame).round(3).to_string())
-        print(f"the whole study (measured n_var {sizes}): {hours:.1f} CPU hours, {hours / 2:.1f} h on 2 cores")
+        print(f"the whole study (measured n_var {sizes}): {hours:.1f} CPU hours, {hours / 2:.1f} h on 2 cores; "
+              f"{projected_cpu_h(frame, full, per_family=True)[0]:.1f} CPU hours from each family's own medians")
     if args.archive:
         print(f"archive {args.archive}: sha256 {archive_records(work, args.archive, name)}")
     return 0

@@ -383,26 +383,31 @@ def cpu_per_evaluation_ms(frame: pd.DataFrame) -> pd.DataFrame:
     return _median_ms(frame).unstack("n_var")
 
 
-def _median_ms(frame: pd.DataFrame) -> pd.Series:
+def _median_ms(frame: pd.DataFrame, keys: Sequence[str] = ("algorithm", "n_var")) -> pd.Series:
     ms = frame.assign(ms=1000.0 * frame["cpu_time_s"] / frame["n_eval"])
-    return ms.groupby(["algorithm", "n_var"])["ms"].median()
+    return ms.groupby(list(keys))["ms"].median()
 
 
-def projected_cpu_h(frame: pd.DataFrame, full) -> tuple[float, str]:
+def projected_cpu_h(frame: pd.DataFrame, full, per_family: bool = False) -> tuple[float, str]:
     """CPU hours of the ``full`` study from measured CPU per evaluation (linear in n_var between measured sizes).
 
-    Per algorithm, the median over the stored runs (all families and seeds) of the CPU seconds per
-    evaluation, taken per n_var and interpolated (held constant outside the measured range), then
-    multiplied by the full study's evaluations, problems and seeds. The median keeps out the first
-    run of a process, which pays the compilation. Returns the hours and the measured sizes.
+    Per algorithm (``per_family``: per algorithm and family, for a study whose families' costs differ
+    much, as the ``-single`` and ``-trip`` forms do), the median over the stored runs (all families
+    and seeds) of the CPU seconds per evaluation, taken per n_var and interpolated (held constant
+    outside the measured range), then multiplied by the full study's evaluations, problems and
+    seeds. The median keeps out the first run of a process, which pays the compilation. Returns the
+    hours and the measured sizes.
     """
-    per_eval = _median_ms(frame) / 1000.0
+    per_eval = _median_ms(frame, ("algorithm", "family", "n_var") if per_family else ("algorithm", "n_var")) / 1000.0
     total_s = 0.0
     for a in full.algorithms:
-        if a.display not in per_eval.index.get_level_values(0):
-            raise SystemExit(f"--estimate: no stored run of {a.display}")
-        known = per_eval[a.display]
-        total_s += sum(np.interp(p.params["n_var"], known.index, known.to_numpy()) for p in full.problems)
+        for p in full.problems:
+            key = (a.display, p.params["family"]) if per_family else (a.display,)
+            try:
+                known = per_eval.loc[key]
+            except KeyError:
+                raise SystemExit(f"--estimate: no stored run of {' on '.join(key)}") from None
+            total_s += float(np.interp(p.params["n_var"], known.index, known.to_numpy()))
     sizes = ", ".join(str(n) for n in sorted(frame["n_var"].unique()))
     return total_s * full.budget.value * len(full.seeds) / 3600, sizes
 

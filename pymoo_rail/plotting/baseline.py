@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 
@@ -21,8 +22,11 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
         for name, runs in cell.groupby("algorithm"):
             median = runs.groupby("n_eval")[indicator].median()
             ax.plot(median.index, median.to_numpy(), label=name)
+        scored = np.isfinite(cell[indicator]).any()  # a cell without a feasible run has nothing to plot on a log axis
         ax.set(title=f"{family} n_var={n_var}", xlabel="evaluations", ylabel=f"median {indicator}", xscale="log",
-               yscale="log")  # the checkpoints are a log ladder
+               yscale="log" if scored else "linear")  # the checkpoints are a log ladder
+        if not scored:
+            ax.text(0.5, 0.5, "no feasible run", transform=ax.transAxes, ha="center")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
     return fig

@@ -76,6 +76,13 @@ def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
     per_algorithm_s = (1e-3 + (1e-3 + 20 / 90 * 2e-3) + 3e-3) * 1000 * 2
     assert hours == pytest.approx(len(names) * per_algorithm_s / 3600)
     assert sizes == "10, 100"
+    # per family: a family ten times dearer counts at its own cost, not at the median over families
+    two = _study(["generated-metro-bi", "generated-suburban-bi"], [10, 100], 2, 1000)
+    both = pd.concat([frame, frame.assign(family="generated-suburban-bi", cpu_time_s=frame["cpu_time_s"] * 10)])
+    expected_s = len(names) * (1e-3 + 3e-3) * 11 * 1000 * 2
+    assert projected_cpu_h(both, two, per_family=True)[0] == pytest.approx(expected_s / 3600)
+    with pytest.raises(SystemExit, match="no stored run of NSGA-II on generated-suburban-bi"):
+        projected_cpu_h(frame, two, per_family=True)
     table = cpu_per_evaluation_ms(frame)  # what --estimate prints: the medians, ms, algorithm x n_var
     assert list(table.columns) == [10, 100] and sorted(table.index) == sorted(names)
     np.testing.assert_allclose(table.to_numpy(), [[1.0, 3.0]] * len(names))
@@ -91,6 +98,11 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
                             for e in (100, 200)])
     fig = plot_cell_convergence(history)
     assert len(fig.axes) == 4 and all(len(ax.get_lines()) == 2 for ax in fig.axes)
+    fig.canvas.draw()
+    infeasible = history.assign(igd_plus=np.where(history["family"] == "x-bi", np.nan, history["igd_plus"]))
+    fig = plot_cell_convergence(infeasible)  # a cell without a feasible run: drawn, not a log-scale error
+    fig.canvas.draw()
+    assert [ax.get_yscale() for ax in fig.axes] == ["linear", "linear", "log", "log"]
     profile = pd.DataFrame({"A": [0.5, 1.0], "B": [0.0, 1.0]}, index=pd.Index([1.0, 2.0], name="tau"))
     assert len(plot_performance_profile(profile).axes[0].get_lines()) == 2
 
