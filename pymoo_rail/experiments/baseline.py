@@ -91,7 +91,7 @@ class IndicatorSet:
 MULTI_OBJECTIVE = IndicatorSet(INDICATORS, RANK_INDICATOR, RANK_INDICATOR, "IGD+")
 """The indicators of the multi-objective families (``-bi``, ``-3obj``)."""
 ONE_OBJECTIVE = IndicatorSet({"gap_kwh": True, "gap_pct": True}, "gap_kwh", "gap_resolved_pct",
-                             "gap to the optimum (% of the reference distance)")
+                             "gap_pct")
 """The indicators of the one-objective families (``-single``, ``-trip``)."""
 
 
@@ -392,21 +392,22 @@ def projected_cpu_h(frame: pd.DataFrame, full, per_family: bool = False) -> tupl
     """CPU hours of the ``full`` study from measured CPU per evaluation (linear in n_var between measured sizes).
 
     Per algorithm (``per_family``: per algorithm and family, for a study whose families' costs differ
-    much, as the ``-single`` and ``-trip`` forms do), the median over the stored runs (all families
+    much, as the ``-single`` and ``-trip`` forms do; a family not measured takes the algorithm's), the median over the stored runs (all families
     and seeds) of the CPU seconds per evaluation, taken per n_var and interpolated (held constant
     outside the measured range), then multiplied by the full study's evaluations, problems and
     seeds. The median keeps out the first run of a process, which pays the compilation. Returns the
     hours and the measured sizes.
     """
-    per_eval = _median_ms(frame, ("algorithm", "family", "n_var") if per_family else ("algorithm", "n_var")) / 1000.0
+    per_eval = _median_ms(frame) / 1000.0
+    per_family_eval = _median_ms(frame, ("algorithm", "family", "n_var")) / 1000.0
     total_s = 0.0
     for a in full.algorithms:
+        if a.display not in per_eval.index.get_level_values(0):
+            raise SystemExit(f"--estimate: no stored run of {a.display}")
         for p in full.problems:
-            key = (a.display, p.params["family"]) if per_family else (a.display,)
-            try:
-                known = per_eval.loc[key]
-            except KeyError:
-                raise SystemExit(f"--estimate: no stored run of {' on '.join(key)}") from None
+            key = (a.display, p.params["family"])
+            known = per_family_eval.loc[key] if per_family and key in per_family_eval.index.droplevel(2) \
+                else per_eval.loc[a.display]
             total_s += float(np.interp(p.params["n_var"], known.index, known.to_numpy()))
     sizes = ", ".join(str(n) for n in sorted(frame["n_var"].unique()))
     return total_s * full.budget.value * len(full.seeds) / 3600, sizes
