@@ -14,7 +14,10 @@ Usage::
     python benchmarks/suite_baseline.py --report-only --archive out/suite_baseline.tar.gz
     nice python benchmarks/suite_baseline.py --profile                            # n_var 300 and 1000, every family
     nice python benchmarks/suite_baseline.py --profile --ladder 1000 --families generated-metro-bi --n-eval 2000
+    nice python benchmarks/suite_baseline.py --study single --workers 2           # the one-objective families
 
+``--study single`` does the same for ``benchmarks/suite_baseline_single.toml`` (the ``-single`` and
+``-trip`` families, scored by the gap to the optimum) into ``suite_baseline_single.md``.
 ``--ladder``, ``--seeds``, ``--families`` and ``--n-eval`` reduce the study (the report says so);
 ``--archive PATH`` packs the study file and raw records into one .tar.gz and prints its SHA-256.
 ``--profile`` stores nothing: it runs seed 1 (default ``--ladder 300 1000``) in this process with
@@ -33,47 +36,29 @@ from pathlib import Path
 import numba
 
 from pymoo_rail.experiments import read_study, run_study
-from pymoo_rail.experiments.baseline import (INDICATORS, archive_records, baseline_table, checkpoints_kb, convergence,
-                                             cpu_per_evaluation_ms, cut_study, front_versions, fronts_statement,
-                                             indicator_frame, performance_profile, projected_cpu_h)
+from pymoo_rail.experiments.baseline import (archive_records, convergence, cpu_per_evaluation_ms, cut_study,
+                                             frame_indicators, indicator_frame, performance_profile, projected_cpu_h,
+                                             report_values)
 from pymoo_rail.experiments.report import write_filled
 from pymoo_rail.experiments.results import load_records
 from pymoo_rail.experiments.run_cost import PARTS, cpu_profile, cpu_shares
-from pymoo_rail.experiments.stats import to_markdown
 from pymoo_rail.plotting import plot_cell_convergence, plot_performance_profile
 
 ROOT = Path(__file__).resolve().parent.parent
-STUDY_FILE = ROOT / "benchmarks" / "suite_baseline.toml"
-TEMPLATE = ROOT / "benchmarks" / "templates" / "suite_baseline.md"
+STUDIES = {"table": "suite_baseline", "single": "suite_baseline_single"}
+"""``--study``: the name of its study file (benchmarks/), template (benchmarks/templates/) and report."""
 
 
-def figures(records, frame, out: Path) -> list[str]:
-    """Median IGD+ vs evaluations per (family, n_var) (the records' checkpoints scored now), and the
-    performance profile on IGD+ (PNG files)."""
+def figures(records, frame, out: Path, name: str) -> list[str]:
+    """Median of the profile indicator (IGD+; the gap for one objective) vs evaluations per (family, n_var),
+    the records' checkpoints scored now, and the performance profile on it (PNG files)."""
     import matplotlib.pyplot as plt
 
-    plot_cell_convergence(convergence(records)).savefig(out / "suite_baseline_convergence.png", dpi=110)
-    profile = plot_performance_profile(performance_profile(frame))
-    profile.savefig(out / "suite_baseline_profile.png", dpi=110)
+    scores = frame_indicators(frame)
+    plot_cell_convergence(convergence(records), scores.profile).savefig(out / f"{name}_convergence.png", dpi=110)
+    plot_performance_profile(performance_profile(frame), scores.label).savefig(out / f"{name}_profile.png", dpi=110)
     plt.close("all")
-    return ["suite_baseline_convergence.png", "suite_baseline_profile.png"]
-
-
-def report_values(study, frame, records, pictures, command: str) -> dict:
-    """The report's numbers: what ran, its CPU, the table and the figures."""
-    table = baseline_table(frame)
-    table["friedman_p"] = table["friedman_p"].map(lambda p: f"{p:.2g}")
-    full = read_study(STUDY_FILE)
-    reduced = (len(study.problems), len(study.seeds), study.budget) != (len(full.problems), len(full.seeds), full.budget)
-    return {"reduced": " (reduced run: not the whole table of the study file)" if reduced else "",
-            "command": command, "study_file": STUDY_FILE.relative_to(ROOT),
-            "cells": frame.groupby(["family", "n_var"]).ngroups, "algorithms": len(study.algorithms),
-            "seeds": len(study.seeds), "budget_kind": study.budget.kind, "budget": f"{study.budget.value:,}",
-            "runs": len(frame), "cpu_min": f"{frame['cpu_time_s'].sum() / 60:.1f}",
-            "cpu_mean": f"{frame['cpu_time_s'].mean():.2f}", "indicators": ", ".join(INDICATORS),
-            "table": to_markdown(table, bold_marker=None), "fronts": fronts_statement(front_versions(records)),
-            "checkpoints_kb": checkpoints_kb(records),
-            "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
+    return [f"{name}_convergence.png", f"{name}_profile.png"]
 
 
 def profile(study, algorithms, threads: int) -> int:
@@ -100,13 +85,14 @@ def profile(study, algorithms, threads: int) -> int:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--study", choices=sorted(STUDIES), default="table", help="the study file (default: table)")
     parser.add_argument("--families", nargs="+", default=None, help="families of the study file (default: all)")
     parser.add_argument("--ladder", nargs="+", type=int, default=None, help="n_var values (default: 10 30 100 300 1000)")
     parser.add_argument("--seeds", type=int, default=None, help="seeds 1..N (default: the study file's 31)")
     parser.add_argument("--n-eval", type=int, default=None, help="evaluations per run (default: the study file's)")
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--dask", action="store_true", help="run on a local Dask cluster of --workers processes")
-    parser.add_argument("--work", default=str(ROOT / "out" / "suite_baseline"), help="study directory (records)")
+    parser.add_argument("--work", default=None, help="study directory (records; default out/<study file's name>)")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "reports"), help="report directory")
     parser.add_argument("--report-only", action="store_true", help="write the report from stored records")
     parser.add_argument("--archive", type=Path, default=None, help="pack the raw records into this .tar.gz")
@@ -117,27 +103,31 @@ def main(argv=None) -> int:
     parser.add_argument("--threads", type=int, default=1, help="Numba threads (--profile; default 1)")
     args = parser.parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")
+    name = STUDIES[args.study]
+    full, work = read_study(ROOT / "benchmarks" / f"{name}.toml"), args.work or str(ROOT / "out" / name)
     if args.profile:
-        return profile(cut_study(read_study(STUDY_FILE), args.families, args.ladder or [300, 1000], 1, args.n_eval),
+        return profile(cut_study(full, args.families, args.ladder or [300, 1000], 1, args.n_eval),
                        args.algorithms, args.threads)
-    study = cut_study(read_study(STUDY_FILE), args.families, args.ladder, args.seeds, args.n_eval)
+    study = cut_study(full, args.families, args.ladder, args.seeds, args.n_eval)
     if not args.report_only:
-        run_study(study, args.work, workers=args.workers, scheduler="local" if args.dask else None, seed_major=True)
-    records = load_records(args.work, study)
+        run_study(study, work, workers=args.workers, scheduler="local" if args.dask else None, seed_major=True)
+    records = load_records(work, study)
     if not records:
-        raise SystemExit(f"no stored runs in {args.work}")
+        raise SystemExit(f"no stored runs in {work}")
     frame, out = indicator_frame(records), Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     command = "python benchmarks/suite_baseline.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    pictures = figures(records, frame, out)
-    write_filled(out / "suite_baseline.md", TEMPLATE, report_values(study, frame, records, pictures, command.strip()))
-    print(f"wrote {out / 'suite_baseline.md'}")
+    values = report_values(study, full, frame, records, figures(records, frame, out, name), command.strip(),
+                           f"benchmarks/{name}.toml")
+    write_filled(out / f"{name}.md", ROOT / "benchmarks" / "templates" / f"{name}.md", values)
+    print(f"wrote {out / f'{name}.md'}")
     if args.estimate:
-        hours, sizes = projected_cpu_h(frame, read_study(STUDY_FILE))
+        hours, sizes = projected_cpu_h(frame, full)
         print("median CPU ms per evaluation\n" + cpu_per_evaluation_ms(frame).round(3).to_string())
-        print(f"the whole study (measured n_var {sizes}): {hours:.1f} CPU hours, {hours / 2:.1f} h on 2 cores")
+        print(f"the whole study (measured n_var {sizes}): {hours:.1f} CPU hours, {hours / 2:.1f} h on 2 cores; "
+              f"{projected_cpu_h(frame, full, per_family=True)[0]:.1f} CPU hours from each family's own medians")
     if args.archive:
-        print(f"archive {args.archive}: sha256 {archive_records(args.work, args.archive)}")
+        print(f"archive {args.archive}: sha256 {archive_records(work, args.archive, name)}")
     return 0
 
 

@@ -14,6 +14,17 @@ so records stay current when the exact solver improves and their scores follow i
 - ``gap_kwh``: median energy gap of the members to the optimum at their own running times
   (:func:`pymoo_rail.optimal.reference.certified_gap`).
 
+A one-objective record (the ``-single`` and ``-trip`` families) is scored by the gap of its best
+feasible energy to the instance's optimum (:data:`ONE_OBJECTIVE`): the certified constrained
+optimum of a ``-single`` instance (its certificate known), the exact split of a ``-trip``:
+
+- ``gap_kwh``: best feasible energy minus the optimum (>= minus the certificate);
+- ``gap_pct``: the same in % of the distance from the optimum to the instance's fixed reference
+  point (:meth:`hv_reference_point`), i.e. ``100 (1 - normalised HV)`` of the one-dimensional front;
+- ``gap_resolved_pct``: ``gap_pct`` raised to the optimum's resolution (its certificate, or
+  :data:`EXACT_RESOLUTION_PCT` for an exact optimum): positive, what the performance profile and the
+  convergence figure use, as a gap within the certificate cannot be told from 0.
+
 The 3-objective families have a bounded front (:mod:`pymoo_rail.suite.comfort`): their IGD+ is to
 the inner (best-known) points, ``hv_norm`` is over the outer bound's hypervolume (the true front's
 lies between the inner points' value and 1), and ``gap_kwh`` is to the line's certified energy /
@@ -33,7 +44,7 @@ import json
 import tarfile
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -41,15 +52,76 @@ import pandas as pd
 from pymoo_rail.experiments.inputs import front_digest
 from pymoo_rail.experiments.registry import canonical_name
 from pymoo_rail.experiments.spec import Budget
-from pymoo_rail.experiments.stats import friedman_holm
-from pymoo_rail.optimal.reference import certified_gap
+from pymoo_rail.experiments.stats import friedman_holm, to_markdown
+from pymoo_rail.optimal.reference import certified_gap, constrained_optimum
 from pymoo_rail.suite import get_problem
 from pymoo_rail.suite.comfort import COMFORT_OBJECTIVES
+from pymoo_rail.suite.trips import TripProblem
 
 INDICATORS = {"igd_plus": True, "hv_norm": False, "gap_kwh": True}
 """The table's indicators and whether lower is better."""
 RANK_INDICATOR = "igd_plus"
 """The indicator the ranks and Holm marks of the table are computed on."""
+EXACT_RESOLUTION_PCT = 1e-6
+"""The resolution of an exact optimum (a trip's split) in ``gap_resolved_pct``: float rounding of its sum."""
+EXACT_FRONT_VERSION = "exact"
+"""The front version a report states for a trip: its optimum is exact on the curves its definition holds."""
+
+
+@dataclass(frozen=True)
+class IndicatorSet:
+    """The indicators of a table for one objective count (:func:`indicator_set`).
+
+    ``lower_better``: the table's indicators and whether lower is better; ``rank``: the one the
+    Friedman ranks and Holm marks are computed on; ``profile``: the positive one of the performance
+    profile and the convergence figure; ``label``: how the figures name it.
+    """
+
+    lower_better: Mapping[str, bool]
+    rank: str
+    profile: str
+    label: str
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The scores of a record: the table's indicators and the profile's."""
+        return tuple(dict.fromkeys([*self.lower_better, self.profile]))
+
+
+MULTI_OBJECTIVE = IndicatorSet(INDICATORS, RANK_INDICATOR, RANK_INDICATOR, "IGD+")
+"""The indicators of the multi-objective families (``-bi``, ``-3obj``)."""
+ONE_OBJECTIVE = IndicatorSet({"gap_kwh": True, "gap_pct": True}, "gap_kwh", "gap_resolved_pct",
+                             "gap_pct")
+"""The indicators of the one-objective families (``-single``, ``-trip``)."""
+
+
+def indicator_set(n_obj: int) -> IndicatorSet:
+    """:data:`ONE_OBJECTIVE` for one objective, :data:`MULTI_OBJECTIVE` for more."""
+    return ONE_OBJECTIVE if int(n_obj) == 1 else MULTI_OBJECTIVE
+
+
+def frame_indicators(frame: pd.DataFrame) -> IndicatorSet:
+    """The indicator set of an :func:`indicator_frame` (its ``n_obj``); raises ValueError for a mix of
+    one-objective and multi-objective records, whose scores cannot share a table."""
+    counts = sorted(int(n) for n in frame["n_obj"].unique())
+    if len({n == 1 for n in counts}) != 1:
+        raise ValueError(f"frame['n_obj'] = {counts}: one-objective and multi-objective records make separate tables")
+    return indicator_set(counts[0])
+
+
+def one_objective_optimum(problem) -> tuple[float, float]:
+    """The optimum (kWh) of a one-objective family instance and its certificate (kWh).
+
+    A ``-single`` instance: the constrained optimum of the line's certified front within the running-time
+    tolerance (:func:`~pymoo_rail.optimal.reference.constrained_optimum`, what ``pareto_front()`` gives)
+    and its bound; a ``-trip`` instance: its exact split (:attr:`~pymoo_rail.suite.trips.TripProblem.optimum`),
+    certificate 0.
+    """
+    if isinstance(problem, TripProblem):
+        return float(problem.optimum[1]), 0.0
+    energy, bound, _ = constrained_optimum(problem.certified_front(), problem.time_tolerance_s,
+                                           window_s=problem.time_window_s)
+    return float(energy), float(bound)
 
 
 def instance_of(record: dict):
@@ -73,37 +145,62 @@ class FrontScorer:
     pf: np.ndarray
     hv_reference_point: np.ndarray
     hv_whole: float  # the certified front's hypervolume, or the outer bound's for a bounded front
+    certificate_kwh: float = 0.0  # one objective: the optimum's bound (0 when exact)
+
+    @property
+    def indicators(self) -> IndicatorSet:
+        """The scores of this instance's records (:func:`indicator_set`)."""
+        return indicator_set(self.problem.n_obj)
 
     def score(self, F: np.ndarray) -> dict[str, float]:
-        """IGD+, normalised HV and median energy gap of the feasible objective vectors ``F`` (NaN for none)."""
+        """The :attr:`indicators` of the feasible objective vectors ``F`` (NaN for none)."""
+        F = np.asarray(F, dtype=float).reshape(-1, self.problem.n_obj)
+        out = dict.fromkeys(self.indicators.columns, float("nan"))
+        if len(F) == 0:
+            return out
+        out.update(self._gap(F) if self.problem.n_obj == 1 else self._front(F))
+        return out
+
+    def _gap(self, F: np.ndarray) -> dict[str, float]:
+        """Best energy minus the optimum; in % of the optimum's distance to the reference point (``hv_whole``)."""
+        gap_kwh = float(F[:, 0].min() - self.pf[0, 0])
+        resolution_pct = max(100.0 * self.certificate_kwh / self.hv_whole, EXACT_RESOLUTION_PCT)
+        gap_pct = 100.0 * gap_kwh / self.hv_whole
+        return {"gap_kwh": gap_kwh, "gap_pct": gap_pct, "gap_resolved_pct": max(gap_pct, resolution_pct)}
+
+    def _front(self, F: np.ndarray) -> dict[str, float]:
+        """IGD+, normalised HV and median energy gap of a front."""
         from pymoo.indicators.hv import HV
         from pymoo.indicators.igd_plus import IGDPlus
 
-        F = np.asarray(F, dtype=float).reshape(-1, self.problem.n_obj)
-        out = dict.fromkeys(INDICATORS, float("nan"))
-        if len(F) == 0:
-            return out
         objectives = list(self.problem.objectives)
         gap = certified_gap(self.problem.certified_front(), F[:, objectives.index("running_time")],
                             F[:, objectives.index("energy")])
         hv = HV(ref_point=self.hv_reference_point)
-        out.update(igd_plus=float(IGDPlus(self.pf)(F)), hv_norm=float(hv(F) / self.hv_whole),
-                   gap_kwh=gap["gap_median_kwh"])
-        return out
+        return {"igd_plus": float(IGDPlus(self.pf)(F)), "hv_norm": float(hv(F) / self.hv_whole),
+                "gap_kwh": gap["gap_median_kwh"]}
 
 
 def front_scorer(problem) -> FrontScorer:
-    """The current front of a family instance, its fixed HV reference point and the HV that counts as 1."""
+    """The current front of a family instance, its fixed HV reference point and the HV that counts as 1.
+
+    One objective: the optimum and its certificate (:func:`one_objective_optimum`); the HV that
+    counts as 1 is the optimum's, its distance to the reference point.
+    """
     from pymoo.indicators.hv import HV
 
-    pf, ref = problem.pareto_front(), problem.hv_reference_point()
+    ref = problem.hv_reference_point()
+    if problem.n_obj == 1:
+        optimum, certificate = one_objective_optimum(problem)
+        return FrontScorer(problem, np.array([[optimum]]), ref, float(ref[0] - optimum), certificate)
+    pf = problem.pareto_front()
     # a bounded front (the -3obj families): HV over the outer bound's, so 1 is out of reach of any run
     whole = problem.bounded_front().hv_outer if problem.objectives == COMFORT_OBJECTIVES else HV(ref_point=ref)(pf)
     return FrontScorer(problem, pf, ref, float(whole))
 
 
 def baseline_indicators(record: dict, problem=None, scorer: FrontScorer | None = None) -> dict[str, float]:
-    """IGD+, normalised HV and median energy gap of one record's final front (NaN where no member is feasible)."""
+    """The scores of one record's final front (:meth:`FrontScorer.score`; NaN where no member is feasible)."""
     problem = scorer.problem if scorer is not None else instance_of(record) if problem is None else problem
     scorer = front_scorer(problem) if scorer is None else scorer
     F = np.asarray(record["front"]["F"], dtype=float).reshape(-1, problem.n_obj)
@@ -126,14 +223,15 @@ def _scorers(records: Iterable[dict]) -> dict:
 
 
 def indicator_frame(records: Iterable[dict]) -> pd.DataFrame:
-    """One row per record: family, n_var, instance seed, run seed, algorithm, the indicators, CPU and evaluations."""
+    """One row per record: family, n_var, n_obj, instance seed, run seed, algorithm, its scores
+    (:attr:`FrontScorer.indicators`), CPU and evaluations."""
     records = list(records)
     scorers, rows = _scorers(records), []
     for record in records:
         scorer = scorers[tuple(sorted(record["problem"].items()))]
         problem = scorer.problem
-        rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
-                     "seed": int(record["seed"]), "algorithm": record["algorithm_label"],
+        rows.append({"family": problem.family, "n_var": int(problem.n_var), "n_obj": int(problem.n_obj),
+                     "instance_seed": problem.seed, "seed": int(record["seed"]), "algorithm": record["algorithm_label"],
                      **baseline_indicators(record, scorer=scorer),
                      "cpu_time_s": float(record["cpu_time_s"]), "n_eval": int(record["n_eval"])})
     return pd.DataFrame(rows)
@@ -142,13 +240,15 @@ def indicator_frame(records: Iterable[dict]) -> pd.DataFrame:
 def front_versions(records: Iterable[dict]) -> pd.DataFrame:
     """The fronts a report scores ``records`` against: per instance its front version and content digest.
 
-    ``front_version``: :attr:`pymoo_rail.suite.FamilyProblem.front_version`; ``front_digest``:
+    ``front_version``: :attr:`pymoo_rail.suite.FamilyProblem.front_version` (:data:`EXACT_FRONT_VERSION`
+    for a trip); ``front_digest``:
     :func:`pymoo_rail.experiments.inputs.front_digest`. Neither is part of a record: a report states them.
     """
     rows = []
     for problem in _instances(records).values():  # no scorer: the front's hypervolume is not needed here
         rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
-                     "front_version": problem.front_version, "front_digest": front_digest(problem)})
+                     "front_version": getattr(problem, "front_version", EXACT_FRONT_VERSION),
+                     "front_digest": front_digest(problem)})
     return pd.DataFrame(rows).sort_values(["family", "n_var", "instance_seed"]).reset_index(drop=True)
 
 
@@ -176,19 +276,22 @@ def _cell(values: pd.Series) -> str:
 
 
 def baseline_table(frame: pd.DataFrame, alpha: float = 0.05,
-                   indicators: Sequence[str] = tuple(INDICATORS)) -> pd.DataFrame:
+                   indicators: Sequence[str] | None = None) -> pd.DataFrame:
     """Mean +- std of each indicator, mean rank and Holm mark vs the best, per (family, n_var) and algorithm.
 
-    Ranks and marks are on :data:`RANK_INDICATOR`, paired by run seed; ``friedman_p`` is the
-    Friedman p-value of the cell. Mark ``best``, ``=`` (not significantly worse than the best at
-    ``alpha`` after Holm's correction) or ``-`` (significantly worse); ``n/a`` (rank NaN) in a cell
-    with fewer than 2 seeds where every algorithm has a value.
+    The indicators (default) and the one ranked are the frame's set (:func:`frame_indicators`: IGD+
+    for several objectives, the gap in kWh for one). Ranks and marks are paired by run seed;
+    ``friedman_p`` is the Friedman p-value of the cell. Mark ``best``, ``=`` (not significantly
+    worse than the best at ``alpha`` after Holm's correction) or ``-`` (significantly worse);
+    ``n/a`` (rank NaN) in a cell with fewer than 2 seeds where every algorithm has a value.
     """
+    scores_of = frame_indicators(frame)
+    indicators = tuple(scores_of.lower_better) if indicators is None else indicators
     rows = []
     for (family, n_var), cell in frame.groupby(["family", "n_var"], sort=True):
-        scores = cell.pivot_table(index="seed", columns="algorithm", values=RANK_INDICATOR, aggfunc="first")
+        scores = cell.pivot_table(index="seed", columns="algorithm", values=scores_of.rank, aggfunc="first")
         complete = scores.dropna(axis=0, how="any")
-        test = (friedman_holm(complete, lower_better=INDICATORS[RANK_INDICATOR], alpha=alpha)
+        test = (friedman_holm(complete, lower_better=scores_of.lower_better[scores_of.rank], alpha=alpha)
                 if len(complete) >= 2 and complete.shape[1] >= 2 else None)  # else no ranks: too few paired seeds
         for algorithm, runs in cell.groupby("algorithm", sort=False):
             rows.append({"family": family, "n_var": n_var, "algorithm": algorithm,
@@ -199,13 +302,15 @@ def baseline_table(frame: pd.DataFrame, alpha: float = 0.05,
     return pd.DataFrame(rows).sort_values(["family", "n_var", "mean_rank"], kind="stable").reset_index(drop=True)
 
 
-def performance_profile(frame: pd.DataFrame, indicator: str = RANK_INDICATOR,
+def performance_profile(frame: pd.DataFrame, indicator: str | None = None,
                         taus: Sequence[float] = tuple(np.geomspace(1, 100, 60))) -> pd.DataFrame:
     """Dolan & More's performance profile: share of (instance, seed) pairs an algorithm solves within tau x the best.
 
-    The ratio of an algorithm on a pair is its indicator over the pair's best (lower is better;
-    a missing value counts as never within). Returns one column per algorithm, indexed by tau.
+    The ratio of an algorithm on a pair is its ``indicator`` (default: the profile indicator of the
+    frame's set, :func:`frame_indicators`) over the pair's best (lower is better; a missing value
+    counts as never within). Returns one column per algorithm, indexed by tau.
     """
+    indicator = frame_indicators(frame).profile if indicator is None else indicator
     keys = ["family", "n_var", "instance_seed", "seed"]
     table = frame.pivot_table(index=keys, columns="algorithm", values=indicator, aggfunc="first")
     best = table.min(axis=1)
@@ -220,7 +325,8 @@ def convergence(records: Iterable[dict]) -> pd.DataFrame:
     One row per record and checkpoint (``checkpoints`` of a suite run: the non-dominated feasible
     objective vectors at the first generation past each of
     :data:`~pymoo_rail.experiments.runner.CHECKPOINTS_EVAL` evaluations), and one for its final front
-    at its ``n_eval``: family, n_var, algorithm, seed, n_eval and the :data:`INDICATORS`.
+    at its ``n_eval``: family, n_var, algorithm, seed, n_eval and the record's scores
+    (:attr:`FrontScorer.indicators`; for one objective the best feasible energy found so far).
     """
     records = list(records)
     scorers, rows = _scorers(records), []
@@ -233,6 +339,24 @@ def convergence(records: Iterable[dict]) -> pd.DataFrame:
                  for n_eval, F in zip(checkpoints["n_eval"], checkpoints["F"]) if n_eval < record["n_eval"]]
         rows.append({**cell, "n_eval": int(record["n_eval"]), **baseline_indicators(record, scorer=scorer)})
     return pd.DataFrame(rows)
+
+
+def report_values(study, full, frame: pd.DataFrame, records: Sequence[dict], pictures: Sequence[str],
+                  command: str, study_file: str) -> dict[str, str]:
+    """The values of a baseline report's template: what ran (``study``, cut from ``full``), its CPU,
+    the table (:func:`baseline_table`), the fronts scored against and the figures (``pictures``, file names)."""
+    table = baseline_table(frame)
+    table["friedman_p"] = table["friedman_p"].map(lambda p: f"{p:.2g}")
+    reduced = (len(study.problems), len(study.seeds), study.budget) != (len(full.problems), len(full.seeds), full.budget)
+    return {"reduced": " (reduced run: not the whole table of the study file)" if reduced else "",
+            "command": command, "study_file": study_file,
+            "cells": str(frame.groupby(["family", "n_var"]).ngroups), "algorithms": str(len(study.algorithms)),
+            "seeds": str(len(study.seeds)), "budget_kind": study.budget.kind, "budget": f"{study.budget.value:,}",
+            "runs": str(len(frame)), "cpu_min": f"{frame['cpu_time_s'].sum() / 60:.1f}",
+            "cpu_mean": f"{frame['cpu_time_s'].mean():.2f}",
+            "indicators": ", ".join(frame_indicators(frame).lower_better),
+            "table": to_markdown(table, bold_marker=None), "fronts": fronts_statement(front_versions(records)),
+            "checkpoints_kb": checkpoints_kb(records), "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
 
 
 def cut_study(study, families=None, ladder=None, seeds: int | None = None, n_eval: int | None = None):
@@ -259,26 +383,32 @@ def cpu_per_evaluation_ms(frame: pd.DataFrame) -> pd.DataFrame:
     return _median_ms(frame).unstack("n_var")
 
 
-def _median_ms(frame: pd.DataFrame) -> pd.Series:
+def _median_ms(frame: pd.DataFrame, keys: Sequence[str] = ("algorithm", "n_var")) -> pd.Series:
     ms = frame.assign(ms=1000.0 * frame["cpu_time_s"] / frame["n_eval"])
-    return ms.groupby(["algorithm", "n_var"])["ms"].median()
+    return ms.groupby(list(keys))["ms"].median()
 
 
-def projected_cpu_h(frame: pd.DataFrame, full) -> tuple[float, str]:
+def projected_cpu_h(frame: pd.DataFrame, full, per_family: bool = False) -> tuple[float, str]:
     """CPU hours of the ``full`` study from measured CPU per evaluation (linear in n_var between measured sizes).
 
-    Per algorithm, the median over the stored runs (all families and seeds) of the CPU seconds per
-    evaluation, taken per n_var and interpolated (held constant outside the measured range), then
-    multiplied by the full study's evaluations, problems and seeds. The median keeps out the first
-    run of a process, which pays the compilation. Returns the hours and the measured sizes.
+    Per algorithm (``per_family``: per algorithm and family, for a study whose families' costs differ
+    much, as the ``-single`` and ``-trip`` forms do; a family not measured takes the algorithm's), the median over the stored runs (all families
+    and seeds) of the CPU seconds per evaluation, taken per n_var and interpolated (held constant
+    outside the measured range), then multiplied by the full study's evaluations, problems and
+    seeds. The median keeps out the first run of a process, which pays the compilation. Returns the
+    hours and the measured sizes.
     """
     per_eval = _median_ms(frame) / 1000.0
+    per_family_eval = _median_ms(frame, ("algorithm", "family", "n_var")) / 1000.0
     total_s = 0.0
     for a in full.algorithms:
         if a.display not in per_eval.index.get_level_values(0):
             raise SystemExit(f"--estimate: no stored run of {a.display}")
-        known = per_eval[a.display]
-        total_s += sum(np.interp(p.params["n_var"], known.index, known.to_numpy()) for p in full.problems)
+        for p in full.problems:
+            key = (a.display, p.params["family"])
+            known = per_family_eval.loc[key] if per_family and key in per_family_eval.index.droplevel(2) \
+                else per_eval.loc[a.display]
+            total_s += float(np.interp(p.params["n_var"], known.index, known.to_numpy()))
     sizes = ", ".join(str(n) for n in sorted(frame["n_var"].unique()))
     return total_s * full.budget.value * len(full.seeds) / 3600, sizes
 
@@ -296,7 +426,9 @@ def archive_records(work: str | Path, path: str | Path, top: str = "suite_baseli
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-__all__ = ["INDICATORS", "RANK_INDICATOR", "instance_of", "FrontScorer", "front_scorer", "baseline_indicators",
+__all__ = ["INDICATORS", "RANK_INDICATOR", "EXACT_RESOLUTION_PCT", "EXACT_FRONT_VERSION", "IndicatorSet",
+           "MULTI_OBJECTIVE", "ONE_OBJECTIVE", "indicator_set", "frame_indicators", "one_objective_optimum",
+           "instance_of", "FrontScorer", "front_scorer", "baseline_indicators",
            "indicator_frame", "front_versions", "fronts_statement", "checkpoints_kb", "baseline_table",
-           "performance_profile", "convergence", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
+           "performance_profile", "convergence", "report_values", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
            "archive_records"]

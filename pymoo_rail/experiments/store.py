@@ -191,8 +191,9 @@ def _check_fields(path: Path, record: dict) -> None:
     checkpoints = record.get("checkpoints")
     if checkpoints is not None:
         try:
+            # an empty F: no feasible member yet at that checkpoint (a run may find none at all)
             if len(checkpoints["n_eval"]) != len(checkpoints["F"]) or not all(
-                    np.asarray(F, dtype=float).reshape(len(F), -1).shape[1] in (0, record["n_obj"])
+                    len(F) == 0 or np.asarray(F, dtype=float).reshape(len(F), -1).shape[1] == record["n_obj"]
                     for F in checkpoints["F"]):
                 raise ValueError("one F of n_obj columns per n_eval")
         except (KeyError, TypeError, ValueError) as err:

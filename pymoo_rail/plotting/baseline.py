@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 
@@ -21,15 +22,18 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
         for name, runs in cell.groupby("algorithm"):
             median = runs.groupby("n_eval")[indicator].median()
             ax.plot(median.index, median.to_numpy(), label=name)
+        scored = np.isfinite(cell[indicator]).any()  # a cell without a feasible run has nothing to plot on a log axis
         ax.set(title=f"{family} n_var={n_var}", xlabel="evaluations", ylabel=f"median {indicator}", xscale="log",
-               yscale="log")  # the checkpoints are a log ladder
+               yscale="log" if scored else "linear")  # the checkpoints are a log ladder
+        if not scored:
+            ax.text(0.5, 0.5, "no feasible run", transform=ax.transAxes, ha="center")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
     return fig
 
 
-def plot_performance_profile(profile: pd.DataFrame):
-    """The share of runs within tau of the best IGD+, one step line per algorithm.
+def plot_performance_profile(profile: pd.DataFrame, indicator: str = "IGD+"):
+    """The share of runs within tau of the best ``indicator`` (its name on the axis), one step line per algorithm.
 
     ``profile``: ``pymoo_rail.experiments.baseline.performance_profile`` (index tau, one column per
     algorithm). Returns the matplotlib ``Figure``.
@@ -39,7 +43,7 @@ def plot_performance_profile(profile: pd.DataFrame):
     fig, ax = plt.subplots(figsize=(5, 3.5))
     for name in profile.columns:
         ax.step(profile.index, profile[name], where="post", label=name)
-    ax.set(xscale="log", xlabel="tau (IGD+ / best IGD+ on the run's instance and seed)", ylabel="share of runs")
+    ax.set(xscale="log", xlabel=f"tau ({indicator} / best on the run's instance and seed)", ylabel="share of runs")
     ax.legend(fontsize=7)
     fig.tight_layout()
     return fig

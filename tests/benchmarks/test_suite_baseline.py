@@ -12,11 +12,11 @@ import pytest
 
 def _study(*cut):
     """The study file cut to (families, ladder, seeds, n_eval)."""
-    from benchmarks.suite_baseline import STUDY_FILE
+    from benchmarks.suite_baseline import ROOT, STUDIES
     from pymoo_rail.experiments import read_study
     from pymoo_rail.experiments.baseline import cut_study
 
-    return cut_study(read_study(STUDY_FILE), *cut)
+    return cut_study(read_study(ROOT / "benchmarks" / f"{STUDIES['table']}.toml"), *cut)
 
 
 def test_the_full_study_is_every_multi_objective_family_on_the_ladder_with_nine_algorithms_and_31_seeds():
@@ -76,6 +76,15 @@ def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
     per_algorithm_s = (1e-3 + (1e-3 + 20 / 90 * 2e-3) + 3e-3) * 1000 * 2
     assert hours == pytest.approx(len(names) * per_algorithm_s / 3600)
     assert sizes == "10, 100"
+    # per family: a family ten times dearer counts at its own cost, not at the median over families
+    two = _study(["generated-metro-bi", "generated-suburban-bi"], [10, 100], 2, 1000)
+    both = pd.concat([frame, frame.assign(family="generated-suburban-bi", cpu_time_s=frame["cpu_time_s"] * 10)])
+    expected_s = len(names) * (1e-3 + 3e-3) * 11 * 1000 * 2
+    assert projected_cpu_h(both, two, per_family=True)[0] == pytest.approx(expected_s / 3600)
+    # a family not measured takes the algorithm's medians over the measured ones
+    assert projected_cpu_h(frame, two, per_family=True)[0] == pytest.approx(projected_cpu_h(frame, two)[0])
+    with pytest.raises(SystemExit, match="no stored run of NSGA-II"):
+        projected_cpu_h(frame[frame["algorithm"] != "NSGA-II"], two, per_family=True)
     table = cpu_per_evaluation_ms(frame)  # what --estimate prints: the medians, ms, algorithm x n_var
     assert list(table.columns) == [10, 100] and sorted(table.index) == sorted(names)
     np.testing.assert_allclose(table.to_numpy(), [[1.0, 3.0]] * len(names))
@@ -91,6 +100,11 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
                             for e in (100, 200)])
     fig = plot_cell_convergence(history)
     assert len(fig.axes) == 4 and all(len(ax.get_lines()) == 2 for ax in fig.axes)
+    fig.canvas.draw()
+    infeasible = history.assign(igd_plus=np.where(history["family"] == "x-bi", np.nan, history["igd_plus"]))
+    fig = plot_cell_convergence(infeasible)  # a cell without a feasible run: drawn, not a log-scale error
+    fig.canvas.draw()
+    assert [ax.get_yscale() for ax in fig.axes] == ["linear", "linear", "log", "log"]
     profile = pd.DataFrame({"A": [0.5, 1.0], "B": [0.0, 1.0]}, index=pd.Index([1.0, 2.0], name="tau"))
     assert len(plot_performance_profile(profile).axes[0].get_lines()) == 2
 
@@ -111,3 +125,19 @@ def test_the_profile_mode_splits_a_run_and_leaves_the_thread_count(capsys):
     assert values[8] == pytest.approx(sum(values[:8]), abs=6e-3)  # printed to 3 decimals
     with pytest.raises(SystemExit, match="none of the study's"):
         main(["--profile", "--ladder", "10", "--algorithms", "no-such-algorithm"])
+
+
+def test_the_single_study_runs_and_reports_the_gap_to_the_optimum(tmp_path, capsys):
+    from benchmarks.suite_baseline import main
+
+    work, out = tmp_path / "work", tmp_path / "reports"
+    assert main(["--study", "single", "--families", "generated-metro-single", "--ladder", "10", "--seeds", "2",
+                 "--n-eval", "200", "--workers", "1", "--work", str(work), "--out", str(out), "--estimate"]) == 0
+    report = (out / "suite_baseline_single.md").read_text()
+    assert report.startswith("# Suite baseline table, one-objective families (reduced run")
+    assert "gap_kwh" in report and "igd_plus" not in report and "${" not in report
+    assert "from `benchmarks/suite_baseline_single.toml`: 1 (family, n_var) cells x 5 algorithms x 2 seeds" in report
+    rows = [line for line in report.splitlines() if line.startswith("| generated-metro-single")]
+    assert len(rows) == 5 and all(line.count("|") > 8 for line in rows)
+    assert (out / "suite_baseline_single_convergence.png").is_file() and (out / "suite_baseline_single_profile.png").is_file()
+    assert "the whole study (measured n_var 10)" in capsys.readouterr().out

@@ -67,7 +67,7 @@ def test_the_table_ranks_every_algorithm_of_a_cell(records):
 
 
 def test_performance_profile_reaches_one_for_the_best_at_tau_one():
-    frame = pd.DataFrame({"family": "f", "n_var": 10, "instance_seed": 1, "seed": [1, 1, 2, 2],
+    frame = pd.DataFrame({"family": "f", "n_var": 10, "n_obj": 2, "instance_seed": 1, "seed": [1, 1, 2, 2],
                           "algorithm": ["a", "b", "a", "b"], "igd_plus": [1.0, 2.0, 1.0, 4.0]})
     profile = performance_profile(frame, taus=[1.0, 2.0, 3.0, 4.0])
     assert profile["a"].tolist() == [1.0, 1.0, 1.0, 1.0]
@@ -158,3 +158,15 @@ def test_the_report_states_the_size_of_the_checkpoints(records):
     assert checkpoints_kb(records) == f"median {np.median(sizes):.1f} kB, largest {sizes[-1]:.1f} kB"
     assert 0 < sizes[-1] < 30
     assert checkpoints_kb([]) == "no records"
+
+
+def test_a_record_with_no_feasible_member_at_its_checkpoints_loads(records, tmp_path):
+    from pymoo_rail.experiments.store import ResultStore
+
+    store = ResultStore(tmp_path)
+    store.prepare()
+    record = {**copy.deepcopy(records[0]), "checkpoints": {"target_n_eval": [200], "n_eval": [200], "F": [[]]}}
+    store.write(record)
+    assert store.load(record["run_id"])["checkpoints"]["F"] == [[]]
+    history = convergence([{**record, "front": {**record["front"], "CV": [1.0] * len(record["front"]["CV"])}}])
+    assert history["igd_plus"].isna().all()  # nothing feasible: NaN at the checkpoint and at the end
