@@ -341,6 +341,20 @@ def convergence(records: Iterable[dict]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def rank_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
+    """How the ranking changes with the dimension: each algorithm's Friedman mean rank averaged over
+    the families of the same form (``-bi``, ``-3obj``, ...), per ``n_var``.
+
+    ``table``: :func:`baseline_table`. One row per (form, algorithm), one column per ``n_var``; a cell
+    without ranks (fewer than 2 paired seeds) stays NaN. Sorted by form, then by the mean rank at the
+    largest ``n_var``.
+    """
+    ranks = table.assign(form=table["family"].str.rsplit("-", n=1).str[-1])
+    out = ranks.pivot_table(index=["form", "algorithm"], columns="n_var", values="mean_rank", aggfunc="mean")
+    out.columns = [f"n_var {int(n)}" for n in out.columns]
+    return out.sort_values(["form", out.columns[-1]]).round(2).reset_index()
+
+
 def report_values(study, full, frame: pd.DataFrame, records: Sequence[dict], pictures: Sequence[str],
                   command: str, study_file: str) -> dict[str, str]:
     """The values of a baseline report's template: what ran (``study``, cut from ``full``), its CPU,
@@ -356,6 +370,7 @@ def report_values(study, full, frame: pd.DataFrame, records: Sequence[dict], pic
             "cpu_mean": f"{frame['cpu_time_s'].mean():.2f}",
             "indicators": ", ".join(frame_indicators(frame).lower_better),
             "table": to_markdown(table, bold_marker=None), "fronts": fronts_statement(front_versions(records)),
+            "ranks": to_markdown(rank_by_dimension(table), bold_marker=None),
             "checkpoints_kb": checkpoints_kb(records), "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
 
 

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, checkpoints_kb, convergence,
-                                             indicator_frame, instance_of, performance_profile)
+                                             indicator_frame, instance_of, performance_profile, rank_by_dimension)
 from pymoo_rail.experiments.runner import execute_run
 from pymoo_rail.experiments.spec import Budget, RunSpec, algorithm, problem
 from pymoo_rail.suite import get_problem
@@ -170,3 +170,28 @@ def test_a_record_with_no_feasible_member_at_its_checkpoints_loads(records, tmp_
     assert store.load(record["run_id"])["checkpoints"]["F"] == [[]]
     history = convergence([{**record, "front": {**record["front"], "CV": [1.0] * len(record["front"]["CV"])}}])
     assert history["igd_plus"].isna().all()  # nothing feasible: NaN at the checkpoint and at the end
+
+
+def test_rank_by_dimension_averages_the_families_of_a_form():
+    table = pd.DataFrame({
+        "family": ["generated-metro-bi", "generated-metro-bi", "generated-suburban-bi", "generated-suburban-bi",
+                   "generated-metro-bi", "generated-metro-bi", "generated-metro-3obj", "generated-metro-3obj"],
+        "n_var": [10, 10, 10, 10, 300, 300, 10, 10],
+        "algorithm": ["A", "B", "A", "B", "A", "B", "A", "B"],
+        "mean_rank": [1.0, 2.0, 2.0, 1.0, 2.0, 1.0, 1.2, 1.8],
+    })
+    ranks = rank_by_dimension(table).set_index(["form", "algorithm"])
+    assert list(ranks.columns) == ["n_var 10", "n_var 300"]
+    assert ranks.loc[("bi", "A"), "n_var 10"] == pytest.approx(1.5)  # the mean of metro's 1 and suburban's 2
+    assert ranks.loc[("bi", "B"), "n_var 300"] == pytest.approx(1.0)
+    assert ranks.loc[("3obj", "A"), "n_var 10"] == pytest.approx(1.2)
+    assert np.isnan(ranks.loc[("3obj", "A"), "n_var 300"])  # no 3obj cell at 300
+    # within a form, sorted by the rank at the largest dimension: B first at 300
+    assert list(ranks.loc["bi"].index) == ["B", "A"]
+
+
+def test_rank_by_dimension_of_a_real_table(records):
+    table = baseline_table(indicator_frame(records))
+    ranks = rank_by_dimension(table)
+    merged = ranks.merge(table, on="algorithm")
+    assert np.allclose(merged["n_var 10"], merged["mean_rank"])
