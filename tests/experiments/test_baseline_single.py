@@ -133,14 +133,36 @@ def test_a_scorer_for_one_objective_has_the_optimum_as_its_front():
     assert scorer.indicators is ONE_OBJECTIVE
 
 
-def test_the_single_study_file_lists_every_one_objective_family_on_the_ladder():
+def _study_file(name: str):
     from pathlib import Path
 
-    study = read_study(Path(__file__).resolve().parents[2] / "benchmarks" / "suite_baseline_single.toml")
-    one_objective = {f for f in list_families() if f.endswith(("-single", "-trip"))}
-    assert len(one_objective) == 6
-    cells = [(p.params["family"], p.params["n_var"], p.params["seed"]) for p in study.problems]
-    assert sorted(cells) == sorted((f, n, 1) for f in one_objective for n in (10, 30, 100, 300, 1000))
+    return read_study(Path(__file__).resolve().parents[2] / "benchmarks" / f"{name}.toml")
+
+
+def _cells(study) -> list[tuple]:
+    return sorted((p.params["family"], p.params["n_var"], p.params["seed"]) for p in study.problems)
+
+
+def test_the_single_study_file_lists_every_single_family_on_the_ladder():
+    study = _study_file("suite_baseline_single")
+    single = {f for f in list_families() if f.endswith("-single")}
+    assert len(single) == 4
+    assert _cells(study) == sorted((f, n, 1) for f in single for n in (10, 30, 100, 300, 1000))
     assert [a.display for a in study.algorithms] == ["GA", "DE", "PSO", "ABC", "random"]
     assert all(ALGORITHMS[canonical_name(a.name)].objectives in ("single", "any") for a in study.algorithms)
     assert study.seeds == tuple(range(1, 32)) and study.budget.kind == "n_eval"
+    assert len(list(study.runs())) == 3100
+
+
+def test_the_trip_study_file_runs_the_same_five_algorithms_repaired_on_both_trip_families():
+    study, single = _study_file("suite_baseline_trip"), _study_file("suite_baseline_single")
+    trip = {f for f in list_families() if f.endswith("-trip")}
+    assert len(trip) == 2
+    assert _cells(study) == sorted((f, n, 1) for f in trip for n in (10, 30, 100, 300, 1000))
+    assert [a.display for a in study.algorithms] == [a.display for a in single.algorithms]
+    assert {a.name for a in study.algorithms} == {"pymoo_rail.journeys.repaired:repaired_algorithm"}
+    # the same populations as the single table, each algorithm the repaired form of the same method
+    for repaired, plain in zip(study.algorithms, single.algorithms):
+        assert repaired.params == {"method": canonical_name(plain.name), **plain.params}
+    assert study.seeds == single.seeds and study.budget == single.budget
+    assert len(list(study.runs())) == 2 * 5 * 5 * 31

@@ -120,7 +120,7 @@ def test_code_parts_per_problem_kind():
     ("control/controllers.py", False, False), ("optimal/dp.py", False, False), ("cli/app.py", False, False),
     ("optimal/reference/store.py", False, False), ("optimal/reference/front.py", False, False),
     ("plotting/fronts.py", False, False), ("suite/coco_logger.py", False, False), ("cases/railjson.py", False, False),
-    ("journeys/allocation.py", False, True),
+    ("journeys/allocation.py", False, True), ("journeys/repaired.py", False, True),
     ("sim/kernel.py", True, True), ("constants.py", True, True), ("algorithms/moabc.py", True, True),
     ("experiments/penalty.py", True, True), ("problems/encodings/speed_codes.py", True, True),
     ("suite/families.py", True, True), ("indicators/spacing.py", True, True)])
@@ -135,6 +135,17 @@ def test_an_edit_outside_the_parts_keeps_the_digest_and_one_inside_changes_it(tm
         file.write("\nEDITED_IN_A_TEST = 1\n")
     after = digest(SUITE_RUN_PARTS), digest(TRIP_RUN_PARTS), digest()
     assert (after[0] != before[0], after[1] != before[1], after[2] != before[2]) == (suite_changes, trip_changes, True)
+
+
+def test_a_repaired_trip_run_is_fingerprinted_by_the_trip_parts_and_the_repair_module():
+    # benchmarks/suite_baseline_trip.toml names its algorithms by import path (pymoo_rail.journeys.repaired)
+    run = RunSpec(problem("suite_family", family="generated-metro-trip", n_var=10, seed=1),
+                  algorithm("pymoo_rail.journeys.repaired:repaired_algorithm", method="ga", pop_size=10), 1,
+                  Budget("n_eval", 20))
+    fingerprint = resolve_run(run).fingerprint
+    assert in_parts("journeys/repaired.py", TRIP_RUN_PARTS) and not in_parts("journeys/repaired.py", SUITE_RUN_PARTS)
+    assert fingerprint["pymoo-rail code"] == inputs_module.package_digest(TRIP_RUN_PARTS)
+    assert fingerprint["algorithm module pymoo_rail.journeys.repaired"].startswith("sha256:")
 
 
 def _suite_study() -> Study:
