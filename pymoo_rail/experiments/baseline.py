@@ -103,6 +103,8 @@ def indicator_set(n_obj: int) -> IndicatorSet:
 def frame_indicators(frame: pd.DataFrame) -> IndicatorSet:
     """The indicator set of an :func:`indicator_frame` (its ``n_obj``); raises ValueError for a mix of
     one-objective and multi-objective records, whose scores cannot share a table."""
+    if frame.empty:
+        raise ValueError("frame: no records, so no table")
     counts = sorted(int(n) for n in frame["n_obj"].unique())
     if len({n == 1 for n in counts}) != 1:
         raise ValueError(f"frame['n_obj'] = {counts}: one-objective and multi-objective records make separate tables")
@@ -192,6 +194,9 @@ def front_scorer(problem) -> FrontScorer:
     ref = problem.hv_reference_point()
     if problem.n_obj == 1:
         optimum, certificate = one_objective_optimum(problem)
+        if not ref[0] > optimum:
+            raise ValueError(f"{problem.suite_name}: hv_reference_point() = {ref.tolist()} is not above the "
+                             f"optimum {optimum!r} kWh, so no gap can be scaled by it")
         return FrontScorer(problem, np.array([[optimum]]), ref, float(ref[0] - optimum), certificate)
     pf = problem.pareto_front()
     # a bounded front (the -3obj families): HV over the outer bound's, so 1 is out of reach of any run
@@ -247,7 +252,7 @@ def front_versions(records: Iterable[dict]) -> pd.DataFrame:
     rows = []
     for problem in _instances(records).values():  # no scorer: the front's hypervolume is not needed here
         rows.append({"family": problem.family, "n_var": int(problem.n_var), "instance_seed": problem.seed,
-                     "front_version": getattr(problem, "front_version", EXACT_FRONT_VERSION),
+                     "front_version": EXACT_FRONT_VERSION if isinstance(problem, TripProblem) else problem.front_version,
                      "front_digest": front_digest(problem)})
     return pd.DataFrame(rows).sort_values(["family", "n_var", "instance_seed"]).reset_index(drop=True)
 
@@ -349,8 +354,11 @@ def rank_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
     without ranks (fewer than 2 paired seeds) stays NaN. Sorted by form, then by the mean rank at the
     largest ``n_var``.
     """
-    ranks = table.assign(form=table["family"].str.rsplit("-", n=1).str[-1])
-    out = ranks.pivot_table(index=["form", "algorithm"], columns="n_var", values="mean_rank", aggfunc="mean")
+    ranks = table.assign(form=table["family"].str.rsplit("-", n=1).str[-1],
+                         mean_rank=pd.to_numeric(table["mean_rank"], errors="coerce"))
+    # NaN unless every family of the form has ranks there: a mean over some families would mislead
+    out = ranks.pivot_table(index=["form", "algorithm"], columns="n_var", values="mean_rank", dropna=False,
+                            aggfunc=lambda r: r.mean() if r.notna().all() else np.nan)
     out.columns = [f"n_var {int(n)}" for n in out.columns]
     return out.sort_values(["form", out.columns[-1]]).round(2).reset_index()
 

@@ -200,7 +200,7 @@ def cpu_breakdown(name: str, running_time_s: float) -> dict:
     """CPU seconds of one profile (as timed by :func:`pymoo_rail_row`) per kernel of the exact solver.
 
     cProfile in ``time.process_time``: tables (``_count_targets`` + ``_fill_transitions``, default and
-    half grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
+    the certificate's check grid), backward sweeps, forward runs and the rest (search, replay, certificate bookkeeping).
     """
     from pymoo_rail.cases import load_case
     from pymoo_rail.optimal import OptimalSolver

@@ -152,7 +152,8 @@ def repaired_algorithm(method: str, **params: Any):
     if method not in REPAIRED_METHODS:
         raise ValueError(f"method: {method!r} is not one of {sorted(REPAIRED_METHODS)}")
     build, classes = REPAIRED_METHODS[method]
-    accepted = _keywords(classes) - {"repair"}
+    # the repair is this function's; ABC sets its bee colony's min_pop_size itself
+    accepted = _keywords(classes) - {"repair", "min_pop_size"}
     unknown = sorted(set(params) - accepted)
     if unknown:
         raise TypeError(f"{method}.{unknown[0]}: {params[unknown[0]]!r} is not a parameter of {classes[0].__name__} "

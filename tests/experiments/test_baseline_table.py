@@ -195,3 +195,21 @@ def test_rank_by_dimension_of_a_real_table(records):
     ranks = rank_by_dimension(table)
     merged = ranks.merge(table, on="algorithm")
     assert np.allclose(merged["n_var 10"], merged["mean_rank"])
+
+
+def test_rank_by_dimension_leaves_a_dimension_without_every_familys_ranks_empty():
+    table = pd.DataFrame({
+        "family": ["generated-metro-bi", "generated-suburban-bi", "generated-metro-bi", "generated-suburban-bi"],
+        "n_var": [10, 10, 300, 300],
+        "algorithm": ["A", "A", "A", "A"],
+        "mean_rank": [1.0, 2.0, 1.0, np.nan],  # suburban at 300: too few paired seeds
+    })
+    ranks = rank_by_dimension(table).set_index(["form", "algorithm"])
+    assert list(ranks.columns) == ["n_var 10", "n_var 300"]  # the column stays
+    assert ranks.loc[("bi", "A"), "n_var 10"] == pytest.approx(1.5)
+    assert np.isnan(ranks.loc[("bi", "A"), "n_var 300"])  # not metro's 1.0 alone
+
+
+def test_an_empty_frame_is_named():
+    with pytest.raises(ValueError, match="no records"):
+        baseline_table(pd.DataFrame(columns=["family", "n_var", "n_obj", "seed", "algorithm"]))

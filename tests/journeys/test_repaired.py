@@ -95,3 +95,8 @@ def test_bad_method_or_keyword_is_named():
     with pytest.raises(TypeError, match=r"ga.pop_sise: 50"):
         repaired_algorithm("ga", pop_sise=50)
     assert repaired_algorithm("de", pop_size=20, CR=0.5).pop_size == 20  # DE's variant keywords pass
+
+
+def test_a_keyword_the_algorithm_sets_itself_is_named():
+    with pytest.raises(TypeError, match="abc.min_pop_size"):
+        repaired_algorithm("abc", min_pop_size=2)
