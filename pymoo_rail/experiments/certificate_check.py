@@ -30,7 +30,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from pymoo_rail.constants import J_PER_KWH
+from pymoo_rail.experiments.exact_checks import energy_at
 from pymoo_rail.experiments.peers import GENERATED_FACTORS, comparable_case, mseetc_cached
 from pymoo_rail.optimal import OptimalSolver, min_running_time
 
@@ -101,9 +101,8 @@ def ours_row(seed: int, shift, case, t: float, ref_kwh: float) -> dict:
     solver = OptimalSolver(case)
     run = solver.profile(t)
     cpu_s = time.process_time() - start
-    moved_kwh = float(run.summary["lambda_w"]) * (run.running_time_s - t) / J_PER_KWH
-    energy_kwh = run.energy.net_kwh + moved_kwh
-    bound_kwh = float(run.summary["energy_bound_kwh"]) + abs(moved_kwh)
+    energy_kwh = energy_at(run, t)
+    bound_kwh = float(run.summary["energy_bound_kwh"]) + abs(energy_kwh - run.energy.net_kwh)
     return {"seed": seed, "factor": shift[0], "plus_s": shift[1], "share": shift[2], "time_s": round(t, 3),
             "n_speeds": int(run.summary["n_speeds"]), "energy_kwh": energy_kwh, "bound_kwh": bound_kwh,
             "mseetc_kwh": ref_kwh, "margin_kwh": bound_kwh - (energy_kwh - ref_kwh), "cpu_s": cpu_s} | solver.last_bound_parts
