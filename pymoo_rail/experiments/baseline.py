@@ -363,6 +363,26 @@ def rank_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
     return out.sort_values(["form", out.columns[-1]]).round(2).reset_index()
 
 
+def top_group_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
+    """Where each algorithm wins, per form and ``n_var``: ``"best / top"``, the number of families in
+    which it has the lowest mean rank (mark ``best``) and in which it is not significantly worse than
+    that best (mark ``best`` or ``=``, Holm-corrected), out of the form's families with ranks there.
+
+    ``table``: :func:`baseline_table`. One row per (form, algorithm), one column per ``n_var``; ``"-"``
+    where no family of the form has ranks at that ``n_var``. Sorted as :func:`rank_by_dimension`.
+    """
+    marks = table.assign(form=table["family"].str.rsplit("-", n=1).str[-1])
+    marks = marks[marks["mark"].isin(["best", "=", "-"])]  # "n/a": too few paired seeds to rank
+    counts = marks.assign(best=marks["mark"] == "best", top=marks["mark"].isin(["best", "="])).groupby(
+        ["form", "algorithm", "n_var"])[["best", "top"]].sum()
+    cells = (counts["best"].astype(str) + " / " + counts["top"].astype(str)).unstack("n_var")
+    cells.columns = [f"n_var {int(n)}" for n in cells.columns]
+    order = rank_by_dimension(table)[["form", "algorithm"]]
+    cells = cells.reindex(pd.MultiIndex.from_frame(order)).reindex(
+        columns=[c for c in rank_by_dimension(table).columns if c.startswith("n_var")])
+    return cells.fillna("-").reset_index()
+
+
 def report_values(study, full, frame: pd.DataFrame, records: Sequence[dict], pictures: Sequence[str],
                   command: str, study_file: str) -> dict[str, str]:
     """The values of a baseline report's template: what ran (``study``, cut from ``full``), its CPU,
@@ -379,6 +399,7 @@ def report_values(study, full, frame: pd.DataFrame, records: Sequence[dict], pic
             "indicators": ", ".join(frame_indicators(frame).lower_better),
             "table": to_markdown(table, bold_marker=None), "fronts": fronts_statement(front_versions(records)),
             "ranks": to_markdown(rank_by_dimension(table), bold_marker=None),
+            "top_group": to_markdown(top_group_by_dimension(table), bold_marker=None),
             "checkpoints_kb": checkpoints_kb(records), "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
 
 
@@ -453,5 +474,5 @@ __all__ = ["INDICATORS", "RANK_INDICATOR", "EXACT_RESOLUTION_PCT", "EXACT_FRONT_
            "MULTI_OBJECTIVE", "ONE_OBJECTIVE", "indicator_set", "frame_indicators", "one_objective_optimum",
            "instance_of", "FrontScorer", "front_scorer", "baseline_indicators",
            "indicator_frame", "front_versions", "fronts_statement", "checkpoints_kb", "baseline_table",
-           "performance_profile", "convergence", "report_values", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
+           "performance_profile", "convergence", "rank_by_dimension", "top_group_by_dimension", "report_values", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
            "archive_records"]

@@ -7,7 +7,8 @@ import pandas as pd
 import pytest
 
 from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, checkpoints_kb, convergence,
-                                             indicator_frame, instance_of, performance_profile, rank_by_dimension)
+                                             indicator_frame, instance_of, performance_profile, rank_by_dimension,
+                                             top_group_by_dimension)
 from pymoo_rail.experiments.runner import execute_run
 from pymoo_rail.experiments.spec import Budget, RunSpec, algorithm, problem
 from pymoo_rail.suite import get_problem
@@ -208,6 +209,30 @@ def test_rank_by_dimension_leaves_a_dimension_without_every_familys_ranks_empty(
     assert list(ranks.columns) == ["n_var 10", "n_var 300"]  # the column stays
     assert ranks.loc[("bi", "A"), "n_var 10"] == pytest.approx(1.5)
     assert np.isnan(ranks.loc[("bi", "A"), "n_var 300"])  # not metro's 1.0 alone
+
+
+def test_top_group_counts_the_families_an_algorithm_wins_or_ties():
+    table = pd.DataFrame({
+        "family": ["generated-metro-bi"] * 2 + ["generated-suburban-bi"] * 2 + ["generated-metro-bi"] * 2
+                  + ["generated-suburban-bi"] * 2,
+        "n_var": [10, 10, 10, 10, 300, 300, 300, 300],
+        "algorithm": ["A", "B"] * 4,
+        "mean_rank": [1.0, 2.0, 1.9, 1.1, 1.0, 2.0, np.nan, np.nan],
+        "mark": ["best", "-", "=", "best", "best", "=", "n/a", "n/a"],  # suburban at 300: too few seeds
+    })
+    top = top_group_by_dimension(table).set_index(["form", "algorithm"])
+    assert list(top.columns) == ["n_var 10", "n_var 300"]
+    assert top.loc[("bi", "A"), "n_var 10"] == "1 / 2"  # best on metro, tied with the best on suburban
+    assert top.loc[("bi", "B"), "n_var 10"] == "1 / 1"  # separated from the best on metro
+    assert top.loc[("bi", "B"), "n_var 300"] == "0 / 1"  # of metro alone: suburban has no ranks
+    assert list(top.index) == list(rank_by_dimension(table).set_index(["form", "algorithm"]).index)
+
+
+def test_top_group_of_a_real_table(records):
+    table = baseline_table(indicator_frame(records))
+    top = top_group_by_dimension(table).set_index("algorithm")["n_var 10"]
+    best = table.loc[table["mark"] == "best", "algorithm"].item()
+    assert top[best].startswith("1 / ")
 
 
 def test_an_empty_frame_is_named():
