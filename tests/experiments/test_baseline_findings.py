@@ -18,17 +18,22 @@ SEEDS = (1, 2, 3)
 FLIP_SEEDS = (1, 2, 3, 4, 5)
 
 
-@pytest.fixture(scope="module")
-def moabc_and_random():
-    """IGD+ at every checkpoint of MOABC and random search on the metro line at n_var 10 and 300."""
+def runs_on_the_metro_line(names, seeds, n_eval: int, **params) -> list[dict]:
+    """Records of each algorithm of ``names`` (built with ``params``) on the metro line at n_var 10 and 300."""
     records = []
     for n_var in (10, 300):
         spec = problem("suite_family", family=FAMILY, n_var=n_var, seed=1)
-        for seed in SEEDS:
-            for name in ("moabc", "random"):
-                record = execute_run(RunSpec(spec, algorithm(name), seed, Budget("n_eval", 2000)))
+        for seed in seeds:
+            for name in names:
+                record = execute_run(RunSpec(spec, algorithm(name, **params), seed, Budget("n_eval", n_eval)))
                 records.append({**record, "algorithm_label": name})
-    return convergence(records)
+    return records
+
+
+@pytest.fixture(scope="module")
+def moabc_and_random():
+    """IGD+ at every checkpoint of MOABC and random search on the metro line at n_var 10 and 300."""
+    return convergence(runs_on_the_metro_line(("moabc", "random"), SEEDS, 2000))
 
 
 def igd_plus(frame, n_var, name, n_eval):
@@ -59,14 +64,7 @@ def test_moabc_stalls_with_the_dimension(moabc_and_random):
 @pytest.fixture(scope="module")
 def sms_emoa_and_golden_ratio():
     """Final IGD+ of SMS-EMOA and GR-NSGA-II on the metro line at n_var 10 and 300, at the table's budget."""
-    records = []
-    for n_var in (10, 300):
-        spec = problem("suite_family", family=FAMILY, n_var=n_var, seed=1)
-        for seed in FLIP_SEEDS:
-            for name in ("sms-emoa", "grnsga2"):
-                record = execute_run(RunSpec(spec, algorithm(name, pop_size=100), seed, Budget("n_eval", 10_000)))
-                records.append({**record, "algorithm_label": name})
-    frame = convergence(records)
+    frame = convergence(runs_on_the_metro_line(("sms-emoa", "grnsga2"), FLIP_SEEDS, 10_000, pop_size=100))
     return frame.sort_values("n_eval").groupby(["n_var", "algorithm", "seed"]).tail(1)
 
 
