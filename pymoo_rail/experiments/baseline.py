@@ -377,9 +377,9 @@ def top_group_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
         ["form", "algorithm", "n_var"])[["best", "top"]].sum()
     cells = (counts["best"].astype(str) + " / " + counts["top"].astype(str)).unstack("n_var")
     cells.columns = [f"n_var {int(n)}" for n in cells.columns]
-    order = rank_by_dimension(table)[["form", "algorithm"]]
-    cells = cells.reindex(pd.MultiIndex.from_frame(order)).reindex(
-        columns=[c for c in rank_by_dimension(table).columns if c.startswith("n_var")])
+    ranks = rank_by_dimension(table)  # its rows and columns, so the two tables line up
+    cells = cells.reindex(pd.MultiIndex.from_frame(ranks[["form", "algorithm"]])).reindex(
+        columns=[c for c in ranks.columns if c.startswith("n_var")])
     return cells.fillna("-").reset_index()
 
 
