@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import tarfile
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -460,14 +461,24 @@ def projected_cpu_h(frame: pd.DataFrame, full, per_family: bool = False) -> tupl
 def archive_records(work: str | Path, path: str | Path, top: str = "suite_baseline") -> str:
     """Pack the study file and every record of the study folder ``work`` into ``path`` (.tar.gz, under ``top``/).
 
-    Returns the archive's SHA-256 (hex).
+    The archive is written beside ``path`` and moved there when complete, so an interrupted call leaves
+    no partial archive under that name. Returns the archive's SHA-256 (hex).
     """
     work, path = Path(work), Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with tarfile.open(path, "w:gz") as tar:
-        for member in sorted(p for p in work.rglob("*") if p.is_file() and p.suffix in (".json", ".toml")):
-            tar.add(member, arcname=str(Path(top) / member.relative_to(work)))
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    partial = path.with_name(path.name + ".partial")
+    digest = hashlib.sha256()
+    try:
+        with tarfile.open(partial, "w:gz") as tar:
+            for member in sorted(p for p in work.rglob("*") if p.is_file() and p.suffix in (".json", ".toml")):
+                tar.add(member, arcname=str(Path(top) / member.relative_to(work)))
+        with partial.open("rb") as packed:  # in chunks: a whole table's archive is gigabytes
+            for chunk in iter(lambda: packed.read(1 << 20), b""):
+                digest.update(chunk)
+        os.replace(partial, path)
+    finally:
+        partial.unlink(missing_ok=True)
+    return digest.hexdigest()
 
 
 __all__ = ["INDICATORS", "RANK_INDICATOR", "EXACT_RESOLUTION_PCT", "EXACT_FRONT_VERSION", "IndicatorSet",
