@@ -41,10 +41,25 @@ def moabc_and_random():
     return convergence(runs_on_the_metro_line(("moabc", "random"), SEEDS, 2000))
 
 
+def per_seed(frame, column: str, seeds, **where) -> np.ndarray:
+    """``column`` of the rows of ``frame`` matching ``where`` (column = value), one per seed of ``seeds``, in seed order."""
+    rows = frame
+    for key, value in where.items():
+        rows = rows[rows[key] == value]
+    rows = rows.sort_values("seed")
+    assert list(rows["seed"]) == list(seeds), where
+    return rows[column].to_numpy()
+
+
+def assert_order_flips(frame, column: str, seeds, ahead_at_10: str, ahead_at_300: str) -> None:
+    """On every seed, ``ahead_at_10`` has the lower final ``column`` at n_var 10, ``ahead_at_300`` at 300."""
+    for n_var, (better, worse) in ((10, (ahead_at_10, ahead_at_300)), (300, (ahead_at_300, ahead_at_10))):
+        low, high = (per_seed(frame, column, seeds, n_var=n_var, algorithm=name) for name in (better, worse))
+        assert np.all(low < high), (n_var, better, low, worse, high)
+
+
 def igd_plus(frame, n_var, name, n_eval):
-    rows = frame[(frame["n_var"] == n_var) & (frame["algorithm"] == name) & (frame["n_eval"] == n_eval)]
-    assert sorted(rows["seed"]) == list(SEEDS)
-    return rows.sort_values("seed")["igd_plus"].to_numpy()
+    return per_seed(frame, "igd_plus", SEEDS, n_var=n_var, algorithm=name, n_eval=n_eval)
 
 
 def test_moabc_trails_random_search_at_300_variables(moabc_and_random):
@@ -77,14 +92,7 @@ def test_ranking_flips_with_the_dimension(sms_emoa_and_golden_ratio):
     """The table's bi-objective ranking turns over between n_var 10 and 300: SMS-EMOA's hypervolume
     selection is the best at 10 variables, GR-NSGA-II's at 300, on every seed (the table's settings:
     population 100, 10,000 evaluations; about 30 s of CPU)."""
-    def final(n_var, name):
-        rows = sms_emoa_and_golden_ratio
-        rows = rows[(rows["n_var"] == n_var) & (rows["algorithm"] == name)].sort_values("seed")
-        assert list(rows["seed"]) == list(FLIP_SEEDS)
-        return rows["igd_plus"].to_numpy()
-
-    assert np.all(final(10, "sms-emoa") < final(10, "grnsga2")), (final(10, "sms-emoa"), final(10, "grnsga2"))
-    assert np.all(final(300, "grnsga2") < final(300, "sms-emoa")), (final(300, "grnsga2"), final(300, "sms-emoa"))
+    assert_order_flips(sms_emoa_and_golden_ratio, "igd_plus", FLIP_SEEDS, "sms-emoa", "grnsga2")
 
 
 @pytest.fixture(scope="module")
@@ -99,14 +107,7 @@ def test_abc_falls_behind_random_search_with_the_dimension(abc_and_random_on_one
     """The one-objective table: ABC beats random search on 31 of 31 seeds at n_var 10 in every
     ``-single`` family and loses to it on 23-30 of 31 at n_var 300 (26 on the metro line): its
     neighbour move changes one variable per evaluation."""
-    def gap(n_var, name):
-        rows = abc_and_random_on_one_objective
-        rows = rows[(rows["n_var"] == n_var) & (rows["algorithm"] == name)].sort_values("seed")
-        assert list(rows["seed"]) == list(SEEDS)
-        return rows["gap_kwh"].to_numpy()
-
-    assert np.all(gap(10, "abc") < gap(10, "random")), (gap(10, "abc"), gap(10, "random"))
-    assert np.all(gap(300, "random") < gap(300, "abc")), (gap(300, "random"), gap(300, "abc"))
+    assert_order_flips(abc_and_random_on_one_objective, "gap_kwh", SEEDS, "abc", "random")
 
 
 @pytest.fixture(scope="module")
@@ -123,10 +124,7 @@ def test_the_one_objective_leader_changes_with_the_budget(pso_and_ga_at_1000_var
     on 29 of 31 seeds, behind it at 2,000 on 29 (PSO has the lowest median gap in 20 of 20 cells at
     200 evaluations, in 5 at 2,000)."""
     def gap(name, n_eval):
-        rows = pso_and_ga_at_1000_variables
-        rows = rows[(rows["algorithm"] == name) & (rows["n_eval"] == n_eval)].sort_values("seed")
-        assert list(rows["seed"]) == list(SEEDS)
-        return rows["gap_kwh"].to_numpy()
+        return per_seed(pso_and_ga_at_1000_variables, "gap_kwh", SEEDS, algorithm=name, n_eval=n_eval)
 
     assert np.all(gap("pso", 500) < gap("ga", 500)), (gap("pso", 500), gap("ga", 500))
     assert np.all(gap("ga", 2000) < gap("pso", 2000)), (gap("ga", 2000), gap("pso", 2000))
