@@ -331,19 +331,24 @@ def convergence(records: Iterable[dict]) -> pd.DataFrame:
     One row per record and checkpoint (``checkpoints`` of a suite run: the non-dominated feasible
     objective vectors at the first generation past each of
     :data:`~pymoo_rail.experiments.runner.CHECKPOINTS_EVAL` evaluations), and one for its final front
-    at its ``n_eval``: family, n_var, algorithm, seed, n_eval and the record's scores
-    (:attr:`FrontScorer.indicators`; for one objective the best feasible energy found so far).
+    at its ``n_eval``: family, n_var, algorithm, seed, n_eval, ``target_n_eval`` and the record's
+    scores (:attr:`FrontScorer.indicators`; for one objective the best feasible energy found so far).
+    ``target_n_eval`` is the checkpoint a row stands for (the final row's: the budget's evaluations),
+    so runs whose generations end at other evaluation counts share a row of the figure.
     """
     records = list(records)
     scorers, rows = _scorers(records), []
     for record in records:
         scorer = scorers[tuple(sorted(record["problem"].items()))]
-        checkpoints = record.get("checkpoints") or {"n_eval": [], "F": []}
+        checkpoints = record.get("checkpoints") or {"target_n_eval": [], "n_eval": [], "F": []}
         cell = {"family": scorer.problem.family, "n_var": int(scorer.problem.n_var),
                 "algorithm": record["algorithm_label"], "seed": int(record["seed"])}
-        rows += [{**cell, "n_eval": int(n_eval), **scorer.score(F)}
-                 for n_eval, F in zip(checkpoints["n_eval"], checkpoints["F"]) if n_eval < record["n_eval"]]
-        rows.append({**cell, "n_eval": int(record["n_eval"]), **baseline_indicators(record, scorer=scorer)})
+        rows += [{**cell, "n_eval": int(n_eval), "target_n_eval": int(target), **scorer.score(F)}
+                 for target, n_eval, F in zip(checkpoints["target_n_eval"], checkpoints["n_eval"], checkpoints["F"])
+                 if n_eval < record["n_eval"]]
+        budget = int((record.get("budget") or {}).get("n_eval", record["n_eval"]))
+        rows.append({**cell, "n_eval": int(record["n_eval"]), "target_n_eval": budget,
+                     **baseline_indicators(record, scorer=scorer)})
     return pd.DataFrame(rows)
 
 

@@ -10,14 +10,17 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
     """Median ``indicator`` vs evaluations, one panel per (family, n_var), one line per algorithm.
 
     ``history``: ``pymoo_rail.experiments.baseline.convergence`` (columns family, n_var, algorithm,
-    n_eval and the indicator: each run's checkpoints scored against the current front). The panels
-    form a grid, a row per family and a column per ``n_var`` (a cell not in ``history`` is left
-    blank), with one legend for the figure. Returns the matplotlib ``Figure``.
+    n_eval and the indicator: each run's checkpoints scored against the current front). The median
+    is over the runs at each ``target_n_eval`` (the checkpoint a row stands for) where ``history``
+    has it, else at each ``n_eval``. The panels form a grid, a row per family and a column per
+    ``n_var`` (a cell not in ``history`` is left blank), with one legend for the figure. Returns the
+    matplotlib ``Figure``.
     """
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import NullFormatter
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
     families, ladder = sorted(history["family"].unique()), sorted(history["n_var"].unique())
+    x = "target_n_eval" if "target_n_eval" in history else "n_eval"  # runs' generations end at other counts
     fig, axes = plt.subplots(len(families), len(ladder), figsize=(3.2 * len(ladder), 2.6 * len(families) + 0.6),
                              squeeze=False)
     for row, family in zip(axes, families):
@@ -27,12 +30,12 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
                 ax.set_axis_off()
                 continue
             for name, runs in cell.groupby("algorithm"):
-                median = runs.groupby("n_eval")[indicator].median()
+                median = runs.groupby(x)[indicator].median()
                 ax.plot(median.index, median.to_numpy(), label=name)
             scored = np.isfinite(cell[indicator]).any()  # a cell without a feasible run has nothing to plot on a log axis
-            ax.set_xscale("log")  # the checkpoints are a log ladder, labelled as they are
-            checkpoints = sorted(cell["n_eval"].unique())
-            ax.set_xticks(checkpoints, labels=[f"{int(e):,}" for e in checkpoints])
+            ax.set_xscale("log")  # the checkpoints are a log ladder: 1-2-5 ticks, written out
+            ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:,.0f}"))
             ax.xaxis.set_minor_formatter(NullFormatter())
             ax.set_yscale("log" if scored else "linear")
             ax.set_title(f"{family}, n_var={n_var}", fontsize=8)

@@ -127,6 +127,10 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
     assert width < 2 * height  # a row per family, a column per n_var: not one strip of panels
     assert [t.get_text() for t in fig.legends[0].get_texts()] == ["A", "B"]
     fig.canvas.draw()
+    # generations end past their checkpoint at counts of their own (seed 2 here): one point per checkpoint
+    jittered = history.assign(target_n_eval=history["n_eval"], n_eval=history["n_eval"] + 7 * (history["seed"] - 1))
+    fig = plot_cell_convergence(jittered)
+    assert all(list(line.get_xdata()) == [100, 200] for ax in fig.axes for line in ax.get_lines())
     ragged = plot_cell_convergence(history[(history["family"] == "x-bi") | (history["n_var"] == 10)])
     assert [ax.axison for ax in ragged.axes] == [True, True, True, False]  # y-bi has no n_var 30: a blank panel
     infeasible = history.assign(igd_plus=np.where(history["family"] == "x-bi", np.nan, history["igd_plus"]))
