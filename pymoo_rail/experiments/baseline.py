@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import tarfile
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -330,19 +331,24 @@ def convergence(records: Iterable[dict]) -> pd.DataFrame:
     One row per record and checkpoint (``checkpoints`` of a suite run: the non-dominated feasible
     objective vectors at the first generation past each of
     :data:`~pymoo_rail.experiments.runner.CHECKPOINTS_EVAL` evaluations), and one for its final front
-    at its ``n_eval``: family, n_var, algorithm, seed, n_eval and the record's scores
-    (:attr:`FrontScorer.indicators`; for one objective the best feasible energy found so far).
+    at its ``n_eval``: family, n_var, algorithm, seed, n_eval, ``target_n_eval`` and the record's
+    scores (:attr:`FrontScorer.indicators`; for one objective the best feasible energy found so far).
+    ``target_n_eval`` is the checkpoint a row stands for (the final row's: the budget's evaluations),
+    so runs whose generations end at other evaluation counts share a row of the figure.
     """
     records = list(records)
     scorers, rows = _scorers(records), []
     for record in records:
         scorer = scorers[tuple(sorted(record["problem"].items()))]
-        checkpoints = record.get("checkpoints") or {"n_eval": [], "F": []}
+        checkpoints = record.get("checkpoints") or {"target_n_eval": [], "n_eval": [], "F": []}
         cell = {"family": scorer.problem.family, "n_var": int(scorer.problem.n_var),
                 "algorithm": record["algorithm_label"], "seed": int(record["seed"])}
-        rows += [{**cell, "n_eval": int(n_eval), **scorer.score(F)}
-                 for n_eval, F in zip(checkpoints["n_eval"], checkpoints["F"]) if n_eval < record["n_eval"]]
-        rows.append({**cell, "n_eval": int(record["n_eval"]), **baseline_indicators(record, scorer=scorer)})
+        rows += [{**cell, "n_eval": int(n_eval), "target_n_eval": int(target), **scorer.score(F)}
+                 for target, n_eval, F in zip(checkpoints["target_n_eval"], checkpoints["n_eval"], checkpoints["F"])
+                 if n_eval < record["n_eval"]]
+        budget = int((record.get("budget") or {}).get("n_eval", record["n_eval"]))
+        rows.append({**cell, "n_eval": int(record["n_eval"]), "target_n_eval": budget,
+                     **baseline_indicators(record, scorer=scorer)})
     return pd.DataFrame(rows)
 
 
@@ -460,14 +466,24 @@ def projected_cpu_h(frame: pd.DataFrame, full, per_family: bool = False) -> tupl
 def archive_records(work: str | Path, path: str | Path, top: str = "suite_baseline") -> str:
     """Pack the study file and every record of the study folder ``work`` into ``path`` (.tar.gz, under ``top``/).
 
-    Returns the archive's SHA-256 (hex).
+    The archive is written beside ``path`` and moved there when complete, so an interrupted call leaves
+    no partial archive under that name. Returns the archive's SHA-256 (hex).
     """
     work, path = Path(work), Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with tarfile.open(path, "w:gz") as tar:
-        for member in sorted(p for p in work.rglob("*") if p.is_file() and p.suffix in (".json", ".toml")):
-            tar.add(member, arcname=str(Path(top) / member.relative_to(work)))
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    partial = path.with_name(path.name + ".partial")
+    digest = hashlib.sha256()
+    try:
+        with tarfile.open(partial, "w:gz") as tar:
+            for member in sorted(p for p in work.rglob("*") if p.is_file() and p.suffix in (".json", ".toml")):
+                tar.add(member, arcname=str(Path(top) / member.relative_to(work)))
+        with partial.open("rb") as packed:  # in chunks: a whole table's archive is gigabytes
+            for chunk in iter(lambda: packed.read(1 << 20), b""):
+                digest.update(chunk)
+        os.replace(partial, path)
+    finally:
+        partial.unlink(missing_ok=True)
+    return digest.hexdigest()
 
 
 __all__ = ["INDICATORS", "RANK_INDICATOR", "EXACT_RESOLUTION_PCT", "EXACT_FRONT_VERSION", "IndicatorSet",

@@ -10,25 +10,46 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
     """Median ``indicator`` vs evaluations, one panel per (family, n_var), one line per algorithm.
 
     ``history``: ``pymoo_rail.experiments.baseline.convergence`` (columns family, n_var, algorithm,
-    n_eval and the indicator: each run's checkpoints scored against the current front). Returns the
+    n_eval and the indicator: each run's checkpoints scored against the current front). The median
+    is over the runs at each ``target_n_eval`` (the checkpoint a row stands for) where ``history``
+    has it, else at each ``n_eval``. The panels form a grid, a row per family and a column per
+    ``n_var`` (a cell not in ``history`` is left blank), with one legend for the figure. Returns the
     matplotlib ``Figure``.
     """
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-    cells = sorted(set(zip(history["family"], history["n_var"])))
-    fig, axes = plt.subplots(1, len(cells), figsize=(4 * len(cells), 3.2), squeeze=False)
-    for ax, (family, n_var) in zip(axes[0], cells):
-        cell = history[(history["family"] == family) & (history["n_var"] == n_var)]
-        for name, runs in cell.groupby("algorithm"):
-            median = runs.groupby("n_eval")[indicator].median()
-            ax.plot(median.index, median.to_numpy(), label=name)
-        scored = np.isfinite(cell[indicator]).any()  # a cell without a feasible run has nothing to plot on a log axis
-        ax.set(title=f"{family} n_var={n_var}", xlabel="evaluations", ylabel=f"median {indicator}", xscale="log",
-               yscale="log" if scored else "linear")  # the checkpoints are a log ladder
-        if not scored:
-            ax.text(0.5, 0.5, "no feasible run", transform=ax.transAxes, ha="center")
-    axes[0][0].legend(fontsize=7)
-    fig.tight_layout()
+    families, ladder = sorted(history["family"].unique()), sorted(history["n_var"].unique())
+    x = "target_n_eval" if "target_n_eval" in history else "n_eval"  # runs' generations end at other counts
+    fig, axes = plt.subplots(len(families), len(ladder), figsize=(3.2 * len(ladder), 2.6 * len(families) + 0.6),
+                             squeeze=False)
+    for row, family in zip(axes, families):
+        for ax, n_var in zip(row, ladder):
+            cell = history[(history["family"] == family) & (history["n_var"] == n_var)]
+            if cell.empty:
+                ax.set_axis_off()
+                continue
+            for name, runs in cell.groupby("algorithm"):
+                median = runs.groupby(x)[indicator].median()
+                ax.plot(median.index, median.to_numpy(), label=name)
+            scored = np.isfinite(cell[indicator]).any()  # a cell without a feasible run has nothing to plot on a log axis
+            ax.set_xscale("log")  # the checkpoints are a log ladder: 1-2-5 ticks, written out
+            ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:,.0f}"))
+            ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.set_yscale("log" if scored else "linear")
+            ax.set_title(f"{family}, n_var={n_var}", fontsize=8)
+            ax.tick_params(which="both", labelsize=7)
+            if not scored:
+                ax.text(0.5, 0.5, "no feasible run", transform=ax.transAxes, ha="center")
+        row[0].set_ylabel(f"median {indicator}", fontsize=8)
+    for ax in axes[-1]:
+        ax.set_xlabel("evaluations", fontsize=8)
+    drawn = [ax for ax in axes.flat if ax.get_lines()]
+    if drawn:
+        handles, labels = drawn[0].get_legend_handles_labels()
+        fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.6 / fig.get_figheight(), 1, 1))  # room for the legend below the grid
     return fig
 
 

@@ -60,6 +60,28 @@ def test_the_archive_holds_the_records_and_its_checksum_is_the_files(tmp_path):
         assert sorted(tar.getnames()) == ["suite_baseline/runs/a.json", "suite_baseline/study.toml"]
 
 
+def test_an_interrupted_archive_leaves_no_file_under_its_name(tmp_path, monkeypatch):
+    from pymoo_rail.experiments.baseline import archive_records
+
+    work = tmp_path / "work"
+    (work / "runs").mkdir(parents=True)
+    for name in ("a", "b"):
+        (work / "runs" / f"{name}.json").write_text('{"x": 1}')
+    added = []
+
+    def add_then_stop(tar, name, arcname=None, **kwargs):  # the user's Ctrl-C after the first record
+        if added:
+            raise KeyboardInterrupt
+        added.append(arcname)
+        return original(tar, name, arcname=arcname, **kwargs)
+
+    original = tarfile.TarFile.add
+    monkeypatch.setattr(tarfile.TarFile, "add", add_then_stop)
+    with pytest.raises(KeyboardInterrupt):
+        archive_records(work, tmp_path / "records.tar.gz")
+    assert added and sorted(p.name for p in tmp_path.iterdir()) == ["work"]
+
+
 def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
     import pandas as pd
 
@@ -100,7 +122,17 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
                             for e in (100, 200)])
     fig = plot_cell_convergence(history)
     assert len(fig.axes) == 4 and all(len(ax.get_lines()) == 2 for ax in fig.axes)
+    assert [ax.get_title() for ax in fig.axes] == ["x-bi, n_var=10", "x-bi, n_var=30", "y-bi, n_var=10", "y-bi, n_var=30"]
+    width, height = fig.get_size_inches()
+    assert width < 2 * height  # a row per family, a column per n_var: not one strip of panels
+    assert [t.get_text() for t in fig.legends[0].get_texts()] == ["A", "B"]
     fig.canvas.draw()
+    # generations end past their checkpoint at counts of their own (seed 2 here): one point per checkpoint
+    jittered = history.assign(target_n_eval=history["n_eval"], n_eval=history["n_eval"] + 7 * (history["seed"] - 1))
+    fig = plot_cell_convergence(jittered)
+    assert all(list(line.get_xdata()) == [100, 200] for ax in fig.axes for line in ax.get_lines())
+    ragged = plot_cell_convergence(history[(history["family"] == "x-bi") | (history["n_var"] == 10)])
+    assert [ax.axison for ax in ragged.axes] == [True, True, True, False]  # y-bi has no n_var 30: a blank panel
     infeasible = history.assign(igd_plus=np.where(history["family"] == "x-bi", np.nan, history["igd_plus"]))
     fig = plot_cell_convergence(infeasible)  # a cell without a feasible run: drawn, not a log-scale error
     fig.canvas.draw()

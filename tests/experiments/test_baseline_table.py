@@ -93,6 +93,7 @@ def test_convergence_scores_each_checkpoint_and_the_final_front(records):
     assert longer["checkpoints"]["n_eval"] == [200, 500, 1000]
     history = convergence([{**longer, "algorithm_label": "nsga2"}])
     assert history["n_eval"].tolist() == [200, 500, 1000, 1200]
+    assert history["target_n_eval"].tolist() == [200, 500, 1000, 1200]  # the final row stands for the budget
     final = baseline_indicators(longer)
     assert history.iloc[-1]["igd_plus"] == final["igd_plus"]
     # elitist NSGA-II: its front at 1000 evaluations is no worse than at 200 (it keeps its non-dominated members)
