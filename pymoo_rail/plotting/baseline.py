@@ -13,14 +13,16 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
     n_eval and the indicator: each run's checkpoints scored against the current front). The median
     is over the runs at each ``target_n_eval`` (the checkpoint a row stands for) where ``history``
     has it, else at each ``n_eval``. The panels form a grid, a row per family and a column per
-    ``n_var`` (a cell not in ``history`` is left blank), with one legend for the figure. Returns the
-    matplotlib ``Figure``.
+    ``n_var`` (a cell not in ``history`` is left blank), with one colour per algorithm in every panel
+    and one legend for the figure. Returns the matplotlib ``Figure``.
     """
     import matplotlib.pyplot as plt
     from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
     families, ladder = sorted(history["family"].unique()), sorted(history["n_var"].unique())
     x = "target_n_eval" if "target_n_eval" in history else "n_eval"  # runs' generations end at other counts
+    cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = {name: cycle[i % len(cycle)] for i, name in enumerate(sorted(history["algorithm"].unique()))}
     fig, axes = plt.subplots(len(families), len(ladder), figsize=(3.2 * len(ladder), 2.6 * len(families) + 0.6),
                              squeeze=False)
     for row, family in zip(axes, families):
@@ -31,7 +33,7 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
                 continue
             for name, runs in cell.groupby("algorithm"):
                 median = runs.groupby(x)[indicator].median()
-                ax.plot(median.index, median.to_numpy(), label=name)
+                ax.plot(median.index, median.to_numpy(), color=colours[name], label=name)
             scored = np.isfinite(cell[indicator]).any()  # a cell without a feasible run has nothing to plot on a log axis
             ax.set_xscale("log")  # the checkpoints are a log ladder: 1-2-5 ticks, written out
             ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
@@ -45,10 +47,9 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
         row[0].set_ylabel(f"median {indicator}", fontsize=8)
     for ax in axes[-1]:
         ax.set_xlabel("evaluations", fontsize=8)
-    drawn = [ax for ax in axes.flat if ax.get_lines()]
-    if drawn:
-        handles, labels = drawn[0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
+    # every algorithm, though a panel may lack one (a cell it did not run)
+    handles = [plt.Line2D([], [], color=colour, label=name) for name, colour in colours.items()]
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
     fig.tight_layout(rect=(0, 0.6 / fig.get_figheight(), 1, 1))  # room for the legend below the grid
     return fig
 

@@ -80,6 +80,13 @@ def test_an_interrupted_archive_leaves_no_file_under_its_name(tmp_path, monkeypa
     with pytest.raises(KeyboardInterrupt):
         archive_records(work, tmp_path / "records.tar.gz")
     assert added and sorted(p.name for p in tmp_path.iterdir()) == ["work"]
+    earlier = tmp_path / "earlier.tar.gz"  # a complete archive of an earlier call stays as it was
+    earlier.write_bytes(b"an earlier archive")
+    added.clear()
+    with pytest.raises(KeyboardInterrupt):
+        archive_records(work, earlier)
+    assert earlier.read_bytes() == b"an earlier archive"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["earlier.tar.gz", "work"]
 
 
 def test_the_projection_interpolates_cpu_per_evaluation_over_n_var():
@@ -133,6 +140,11 @@ def test_the_figures_have_a_panel_per_cell_and_a_line_per_algorithm():
     assert all(list(line.get_xdata()) == [100, 200] for ax in fig.axes for line in ax.get_lines())
     ragged = plot_cell_convergence(history[(history["family"] == "x-bi") | (history["n_var"] == 10)])
     assert [ax.axison for ax in ragged.axes] == [True, True, True, False]  # y-bi has no n_var 30: a blank panel
+    # a cell without algorithm A: B keeps its colour, and the legend still names A
+    fig = plot_cell_convergence(history[(history["family"] == "x-bi") | (history["algorithm"] == "B")])
+    colours_of_b = {line.get_color() for ax in fig.axes for line in ax.get_lines() if line.get_label() == "B"}
+    assert len(colours_of_b) == 1, colours_of_b
+    assert [t.get_text() for t in fig.legends[0].get_texts()] == ["A", "B"]
     infeasible = history.assign(igd_plus=np.where(history["family"] == "x-bi", np.nan, history["igd_plus"]))
     fig = plot_cell_convergence(infeasible)  # a cell without a feasible run: drawn, not a log-scale error
     fig.canvas.draw()

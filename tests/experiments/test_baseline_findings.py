@@ -59,7 +59,7 @@ def assert_order_flips(frame, column: str, seeds, ahead_at_10: str, ahead_at_300
 
 
 def igd_plus(frame, n_var, name, n_eval):
-    return per_seed(frame, "igd_plus", SEEDS, n_var=n_var, algorithm=name, n_eval=n_eval)
+    return per_seed(frame, "igd_plus", SEEDS, n_var=n_var, algorithm=name, target_n_eval=n_eval)
 
 
 def test_moabc_trails_random_search_at_300_variables(moabc_and_random):
@@ -124,7 +124,7 @@ def test_the_one_objective_leader_changes_with_the_budget(pso_and_ga_at_1000_var
     on 29 of 31 seeds, behind it at 2,000 on 29 (PSO has the lowest median gap in 20 of 20 cells at
     200 evaluations, in 5 at 2,000)."""
     def gap(name, n_eval):
-        return per_seed(pso_and_ga_at_1000_variables, "gap_kwh", SEEDS, algorithm=name, n_eval=n_eval)
+        return per_seed(pso_and_ga_at_1000_variables, "gap_kwh", SEEDS, algorithm=name, target_n_eval=n_eval)
 
     assert np.all(gap("pso", 500) < gap("ga", 500)), (gap("pso", 500), gap("ga", 500))
     assert np.all(gap("ga", 2000) < gap("pso", 2000)), (gap("ga", 2000), gap("pso", 2000))

@@ -88,11 +88,11 @@ def test_a_suite_record_holds_raw_vectors_and_nothing_scored_against_the_front(r
 
 def test_convergence_scores_each_checkpoint_and_the_final_front(records):
     spec = problem("suite_family", family=FAMILY, n_var=10, seed=1)
-    longer = execute_run(RunSpec(spec, algorithm("nsga2", pop_size=50), 1, Budget("n_eval", 1200)))
+    longer = execute_run(RunSpec(spec, algorithm("nsga2", pop_size=70), 1, Budget("n_eval", 1200)))
     assert longer["checkpoints"]["target_n_eval"] == [200, 500, 1000]
-    assert longer["checkpoints"]["n_eval"] == [200, 500, 1000]
+    assert longer["checkpoints"]["n_eval"] == [210, 560, 1050]  # the first generation past each checkpoint
     history = convergence([{**longer, "algorithm_label": "nsga2"}])
-    assert history["n_eval"].tolist() == [200, 500, 1000, 1200]
+    assert history["n_eval"].tolist() == [210, 560, 1050, 1260]
     assert history["target_n_eval"].tolist() == [200, 500, 1000, 1200]  # the final row stands for the budget
     final = baseline_indicators(longer)
     assert history.iloc[-1]["igd_plus"] == final["igd_plus"]
