@@ -52,13 +52,13 @@ STUDIES = {"table": "suite_baseline", "single": "suite_baseline_single", "trip":
 """``--study``: the name of its study file (benchmarks/), template (benchmarks/templates/) and report."""
 
 
-def figures(records, frame, out: Path, name: str) -> list[str]:
+def figures(history, frame, out: Path, name: str) -> list[str]:
     """Median of the profile indicator (IGD+; the gap for one objective) vs evaluations per (family, n_var),
-    the records' checkpoints scored now, and the performance profile on it (PNG files)."""
+    from the records' checkpoints scored now (``history``), and the performance profile on it (PNG files)."""
     import matplotlib.pyplot as plt
 
     scores = frame_indicators(frame)
-    plot_cell_convergence(convergence(records), scores.profile).savefig(out / f"{name}_convergence.png", dpi=110)
+    plot_cell_convergence(history, scores.profile).savefig(out / f"{name}_convergence.png", dpi=110)
     plot_performance_profile(performance_profile(frame), scores.label).savefig(out / f"{name}_profile.png", dpi=110)
     plt.close("all")
     return [f"{name}_convergence.png", f"{name}_profile.png"]
@@ -124,8 +124,9 @@ def main(argv=None) -> int:
     frame, out = indicator_frame(records), Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     command = "python benchmarks/suite_baseline.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    values = report_values(study, full, frame, records, figures(records, frame, out, name), command.strip(),
-                           f"benchmarks/{name}.toml")
+    history = convergence(records)
+    values = report_values(study, full, frame, records, figures(history, frame, out, name), command.strip(),
+                           f"benchmarks/{name}.toml", history)
     write_filled(out / f"{name}.md", ROOT / "benchmarks" / "templates" / f"{name}.md", values)
     print(f"wrote {out / f'{name}.md'}")
     if args.estimate:

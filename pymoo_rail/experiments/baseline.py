@@ -389,10 +389,33 @@ def top_group_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
     return cells.fillna("-").reset_index()
 
 
+def leaders_by_checkpoint(history: pd.DataFrame, indicator: str) -> pd.DataFrame:
+    """Who leads along the run: per form and checkpoint, in how many (family, n_var) cells each
+    algorithm has the lowest median ``indicator`` over its seeds (tied algorithms each count).
+
+    ``history``: :func:`convergence` (its ``target_n_eval``, the checkpoint a row stands for; the last
+    is the budget). A cell counts at a checkpoint where some median is finite. One row per (form,
+    algorithm), one column per checkpoint; sorted by form, then by the count at the budget (most first).
+    """
+    h = history.assign(form=history["family"].str.rsplit("-", n=1).str[-1])
+    keys = ["form", "family", "n_var", "target_n_eval"]
+    medians = h.groupby([*keys, "algorithm"])[indicator].median().dropna().reset_index()
+    lead = medians[medians[indicator] == medians.groupby(keys)[indicator].transform("min")]
+    counts = lead.groupby(["form", "algorithm", "target_n_eval"]).size().unstack("target_n_eval")
+    rows = pd.MultiIndex.from_frame(h[["form", "algorithm"]].drop_duplicates().sort_values(["form", "algorithm"]))
+    checkpoints = sorted(h["target_n_eval"].unique())
+    counts = counts.reindex(index=rows, columns=checkpoints).fillna(0).astype(int)
+    counts.columns = [f"{int(n):,} evals" for n in checkpoints]
+    counts = counts.reset_index()
+    return counts.sort_values(["form", counts.columns[-1]], ascending=[True, False], kind="stable").reset_index(drop=True)
+
+
 def report_values(study, full, frame: pd.DataFrame, records: Sequence[dict], pictures: Sequence[str],
-                  command: str, study_file: str) -> dict[str, str]:
+                  command: str, study_file: str, history: pd.DataFrame) -> dict[str, str]:
     """The values of a baseline report's template: what ran (``study``, cut from ``full``), its CPU,
-    the table (:func:`baseline_table`), the fronts scored against and the figures (``pictures``, file names)."""
+    the table (:func:`baseline_table`), the fronts scored against, who leads at each checkpoint of
+    ``history`` (:func:`convergence`, :func:`leaders_by_checkpoint` on the rank indicator) and the
+    figures (``pictures``, file names)."""
     table = baseline_table(frame)
     table["friedman_p"] = table["friedman_p"].map(lambda p: f"{p:.2g}")
     reduced = (len(study.problems), len(study.seeds), study.budget) != (len(full.problems), len(full.seeds), full.budget)
@@ -406,6 +429,7 @@ def report_values(study, full, frame: pd.DataFrame, records: Sequence[dict], pic
             "table": to_markdown(table, bold_marker=None), "fronts": fronts_statement(front_versions(records)),
             "ranks": to_markdown(rank_by_dimension(table), bold_marker=None),
             "top_group": to_markdown(top_group_by_dimension(table), bold_marker=None),
+            "leaders": to_markdown(leaders_by_checkpoint(history, frame_indicators(frame).rank), bold_marker=None),
             "checkpoints_kb": checkpoints_kb(records), "pictures": "\n".join(f"![{n}]({n})" for n in pictures)}
 
 
@@ -490,5 +514,5 @@ __all__ = ["INDICATORS", "RANK_INDICATOR", "EXACT_RESOLUTION_PCT", "EXACT_FRONT_
            "MULTI_OBJECTIVE", "ONE_OBJECTIVE", "indicator_set", "frame_indicators", "one_objective_optimum",
            "instance_of", "FrontScorer", "front_scorer", "baseline_indicators",
            "indicator_frame", "front_versions", "fronts_statement", "checkpoints_kb", "baseline_table",
-           "performance_profile", "convergence", "rank_by_dimension", "top_group_by_dimension", "report_values", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
+           "performance_profile", "convergence", "rank_by_dimension", "top_group_by_dimension", "leaders_by_checkpoint", "report_values", "cut_study", "cpu_per_evaluation_ms", "projected_cpu_h",
            "archive_records"]

@@ -183,6 +183,9 @@ def test_the_single_study_runs_and_reports_the_gap_to_the_optimum(tmp_path, caps
     assert "from `benchmarks/suite_baseline_single.toml`: 1 (family, n_var) cells x 5 algorithms x 2 seeds" in report
     rows = [line for line in report.splitlines() if line.startswith("| generated-metro-single")]
     assert len(rows) == 5 and all(line.count("|") > 8 for line in rows)
+    assert "| form | algorithm | 200 evals |" in report  # who leads at each checkpoint: n_eval 200 is the budget
+    leaders = [line.split("|") for line in report.splitlines() if line.startswith("| single |") and "evals" not in line]
+    assert sum(int(cells[-2]) for cells in leaders[-5:]) >= 1  # the last table: a leader in the one cell
     assert (out / "suite_baseline_single_convergence.png").is_file() and (out / "suite_baseline_single_profile.png").is_file()
     assert "the whole study (measured n_var 10)" in capsys.readouterr().out
 

@@ -7,8 +7,8 @@ import pandas as pd
 import pytest
 
 from pymoo_rail.experiments.baseline import (baseline_indicators, baseline_table, checkpoints_kb, convergence,
-                                             indicator_frame, instance_of, performance_profile, rank_by_dimension,
-                                             top_group_by_dimension)
+                                             indicator_frame, instance_of, leaders_by_checkpoint, performance_profile,
+                                             rank_by_dimension, top_group_by_dimension)
 from pymoo_rail.experiments.runner import execute_run
 from pymoo_rail.experiments.spec import Budget, RunSpec, algorithm, problem
 from pymoo_rail.suite import get_problem
@@ -227,6 +227,26 @@ def test_top_group_counts_the_families_an_algorithm_wins_or_ties():
     assert top.loc[("bi", "B"), "n_var 10"] == "1 / 1"  # separated from the best on metro
     assert top.loc[("bi", "B"), "n_var 300"] == "0 / 1"  # of metro alone: suburban has no ranks
     assert list(top.index) == list(rank_by_dimension(table).set_index(["form", "algorithm"]).index)
+
+
+def test_leaders_count_the_cells_with_the_lowest_median_at_each_checkpoint():
+    rows = []
+    for family, n_var, checkpoint, values in [
+            ("generated-metro-bi", 10, 200, {"A": (1, 2, 3), "B": (2, 3, 4)}),     # A's median 2 < B's 3
+            ("generated-metro-bi", 10, 1000, {"A": (5, 5, 9), "B": (1, 1, 9)}),    # B leads later
+            ("generated-metro-bi", 30, 200, {"A": (1, 1, 1), "B": (1, 1, 1)}),     # a tie: both count
+            ("generated-metro-bi", 30, 1000, {"A": (np.nan,) * 3, "B": (np.nan,) * 3}),  # no feasible run: no leader
+            ("generated-metro-3obj", 10, 200, {"A": (3, 3, 3), "B": (1, 9, 9)})]:  # the median, not the best seed
+        for name, scores in values.items():
+            rows += [{"family": family, "n_var": n_var, "algorithm": name, "seed": seed, "target_n_eval": checkpoint,
+                      "igd_plus": score} for seed, score in enumerate(scores, start=1)]
+    leaders = leaders_by_checkpoint(pd.DataFrame(rows), "igd_plus")
+    assert list(leaders.columns) == ["form", "algorithm", "200 evals", "1,000 evals"]
+    table = leaders.set_index(["form", "algorithm"])
+    assert table.loc[("bi", "A")].tolist() == [2, 0] and table.loc[("bi", "B")].tolist() == [1, 1]
+    assert table.loc[("3obj", "A")].tolist() == [1, 0] and table.loc[("3obj", "B")].tolist() == [0, 0]
+    assert list(leaders["form"]) == ["3obj", "3obj", "bi", "bi"]
+    assert list(leaders.loc[leaders["form"] == "bi", "algorithm"]) == ["B", "A"]  # most cells led at the budget first
 
 
 def test_top_group_of_a_real_table(records):
