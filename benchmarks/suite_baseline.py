@@ -118,7 +118,7 @@ def main(argv=None) -> int:
     if not args.report_only:
         run_study(study, work, workers=args.workers, scheduler="local" if args.dask else None, seed_major=True,
                   trusted=trusted)
-    records = load_records(work, study, trusted=trusted)
+    records = load_records(work, study, trusted=trusted, decisions=False)  # scored on objective vectors alone
     if not records:
         raise SystemExit(f"no stored runs in {work}")
     frame, out = indicator_frame(records), Path(args.out)

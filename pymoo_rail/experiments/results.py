@@ -28,7 +28,7 @@ def _study_of(directory: Path, study: Study | None) -> Study | None:
 
 
 def load_records(directory: str | Path, study: Study | None = None, all_runs: bool = False,
-                 trusted: bool = False) -> list[dict]:
+                 trusted: bool = False, decisions: bool = True) -> list[dict]:
     """The stored records of a study directory.
 
     Parameters
@@ -49,6 +49,10 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
         looks the module up, which imports its packages. Without it such a study is an
         :class:`~pymoo_rail.experiments.registry.UntrustedCodeError` naming the entry; nothing
         the folder names is imported.
+    decisions : bool
+        Keep each final front's decision vectors (``front["X"]``). ``False`` drops them once the
+        record has passed its checks: they are most of a large study's records (a suite
+        baseline table's report needs its objective vectors alone).
 
     Raises
     ------
@@ -61,7 +65,7 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
     study = None if all_runs else _study_of(directory, study)
     store = ResultStore(directory)
     if study is None:
-        return list(store.records())
+        return [_lean(record, decisions) for record in store.records()]
     check_trust(study, trusted)
     runs = {r.run_id: r for r in study.runs()}
     records = []
@@ -80,12 +84,19 @@ def load_records(directory: str | Path, study: Study | None = None, all_runs: bo
             continue
         record["problem_label"] = run.problem.display
         record["algorithm_label"] = run.algorithm.display
-        records.append(record)
+        records.append(_lean(record, decisions))
     if other_code:
         warnings.warn(f"{len(other_code)} of the records in {directory} were computed by other code (e.g. "
                       f"{other_code[0]}); they are shown as stored: run the study again to recompute them",
                       stacklevel=2)
     return records
+
+
+def _lean(record: dict, decisions: bool) -> dict:
+    """``record`` as it is, or without its front's decision vectors."""
+    if not decisions:
+        record["front"] = {key: value for key, value in record["front"].items() if key != "X"}
+    return record
 
 
 def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
@@ -111,6 +122,9 @@ def records_frame(records: list[dict], fronts: bool = True) -> pd.DataFrame:
         row["unavailable"] = dict(r.get("unavailable", {}))
         row.update({k: v for k, v in r.get("counters", {}).items() if k not in row})
         if fronts:
+            if "X" not in r["front"]:
+                raise ValueError(f"records_frame: run {r['run_id']} was loaded without its decision vectors "
+                                 "(load_records(..., decisions=False)); pass fronts=False or load it with them")
             n_obj, n_var = r["n_obj"], r["n_var"]
             row["F"] = np.asarray(r["front"]["F"], dtype=float).reshape(-1, n_obj)
             row["X"] = np.asarray(r["front"]["X"], dtype=float).reshape(-1, n_var)

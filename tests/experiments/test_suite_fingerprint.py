@@ -18,6 +18,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 import pymoo_rail
@@ -25,7 +26,7 @@ from pymoo_rail.experiments import inputs as inputs_module
 from pymoo_rail.experiments.inputs import (SUITE_RUN_PARTS, TRIP_RUN_PARTS, code_parts, front_digest, in_parts,
                                            resolve_run)
 from pymoo_rail.experiments.baseline import front_versions, fronts_statement, indicator_frame
-from pymoo_rail.experiments.results import load_records
+from pymoo_rail.experiments.results import load_records, records_frame
 from pymoo_rail.experiments.runner import execute_run, run_study
 from pymoo_rail.experiments.spec import Budget, RunSpec, Study, algorithm, problem
 from pymoo_rail.suite import get_problem
@@ -178,6 +179,19 @@ def _scaled_front(front, factor: float):
     table = front.table.copy()
     table["energy_kwh"] = table["energy_kwh"] * factor
     return replace(front, table=table)
+
+
+def test_records_loaded_without_decision_vectors_score_the_same(tmp_path):
+    study = _suite_study()
+    run_study(study, tmp_path, workers=1, progress=False)
+    full, lean = load_records(tmp_path, study), load_records(tmp_path, study, decisions=False)
+    assert len(full[0]["front"]["X"]) == len(full[0]["front"]["F"]) > 0
+    assert "X" not in lean[0]["front"] and lean[0]["front"]["F"] == full[0]["front"]["F"]
+    pd.testing.assert_frame_equal(indicator_frame(lean), indicator_frame(full))
+    assert "X" not in load_records(tmp_path, all_runs=True, decisions=False)[0]["front"]
+    with pytest.raises(ValueError, match="decisions=False.*fronts=False"):
+        records_frame(lean)
+    assert len(records_frame(lean, fronts=False)) == 1
 
 
 def test_stored_suite_runs_stay_current_when_the_front_improves_and_their_scores_follow_it(tmp_path, monkeypatch):
