@@ -352,6 +352,11 @@ def convergence(records: Iterable[dict]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _form(families: pd.Series) -> pd.Series:
+    """Each family's form, the last part of its name (``generated-metro-bi`` -> ``bi``)."""
+    return families.str.rsplit("-", n=1).str[-1]
+
+
 def rank_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
     """How the ranking changes with the dimension: each algorithm's Friedman mean rank averaged over
     the families of the same form (``-bi``, ``-3obj``, ...), per ``n_var``.
@@ -360,7 +365,7 @@ def rank_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
     without ranks (fewer than 2 paired seeds) stays NaN. Sorted by form, then by the mean rank at the
     largest ``n_var``.
     """
-    ranks = table.assign(form=table["family"].str.rsplit("-", n=1).str[-1],
+    ranks = table.assign(form=_form(table["family"]),
                          mean_rank=pd.to_numeric(table["mean_rank"], errors="coerce"))
     # NaN unless every family of the form has ranks there: a mean over some families would mislead
     out = ranks.pivot_table(index=["form", "algorithm"], columns="n_var", values="mean_rank", dropna=False,
@@ -377,7 +382,7 @@ def top_group_by_dimension(table: pd.DataFrame) -> pd.DataFrame:
     ``table``: :func:`baseline_table`. One row per (form, algorithm), one column per ``n_var``; ``"-"``
     where no family of the form has ranks at that ``n_var``. Sorted as :func:`rank_by_dimension`.
     """
-    marks = table.assign(form=table["family"].str.rsplit("-", n=1).str[-1])
+    marks = table.assign(form=_form(table["family"]))
     marks = marks[marks["mark"].isin(["best", "=", "-"])]  # "n/a": too few paired seeds to rank
     counts = marks.assign(best=marks["mark"] == "best", top=marks["mark"].isin(["best", "="])).groupby(
         ["form", "algorithm", "n_var"])[["best", "top"]].sum()
@@ -397,7 +402,7 @@ def leaders_by_checkpoint(history: pd.DataFrame, indicator: str) -> pd.DataFrame
     is the budget). A cell counts at a checkpoint where some median is finite. One row per (form,
     algorithm), one column per checkpoint; sorted by form, then by the count at the budget (most first).
     """
-    h = history.assign(form=history["family"].str.rsplit("-", n=1).str[-1])
+    h = history.assign(form=_form(history["family"]))
     keys = ["form", "family", "n_var", "target_n_eval"]
     medians = h.groupby([*keys, "algorithm"])[indicator].median().dropna().reset_index()
     lead = medians[medians[indicator] == medians.groupby(keys)[indicator].transform("min")]

@@ -25,10 +25,11 @@ def plot_cell_convergence(history: pd.DataFrame, indicator: str = "igd_plus"):
     colours = {name: cycle[i % len(cycle)] for i, name in enumerate(sorted(history["algorithm"].unique()))}
     fig, axes = plt.subplots(len(families), len(ladder), figsize=(3.2 * len(ladder), 2.6 * len(families) + 0.6),
                              squeeze=False)
+    cells = dict(iter(history.groupby(["family", "n_var"])))  # one pass, not one scan a panel
     for row, family in zip(axes, families):
         for ax, n_var in zip(row, ladder):
-            cell = history[(history["family"] == family) & (history["n_var"] == n_var)]
-            if cell.empty:
+            cell = cells.get((family, n_var))
+            if cell is None:
                 ax.set_axis_off()
                 continue
             for name, runs in cell.groupby("algorithm"):
